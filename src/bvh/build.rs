@@ -1,0 +1,184 @@
+//! Top-down construction. Large subtrees are built in parallel with `rayon::join` and
+//! concatenated (depth-first order is preserved, so the result does not depend on the thread
+//! count); small ones are built with an explicit stack, so no input can overflow the call stack.
+
+use super::{BuildOptions, Bvh, Node, Strategy};
+use crate::geom::{Aabb, DVec3};
+
+/// SAH bins per axis. Wald (2007) reports 16–32 bins lose almost nothing against a full sweep.
+const BINS: usize = 16;
+/// Subtrees larger than this are split across threads.
+const PAR_THRESHOLD: usize = 16 * 1024;
+/// Beyond this depth parallel recursion stops (bounds the call stack on lopsided splits).
+const PAR_MAX_DEPTH: usize = 32;
+
+struct Input<'a> {
+    boxes: &'a [Aabb],
+    cents: &'a [DVec3],
+    opts: BuildOptions,
+}
+
+pub(super) fn build(boxes: &[Aabb], opts: BuildOptions) -> Bvh {
+    let opts = BuildOptions { leaf_size: opts.leaf_size.clamp(1, 255), ..opts };
+    let cents: Vec<DVec3> = boxes.iter().map(Aabb::center).collect();
+    let mut prims: Vec<u32> = (0..boxes.len() as u32).collect();
+    if boxes.is_empty() {
+        return Bvh { nodes: Vec::new(), prims };
+    }
+    let input = Input { boxes, cents: &cents, opts };
+    let nodes = subtree(&input, &mut prims, 0, 0);
+    Bvh { nodes, prims }
+}
+
+fn bounds_of(input: &Input, prims: &[u32]) -> Aabb {
+    prims.iter().fold(Aabb::EMPTY, |b, &p| b.union(input.boxes[p as usize]))
+}
+
+fn subtree(input: &Input, prims: &mut [u32], base: u32, depth: usize) -> Vec<Node> {
+    if prims.len() <= PAR_THRESHOLD || depth >= PAR_MAX_DEPTH {
+        return sequential(input, prims, base);
+    }
+    let bounds = bounds_of(input, prims);
+    let mid = split(input, prims);
+    let (l, r) = prims.split_at_mut(mid);
+    let (ln, rn) = rayon::join(
+        || subtree(input, l, base, depth + 1),
+        || subtree(input, r, base + mid as u32, depth + 1),
+    );
+    let mut nodes = Vec::with_capacity(1 + ln.len() + rn.len());
+    nodes.push(Node { bounds, a: 1 + ln.len() as u32, count: 0 });
+    for part in [ln, rn] {
+        let off = nodes.len() as u32;
+        nodes.extend(part.into_iter().map(|mut n| {
+            if !n.is_leaf() {
+                n.a += off;
+            }
+            n
+        }));
+    }
+    nodes
+}
+
+/// Depth-first build of one subtree with an explicit stack. Node indices are local.
+fn sequential(input: &Input, prims: &mut [u32], base: u32) -> Vec<Node> {
+    let mut nodes: Vec<Node> = Vec::with_capacity(2 * prims.len() / input.opts.leaf_size as usize + 1);
+    // (start, end, parent whose right child this is)
+    let mut stack: Vec<(usize, usize, Option<usize>)> = vec![(0, prims.len(), None)];
+    while let Some((start, end, right_of)) = stack.pop() {
+        let idx = nodes.len();
+        if let Some(p) = right_of {
+            nodes[p].a = idx as u32;
+        }
+        let slice = &mut prims[start..end];
+        let bounds = bounds_of(input, slice);
+        if slice.len() <= input.opts.leaf_size as usize {
+            nodes.push(Node { bounds, a: base + start as u32, count: slice.len() as u32 });
+            continue;
+        }
+        let mid = start + split(input, slice);
+        nodes.push(Node { bounds, a: 0, count: 0 });
+        stack.push((mid, end, Some(idx)));
+        stack.push((start, mid, None));
+    }
+    nodes
+}
+
+/// Partition `prims` in place and return the split point, in `1..prims.len()`.
+fn split(input: &Input, prims: &mut [u32]) -> usize {
+    let n = prims.len();
+    let cb = prims.iter().fold(Aabb::EMPTY, |b, &p| b.grow(input.cents[p as usize]));
+    let ext = cb.extent();
+    let axis = if ext.x >= ext.y && ext.x >= ext.z {
+        0
+    } else if ext.y >= ext.z {
+        1
+    } else {
+        2
+    };
+    if ext[axis] <= 0.0 {
+        return n / 2; // all centroids coincide: any split is as good as another
+    }
+    let mid = match input.opts.strategy {
+        Strategy::Sah => sah_split(input, prims, &cb),
+        Strategy::Median => {
+            let plane = cb.center()[axis];
+            partition(prims, |p| input.cents[p as usize][axis] < plane)
+        }
+        Strategy::Equal => {
+            let k = n / 2;
+            let c = input.cents;
+            prims.select_nth_unstable_by(k, |&p, &q| {
+                c[p as usize][axis].total_cmp(&c[q as usize][axis]).then(p.cmp(&q))
+            });
+            k
+        }
+    };
+    if mid == 0 || mid == n {
+        n / 2
+    } else {
+        mid
+    }
+}
+
+#[inline]
+fn bin_of(c: f64, min: f64, scale: f64) -> usize {
+    (((c - min) * scale) as usize).min(BINS - 1)
+}
+
+/// Binned SAH over all three axes; returns the partition point.
+fn sah_split(input: &Input, prims: &mut [u32], cb: &Aabb) -> usize {
+    let mut best = (f64::INFINITY, 0usize, 0usize); // (cost, axis, first bin of the right side)
+    for axis in 0..3 {
+        let (min, ext) = (cb.min[axis], cb.extent()[axis]);
+        if ext <= 0.0 {
+            continue;
+        }
+        let scale = BINS as f64 / ext;
+        let mut counts = [0usize; BINS];
+        let mut boxes = [Aabb::EMPTY; BINS];
+        for &p in prims.iter() {
+            let b = bin_of(input.cents[p as usize][axis], min, scale);
+            counts[b] += 1;
+            boxes[b] = boxes[b].union(input.boxes[p as usize]);
+        }
+        // Right-to-left sweep: area and count of bins[i..].
+        let mut right = [(0.0f64, 0usize); BINS];
+        let (mut acc, mut cnt) = (Aabb::EMPTY, 0);
+        for i in (1..BINS).rev() {
+            acc = acc.union(boxes[i]);
+            cnt += counts[i];
+            right[i] = (acc.half_area(), cnt);
+        }
+        let (mut acc, mut cnt) = (Aabb::EMPTY, 0);
+        for i in 1..BINS {
+            acc = acc.union(boxes[i - 1]);
+            cnt += counts[i - 1];
+            let (ra, rc) = right[i];
+            if cnt == 0 || rc == 0 {
+                continue;
+            }
+            let cost = acc.half_area() * cnt as f64 + ra * rc as f64;
+            if cost < best.0 {
+                best = (cost, axis, i);
+            }
+        }
+    }
+    if !best.0.is_finite() {
+        return prims.len() / 2;
+    }
+    let (_, axis, split_bin) = best;
+    let (min, scale) = (cb.min[axis], BINS as f64 / cb.extent()[axis]);
+    partition(prims, |p| bin_of(input.cents[p as usize][axis], min, scale) < split_bin)
+}
+
+/// In-place partition (deterministic): elements satisfying `left` first; returns their count.
+fn partition(prims: &mut [u32], left: impl Fn(u32) -> bool) -> usize {
+    let mut i = 0;
+    for j in 0..prims.len() {
+        if left(prims[j]) {
+            prims.swap(i, j);
+            i += 1;
+        }
+    }
+    i
+}

@@ -1,0 +1,264 @@
+//! Simultaneous (dual-tree) walks of two BVHs. The leaf work is passed in as closures, so the
+//! walk knows nothing about triangles and is tested with fake leaves.
+//!
+//! Both walks descend the larger node of a pair (by surface area; a leaf is never split), keep
+//! an explicit stack (no recursion limit), and run in parallel: the root pair is expanded
+//! breadth-first into a fixed number of independent sub-walks, which rayon runs on any number of
+//! threads. The seeding does not depend on the thread count and results are merged in seed order,
+//! so the output is the same whatever the number of threads.
+
+use crate::bvh::{Bvh, Node};
+use crate::geom::Aabb;
+use rayon::prelude::*;
+use std::sync::atomic::{AtomicU64, Ordering};
+
+/// How many independent sub-walks the root pair is split into (fixed, for determinism).
+const SEED_TASKS: usize = 256;
+
+/// Which node of a pair to open: the larger, never a leaf. `None` when both are leaves.
+#[inline]
+fn open_a(a: &Node, b: &Node) -> Option<bool> {
+    match (a.is_leaf(), b.is_leaf()) {
+        (true, true) => None,
+        (true, false) => Some(false),
+        (false, true) => Some(true),
+        (false, false) => Some(a.bounds.half_area() >= b.bounds.half_area()),
+    }
+}
+
+/// The two children pairs of `(i, j)` after opening one side.
+#[inline]
+fn children(ta: &Bvh, tb: &Bvh, i: u32, j: u32) -> Option<[(u32, u32); 2]> {
+    let (a, b) = (&ta.nodes[i as usize], &tb.nodes[j as usize]);
+    Some(if open_a(a, b)? { [(i + 1, j), (a.a, j)] } else { [(i, j + 1), (i, b.a)] })
+}
+
+/// Breadth-first expansion of the root pair into about `SEED_TASKS` pairs that pass `keep`.
+fn seed(ta: &Bvh, tb: &Bvh, keep: &dyn Fn(&Aabb, &Aabb) -> bool) -> Vec<(u32, u32)> {
+    if ta.nodes.is_empty() || tb.nodes.is_empty() || !keep(&ta.nodes[0].bounds, &tb.nodes[0].bounds)
+    {
+        return Vec::new();
+    }
+    let mut level = vec![(0u32, 0u32)];
+    loop {
+        let mut next = Vec::with_capacity(level.len() * 2);
+        let mut opened = false;
+        for &(i, j) in &level {
+            match children(ta, tb, i, j) {
+                None => next.push((i, j)),
+                Some(kids) => {
+                    opened = true;
+                    for (ci, cj) in kids {
+                        if keep(&ta.nodes[ci as usize].bounds, &tb.nodes[cj as usize].bounds) {
+                            next.push((ci, cj));
+                        }
+                    }
+                }
+            }
+        }
+        level = next;
+        if !opened || level.len() >= SEED_TASKS || level.is_empty() {
+            return level;
+        }
+    }
+}
+
+/// Visit every pair of leaves whose boxes pass `boxes_meet` (tested on every node pair on the
+/// way down) and let `leaf` turn the two leaves' triangle lists into results. Results come back
+/// in an order that depends only on the trees, not on the thread count.
+pub fn collect_pairs<T, M, L>(ta: &Bvh, tb: &Bvh, boxes_meet: M, leaf: L) -> Vec<T>
+where
+    T: Send,
+    M: Fn(&Aabb, &Aabb) -> bool + Sync,
+    L: Fn(&[u32], &[u32], &mut Vec<T>) + Sync,
+{
+    let seeds = seed(ta, tb, &boxes_meet);
+    let parts: Vec<Vec<T>> = seeds
+        .par_iter()
+        .map(|&s| {
+            let mut out = Vec::new();
+            let mut stack = vec![s];
+            while let Some((i, j)) = stack.pop() {
+                match children(ta, tb, i, j) {
+                    None => {
+                        let (a, b) = (&ta.nodes[i as usize], &tb.nodes[j as usize]);
+                        leaf(ta.leaf_prims(a), tb.leaf_prims(b), &mut out);
+                    }
+                    Some(kids) => {
+                        for &(ci, cj) in kids.iter().rev() {
+                            let (a, b) = (&ta.nodes[ci as usize], &tb.nodes[cj as usize]);
+                            if boxes_meet(&a.bounds, &b.bounds) {
+                                stack.push((ci, cj));
+                            }
+                        }
+                    }
+                }
+            }
+            out
+        })
+        .collect();
+    parts.into_iter().flatten().collect()
+}
+
+/// A candidate for [`min_pair`]: its distance and a key that breaks ties deterministically.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Candidate<R> {
+    /// The (non-negative) distance.
+    pub distance: f64,
+    /// Tie-break key (lowest wins), e.g. the two triangle indices.
+    pub key: (u32, u32),
+    /// Whatever the leaf wants to return with it.
+    pub data: R,
+}
+
+fn better<R>(x: &Candidate<R>, y: &Candidate<R>) -> bool {
+    (x.distance, x.key) < (y.distance, y.key)
+}
+
+/// Branch-and-bound search for the closest pair: node pairs are pruned when the lower bound
+/// `box_distance` of their boxes exceeds the best distance found so far plus `slack` (the
+/// caller's bound on f64 rounding of distances, so that no pair that could tie is pruned). The
+/// winner is the minimum of (distance, key) over all candidates that could be it, so the answer
+/// does not depend on the thread count or on the order in which threads find candidates.
+pub fn min_pair<R, D, L>(ta: &Bvh, tb: &Bvh, box_distance: D, slack: f64, leaf: L) -> Option<Candidate<R>>
+where
+    R: Send + Copy,
+    D: Fn(&Aabb, &Aabb) -> f64 + Sync,
+    L: Fn(&[u32], &[u32], f64) -> Option<Candidate<R>> + Sync,
+{
+    // Best distance so far, as f64 bits (order-preserving for non-negative values).
+    let best = AtomicU64::new(f64::INFINITY.to_bits());
+    let bound = |best: &AtomicU64| f64::from_bits(best.load(Ordering::Relaxed)) + slack;
+    let mut seeds: Vec<(f64, u32, u32)> = seed(ta, tb, &|_, _| true)
+        .into_iter()
+        .map(|(i, j)| (box_distance(&ta.nodes[i as usize].bounds, &tb.nodes[j as usize].bounds), i, j))
+        .collect();
+    seeds.sort_by(|x, y| x.0.total_cmp(&y.0).then((x.1, x.2).cmp(&(y.1, y.2))));
+    let found: Vec<Option<Candidate<R>>> = seeds
+        .par_iter()
+        .map(|&(lb, i, j)| {
+            let mut mine: Option<Candidate<R>> = None;
+            if lb > bound(&best) {
+                return None;
+            }
+            let mut stack = vec![(lb, i, j)];
+            while let Some((lb, i, j)) = stack.pop() {
+                if lb > bound(&best) {
+                    continue;
+                }
+                match children(ta, tb, i, j) {
+                    None => {
+                        let (a, b) = (&ta.nodes[i as usize], &tb.nodes[j as usize]);
+                        let cur = f64::from_bits(best.load(Ordering::Relaxed));
+                        if let Some(c) = leaf(ta.leaf_prims(a), tb.leaf_prims(b), cur + slack) {
+                            best.fetch_min(c.distance.to_bits(), Ordering::Relaxed);
+                            if mine.as_ref().is_none_or(|m| better(&c, m)) {
+                                mine = Some(c);
+                            }
+                        }
+                    }
+                    Some(kids) => {
+                        let d = kids.map(|(ci, cj)| {
+                            box_distance(&ta.nodes[ci as usize].bounds, &tb.nodes[cj as usize].bounds)
+                        });
+                        // Push the farther first so the nearer is opened first.
+                        let order = if d[0] <= d[1] { [1, 0] } else { [0, 1] };
+                        for k in order {
+                            if d[k] <= bound(&best) {
+                                stack.push((d[k], kids[k].0, kids[k].1));
+                            }
+                        }
+                    }
+                }
+            }
+            mine
+        })
+        .collect();
+    found.into_iter().flatten().reduce(|x, y| if better(&y, &x) { y } else { x })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::bvh::{BuildOptions, Strategy};
+    use crate::geom::DVec3;
+
+    fn unit_boxes(n: usize, offset: f64) -> Vec<Aabb> {
+        // A row of unit-ish boxes along x, spaced 2 apart.
+        (0..n)
+            .map(|i| {
+                let x = offset + 2.0 * i as f64;
+                Aabb { min: DVec3::new(x, 0.0, 0.0), max: DVec3::new(x + 1.0, 1.0, 1.0) }
+            })
+            .collect()
+    }
+
+    #[test]
+    fn fake_leaves_find_exactly_the_overlapping_box_pairs() {
+        let a = unit_boxes(300, 0.0);
+        let b = unit_boxes(200, 1.0); // b_k touches a_k and a_{k+1} at faces
+        for strategy in [Strategy::Sah, Strategy::Median, Strategy::Equal] {
+            for leaf_size in [1, 4] {
+                let opts = BuildOptions { strategy, leaf_size };
+                let (ta, tb) = (Bvh::build_from_boxes(&a, opts), Bvh::build_from_boxes(&b, opts));
+                let mut got = collect_pairs(&ta, &tb, |x, y| x.overlaps(y), |la, lb, out| {
+                    for &i in la {
+                        for &j in lb {
+                            if a[i as usize].overlaps(&b[j as usize]) {
+                                out.push((i, j));
+                            }
+                        }
+                    }
+                });
+                got.sort();
+                let mut want = Vec::new();
+                for i in 0..a.len() as u32 {
+                    for j in 0..b.len() as u32 {
+                        if a[i as usize].overlaps(&b[j as usize]) {
+                            want.push((i, j));
+                        }
+                    }
+                }
+                assert_eq!(got, want, "{strategy:?} leaf {leaf_size}");
+                assert_eq!(want.len(), 400);
+            }
+        }
+    }
+
+    #[test]
+    fn branch_and_bound_finds_the_brute_force_minimum() {
+        let a = unit_boxes(100, 0.0);
+        let b: Vec<Aabb> = unit_boxes(100, 0.0)
+            .into_iter()
+            .map(|x| Aabb { min: x.min + DVec3::new(0.3, 0.0, 5.0), max: x.max + DVec3::new(0.3, 0.0, 5.0) })
+            .collect();
+        let opts = BuildOptions::default();
+        let (ta, tb) = (Bvh::build_from_boxes(&a, opts), Bvh::build_from_boxes(&b, opts));
+        let got = min_pair(&ta, &tb, |x, y| x.distance_sq(y).sqrt(), 0.0, |la, lb, _| {
+            let mut best: Option<Candidate<()>> = None;
+            for &i in la {
+                for &j in lb {
+                    let c = Candidate { distance: a[i as usize].distance_sq(&b[j as usize]).sqrt(), key: (i, j), data: () };
+                    if best.as_ref().is_none_or(|m| better(&c, m)) {
+                        best = Some(c);
+                    }
+                }
+            }
+            best
+        })
+        .unwrap();
+        // Every b box sits 4 above its a box: all 100 (i, i) pairs tie at 4, and also the
+        // neighbours overlapping in x; the lowest key wins.
+        assert_eq!(got.distance, 4.0);
+        assert_eq!(got.key, (0, 0));
+    }
+
+    #[test]
+    fn empty_trees_give_nothing() {
+        let a = unit_boxes(10, 0.0);
+        let ta = Bvh::build_from_boxes(&a, BuildOptions::default());
+        let tb = Bvh::build_from_boxes(&[], BuildOptions::default());
+        let got: Vec<()> = collect_pairs(&ta, &tb, |_, _| true, |_, _, _| {});
+        assert!(got.is_empty());
+    }
+}
