@@ -14,9 +14,14 @@
 #![deny(missing_docs)]
 
 pub mod bvh;
+pub mod cli;
+pub mod distance;
 pub mod error;
 pub mod geom;
+pub mod load;
 pub mod mesh;
+pub mod query;
+pub mod report;
 pub mod traverse;
 pub mod tri_tri;
 

@@ -19,19 +19,31 @@ struct Input<'a> {
 }
 
 pub(super) fn build(boxes: &[Aabb], opts: BuildOptions) -> Bvh {
-    let opts = BuildOptions { leaf_size: opts.leaf_size.clamp(1, 255), ..opts };
+    let opts = BuildOptions {
+        leaf_size: opts.leaf_size.clamp(1, 255),
+        ..opts
+    };
     let cents: Vec<DVec3> = boxes.iter().map(Aabb::center).collect();
     let mut prims: Vec<u32> = (0..boxes.len() as u32).collect();
     if boxes.is_empty() {
-        return Bvh { nodes: Vec::new(), prims };
+        return Bvh {
+            nodes: Vec::new(),
+            prims,
+        };
     }
-    let input = Input { boxes, cents: &cents, opts };
+    let input = Input {
+        boxes,
+        cents: &cents,
+        opts,
+    };
     let nodes = subtree(&input, &mut prims, 0, 0);
     Bvh { nodes, prims }
 }
 
 fn bounds_of(input: &Input, prims: &[u32]) -> Aabb {
-    prims.iter().fold(Aabb::EMPTY, |b, &p| b.union(input.boxes[p as usize]))
+    prims
+        .iter()
+        .fold(Aabb::EMPTY, |b, &p| b.union(input.boxes[p as usize]))
 }
 
 fn subtree(input: &Input, prims: &mut [u32], base: u32, depth: usize) -> Vec<Node> {
@@ -46,7 +58,11 @@ fn subtree(input: &Input, prims: &mut [u32], base: u32, depth: usize) -> Vec<Nod
         || subtree(input, r, base + mid as u32, depth + 1),
     );
     let mut nodes = Vec::with_capacity(1 + ln.len() + rn.len());
-    nodes.push(Node { bounds, a: 1 + ln.len() as u32, count: 0 });
+    nodes.push(Node {
+        bounds,
+        a: 1 + ln.len() as u32,
+        count: 0,
+    });
     for part in [ln, rn] {
         let off = nodes.len() as u32;
         nodes.extend(part.into_iter().map(|mut n| {
@@ -61,7 +77,8 @@ fn subtree(input: &Input, prims: &mut [u32], base: u32, depth: usize) -> Vec<Nod
 
 /// Depth-first build of one subtree with an explicit stack. Node indices are local.
 fn sequential(input: &Input, prims: &mut [u32], base: u32) -> Vec<Node> {
-    let mut nodes: Vec<Node> = Vec::with_capacity(2 * prims.len() / input.opts.leaf_size as usize + 1);
+    let mut nodes: Vec<Node> =
+        Vec::with_capacity(2 * prims.len() / input.opts.leaf_size as usize + 1);
     // (start, end, parent whose right child this is)
     let mut stack: Vec<(usize, usize, Option<usize>)> = vec![(0, prims.len(), None)];
     while let Some((start, end, right_of)) = stack.pop() {
@@ -72,11 +89,19 @@ fn sequential(input: &Input, prims: &mut [u32], base: u32) -> Vec<Node> {
         let slice = &mut prims[start..end];
         let bounds = bounds_of(input, slice);
         if slice.len() <= input.opts.leaf_size as usize {
-            nodes.push(Node { bounds, a: base + start as u32, count: slice.len() as u32 });
+            nodes.push(Node {
+                bounds,
+                a: base + start as u32,
+                count: slice.len() as u32,
+            });
             continue;
         }
         let mid = start + split(input, slice);
-        nodes.push(Node { bounds, a: 0, count: 0 });
+        nodes.push(Node {
+            bounds,
+            a: 0,
+            count: 0,
+        });
         stack.push((mid, end, Some(idx)));
         stack.push((start, mid, None));
     }
@@ -86,7 +111,9 @@ fn sequential(input: &Input, prims: &mut [u32], base: u32) -> Vec<Node> {
 /// Partition `prims` in place and return the split point, in `1..prims.len()`.
 fn split(input: &Input, prims: &mut [u32]) -> usize {
     let n = prims.len();
-    let cb = prims.iter().fold(Aabb::EMPTY, |b, &p| b.grow(input.cents[p as usize]));
+    let cb = prims
+        .iter()
+        .fold(Aabb::EMPTY, |b, &p| b.grow(input.cents[p as usize]));
     let ext = cb.extent();
     let axis = if ext.x >= ext.y && ext.x >= ext.z {
         0
@@ -108,7 +135,9 @@ fn split(input: &Input, prims: &mut [u32]) -> usize {
             let k = n / 2;
             let c = input.cents;
             prims.select_nth_unstable_by(k, |&p, &q| {
-                c[p as usize][axis].total_cmp(&c[q as usize][axis]).then(p.cmp(&q))
+                c[p as usize][axis]
+                    .total_cmp(&c[q as usize][axis])
+                    .then(p.cmp(&q))
             });
             k
         }
@@ -168,7 +197,9 @@ fn sah_split(input: &Input, prims: &mut [u32], cb: &Aabb) -> usize {
     }
     let (_, axis, split_bin) = best;
     let (min, scale) = (cb.min[axis], BINS as f64 / cb.extent()[axis]);
-    partition(prims, |p| bin_of(input.cents[p as usize][axis], min, scale) < split_bin)
+    partition(prims, |p| {
+        bin_of(input.cents[p as usize][axis], min, scale) < split_bin
+    })
 }
 
 /// In-place partition (deterministic): elements satisfying `left` first; returns their count.

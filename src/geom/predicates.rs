@@ -19,7 +19,11 @@ pub type Sign = i8;
 
 #[inline]
 fn c3(p: DVec3) -> Coord3D<f64> {
-    Coord3D { x: p.x, y: p.y, z: p.z }
+    Coord3D {
+        x: p.x,
+        y: p.y,
+        z: p.z,
+    }
 }
 
 #[inline]
@@ -57,7 +61,11 @@ pub fn project(p: DVec3, axis: usize) -> Coord<f64> {
 /// projected along `axis`.
 #[inline]
 pub fn orient2d(a: DVec3, b: DVec3, c: DVec3, axis: usize) -> Sign {
-    sign(robust::orient2d(project(a, axis), project(b, axis), project(c, axis)))
+    sign(robust::orient2d(
+        project(a, axis),
+        project(b, axis),
+        project(c, axis),
+    ))
 }
 
 /// Exact: are the three points collinear (or coincident)? True iff every component of
@@ -89,6 +97,19 @@ pub fn line_axis(p: DVec3, q: DVec3) -> usize {
         2
     }
 }
+
+/// How much f64 rounding may move a closed-form triangle–triangle distance between inputs whose
+/// coordinates are at most `scale` in magnitude: `DISTANCE_ROUNDING_ULPS` ulps of `scale`.
+/// The closest-pair search never prunes a node pair whose box distance is within this of the
+/// best distance found, so that every pair that could tie is evaluated and the reported pair
+/// does not depend on the thread count. It is a search margin, not a tolerance on any verdict.
+pub fn distance_rounding_slack(scale: f64) -> f64 {
+    DISTANCE_ROUNDING_ULPS * f64::EPSILON * scale
+}
+
+/// See [`distance_rounding_slack`]. The closed forms take a few dozen roundings on differences
+/// of coordinates; 64 ulps of the coordinate scale bounds them with room to spare.
+pub const DISTANCE_ROUNDING_ULPS: f64 = 64.0;
 
 /// User tolerances, all in model units (absolute), all zero by default.
 ///
@@ -163,13 +184,20 @@ mod tests {
         let b = DVec3::new(0.0, 1.0e8 + 3.0, z);
         let c = DVec3::new(-1.0e8 + 0.5, -7.0, z);
         let up = f64::from_bits(z.to_bits() + 1);
-        assert_eq!(orient3d(a, b, c, DVec3::new(0.25, 0.75, up)), orient3d(a, b, c, a + DVec3::Z));
+        assert_eq!(
+            orient3d(a, b, c, DVec3::new(0.25, 0.75, up)),
+            orient3d(a, b, c, a + DVec3::Z)
+        );
         assert_eq!(orient3d(a, b, c, DVec3::new(0.25, 0.75, z)), 0);
     }
 
     #[test]
     fn orient2d_projection_matches_normal_component() {
-        let (a, b, c) = (DVec3::ZERO, DVec3::new(1.0, 2.0, 3.0), DVec3::new(-2.0, 0.5, 1.0));
+        let (a, b, c) = (
+            DVec3::ZERO,
+            DVec3::new(1.0, 2.0, 3.0),
+            DVec3::new(-2.0, 0.5, 1.0),
+        );
         let n = (b - a).cross(c - a);
         for k in 0..3 {
             assert_eq!(orient2d(a, b, c, k) as f64, n[k].signum());
@@ -193,11 +221,20 @@ mod tests {
         let t = Tolerances::default();
         assert!(!t.is_touch(0.0), "zero tolerance never consults distances");
         assert!(!t.is_clearance(0.0));
-        let t = Tolerances { touch: 0.5, clearance: 2.0 };
+        let t = Tolerances {
+            touch: 0.5,
+            clearance: 2.0,
+        };
         assert!(t.is_touch(0.5) && !t.is_touch(0.51));
         assert!(t.is_clearance(1.99) && !t.is_clearance(2.0));
-        let a = Aabb { min: DVec3::ZERO, max: DVec3::ONE };
-        let b = Aabb { min: DVec3::new(3.0, 0.0, 0.0), max: DVec3::new(4.0, 1.0, 1.0) };
+        let a = Aabb {
+            min: DVec3::ZERO,
+            max: DVec3::ONE,
+        };
+        let b = Aabb {
+            min: DVec3::new(3.0, 0.0, 0.0),
+            max: DVec3::new(4.0, 1.0, 1.0),
+        };
         assert!(t.boxes_may_meet(&a, &b));
         assert!(!Tolerances::default().boxes_may_meet(&a, &b));
     }

@@ -1,0 +1,296 @@
+//! Command line: clap definitions, and their conversion into a validated [`Config`] (the core
+//! never sees clap). [`run`] does the whole job and hands back what to print and the exit code;
+//! the binary prints it.
+
+use crate::bvh::{BuildOptions, Strategy};
+use crate::error::{Error, Result};
+use crate::geom::predicates::Tolerances;
+use crate::query::{self, FailOn, InputSpec, Settings};
+use crate::report::{self, SettingsReport};
+use clap::{Parser, ValueEnum};
+use glam::{DMat4, DVec3, DVec4};
+use std::path::PathBuf;
+use std::time::Instant;
+
+/// Do two meshes clash, where, and how close do they come? Reads OBJ, STL (ASCII or binary) and
+/// glTF (.gltf/.glb); writes a JSON report. Exit code: 0 nothing at or above --fail-on,
+/// 1 findings at or above it, 2 bad input, I/O or usage error.
+#[derive(Debug, Parser)]
+#[command(name = "meshclash", version, about, long_about = None)]
+pub struct Args {
+    /// First mesh (A).
+    pub a: PathBuf,
+    /// Second mesh (B).
+    pub b: PathBuf,
+    /// Write the report to FILE (atomically) instead of stdout.
+    #[arg(short, long, value_name = "FILE")]
+    pub output: Option<PathBuf>,
+    /// Move A by x,y,z (after --transform-a).
+    #[arg(long, value_name = "X,Y,Z", allow_hyphen_values = true)]
+    pub translate_a: Option<String>,
+    /// Move B by x,y,z (after --transform-b).
+    #[arg(long, value_name = "X,Y,Z", allow_hyphen_values = true)]
+    pub translate_b: Option<String>,
+    /// Affine transform of A: 12 (3×4) or 16 (4×4, last row 0,0,0,1) comma-separated numbers, row-major.
+    #[arg(long, value_name = "M", allow_hyphen_values = true)]
+    pub transform_a: Option<String>,
+    /// Affine transform of B, as --transform-a.
+    #[arg(long, value_name = "M", allow_hyphen_values = true)]
+    pub transform_b: Option<String>,
+    /// Pairs that do not touch but are within this distance count as touching (model units).
+    #[arg(
+        long,
+        value_name = "E",
+        default_value_t = 0.0,
+        allow_negative_numbers = true
+    )]
+    pub touch_tolerance: f64,
+    /// Also report every pair closer than D that does not touch (model units).
+    #[arg(
+        long,
+        value_name = "D",
+        default_value_t = 0.0,
+        allow_negative_numbers = true
+    )]
+    pub clearance: f64,
+    /// Exit 1 when the verdict is at or above this.
+    #[arg(long, value_enum, default_value_t = FailOnArg::Clash)]
+    pub fail_on: FailOnArg,
+    /// BVH split strategy.
+    #[arg(long, value_enum, default_value_t = BvhArg::Sah)]
+    pub bvh: BvhArg,
+    /// Largest BVH leaf, in triangles (1..=64).
+    #[arg(long, value_name = "N", default_value_t = 4)]
+    pub leaf_size: u32,
+    /// Worker threads (0 = one per core).
+    #[arg(long, value_name = "N", default_value_t = 0)]
+    pub threads: usize,
+    /// List at most N pairs (the summary counts stay complete).
+    #[arg(long, value_name = "N", default_value_t = 1000)]
+    pub max_pairs: usize,
+    /// Deterministic report: no timings, no thread count (byte-identical across runs).
+    #[arg(long)]
+    pub no_timings: bool,
+    /// Do not print warnings on stderr.
+    #[arg(short, long)]
+    pub quiet: bool,
+}
+
+/// `--fail-on` values.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
+pub enum FailOnArg {
+    /// Crossing pairs fail.
+    Clash,
+    /// Touching or crossing pairs fail.
+    Touching,
+    /// Anything within the clearance fails.
+    Clearance,
+    /// Never fail on findings.
+    Never,
+}
+
+/// `--bvh` values.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
+pub enum BvhArg {
+    /// Binned surface-area heuristic.
+    Sah,
+    /// Spatial median of the centroid bounds.
+    Median,
+    /// Equal counts (object median).
+    Equal,
+}
+
+/// A validated configuration.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Config {
+    /// Inputs A and B with their placements.
+    pub inputs: [InputSpec; 2],
+    /// Where the report goes (None = stdout).
+    pub output: Option<PathBuf>,
+    /// Search settings.
+    pub settings: Settings,
+    /// Failure threshold.
+    pub fail_on: FailOn,
+    /// Worker threads (0 = default).
+    pub threads: usize,
+    /// Cap on listed pairs.
+    pub max_pairs: usize,
+    /// Deterministic report.
+    pub deterministic: bool,
+}
+
+fn numbers(flag: &str, s: &str) -> Result<Vec<f64>> {
+    s.split(',')
+        .map(|t| {
+            let t = t.trim();
+            match t.parse::<f64>() {
+                Ok(v) if v.is_finite() => Ok(v),
+                _ => Err(Error::Usage(format!(
+                    "--{flag}: '{t}' is not a finite number"
+                ))),
+            }
+        })
+        .collect()
+}
+
+/// Parse a row-major 3×4 or 4×4 affine matrix.
+pub fn parse_transform(flag: &str, s: &str) -> Result<DMat4> {
+    let v = numbers(flag, s)?;
+    if v.len() != 12 && v.len() != 16 {
+        return Err(Error::Usage(format!(
+            "--{flag} takes 12 or 16 numbers, got {}",
+            v.len()
+        )));
+    }
+    if v.len() == 16 && v[12..] != [0.0, 0.0, 0.0, 1.0] {
+        return Err(Error::Usage(format!(
+            "--{flag}: the last row must be 0,0,0,1 (affine only)"
+        )));
+    }
+    let row = |r: usize| DVec4::new(v[4 * r], v[4 * r + 1], v[4 * r + 2], v[4 * r + 3]);
+    Ok(DMat4::from_cols(row(0), row(1), row(2), DVec4::W).transpose())
+}
+
+/// Parse `x,y,z`.
+pub fn parse_translation(flag: &str, s: &str) -> Result<DVec3> {
+    let v = numbers(flag, s)?;
+    match v[..] {
+        [x, y, z] => Ok(DVec3::new(x, y, z)),
+        _ => Err(Error::Usage(format!(
+            "--{flag} takes x,y,z, got {} numbers",
+            v.len()
+        ))),
+    }
+}
+
+fn placement(name: char, transform: &Option<String>, translate: &Option<String>) -> Result<DMat4> {
+    let mut m = DMat4::IDENTITY;
+    if let Some(t) = transform {
+        m = parse_transform(&format!("transform-{name}"), t)?;
+    }
+    if let Some(t) = translate {
+        m = DMat4::from_translation(parse_translation(&format!("translate-{name}"), t)?) * m;
+    }
+    Ok(m)
+}
+
+fn tolerance(flag: &str, v: f64) -> Result<f64> {
+    if v.is_finite() && v >= 0.0 {
+        Ok(v)
+    } else {
+        Err(Error::Usage(format!(
+            "--{flag} must be a finite number >= 0, got {v}"
+        )))
+    }
+}
+
+impl Args {
+    /// Validate into a [`Config`].
+    pub fn into_config(self) -> Result<Config> {
+        if !(1..=64).contains(&self.leaf_size) {
+            return Err(Error::Usage(format!(
+                "--leaf-size must be 1..=64, got {}",
+                self.leaf_size
+            )));
+        }
+        let tolerances = Tolerances {
+            touch: tolerance("touch-tolerance", self.touch_tolerance)?,
+            clearance: tolerance("clearance", self.clearance)?,
+        };
+        Ok(Config {
+            inputs: [
+                InputSpec {
+                    path: self.a,
+                    transform: placement('a', &self.transform_a, &self.translate_a)?,
+                },
+                InputSpec {
+                    path: self.b,
+                    transform: placement('b', &self.transform_b, &self.translate_b)?,
+                },
+            ],
+            output: self.output,
+            settings: Settings {
+                tolerances,
+                bvh: BuildOptions {
+                    strategy: match self.bvh {
+                        BvhArg::Sah => Strategy::Sah,
+                        BvhArg::Median => Strategy::Median,
+                        BvhArg::Equal => Strategy::Equal,
+                    },
+                    leaf_size: self.leaf_size,
+                },
+            },
+            fail_on: match self.fail_on {
+                FailOnArg::Clash => FailOn::Clash,
+                FailOnArg::Touching => FailOn::Touching,
+                FailOnArg::Clearance => FailOn::Clearance,
+                FailOnArg::Never => FailOn::Never,
+            },
+            threads: self.threads,
+            max_pairs: self.max_pairs,
+            deterministic: self.no_timings,
+        })
+    }
+}
+
+/// What the binary should do after a successful run.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Outcome {
+    /// The JSON report, if it goes to stdout (None when written to `--output`).
+    pub stdout: Option<String>,
+    /// Lines for stderr (warnings).
+    pub warnings: Vec<String>,
+    /// 0 or 1.
+    pub exit_code: u8,
+}
+
+/// Do the whole job for a validated config.
+pub fn run(cfg: &Config) -> Result<Outcome> {
+    let pool = rayon::ThreadPoolBuilder::new()
+        .num_threads(cfg.threads)
+        .build()
+        .map_err(|e| Error::Usage(format!("--threads: {e}")))?;
+    pool.install(|| run_in_pool(cfg, pool.current_num_threads()))
+}
+
+fn run_in_pool(cfg: &Config, threads: usize) -> Result<Outcome> {
+    let t0 = Instant::now();
+    let (a, b) = rayon::join(
+        || query::load_input(&cfg.inputs[0]),
+        || query::load_input(&cfg.inputs[1]),
+    );
+    let (a, b) = (a?, b?);
+    let load_ms = t0.elapsed().as_secs_f64() * 1e3;
+    let result = query::check(&a.mesh, &b.mesh, &cfg.settings);
+    let failed = cfg.fail_on.fails(result.verdict);
+    let ctx = report::Context {
+        inputs: [&a, &b],
+        transforms: [cfg.inputs[0].transform, cfg.inputs[1].transform],
+        settings: SettingsReport {
+            touch_tolerance: cfg.settings.tolerances.touch,
+            clearance: cfg.settings.tolerances.clearance,
+            fail_on: cfg.fail_on.name().into(),
+            bvh: cfg.settings.bvh.strategy.name().into(),
+            leaf_size: cfg.settings.bvh.leaf_size,
+            max_pairs: cfg.max_pairs,
+            threads: (!cfg.deterministic).then_some(threads),
+        },
+        failed,
+        times: (!cfg.deterministic).then(|| (load_ms, t0.elapsed().as_secs_f64() * 1e3)),
+    };
+    let rep = report::build(&ctx, &result);
+    let json = report::to_json(&rep);
+    let warnings = rep.warnings.clone();
+    let stdout = match &cfg.output {
+        Some(path) => {
+            report::write_atomic(path, json.as_bytes())?;
+            None
+        }
+        None => Some(json),
+    };
+    Ok(Outcome {
+        stdout,
+        warnings,
+        exit_code: failed as u8,
+    })
+}

@@ -1,0 +1,397 @@
+//! glTF 2.0 loader (`.gltf` JSON and `.glb` binary), without the `gltf` crate's `import`.
+//!
+//! - **Buffers**: the GLB binary chunk, base64 `data:` URIs, or relative files next to the
+//!   glTF (percent-decoded; other schemes are refused). Each must hold its `byteLength`; every
+//!   bufferView and accessor range is checked before reading (see `gltf_data`).
+//! - **Scene**: the default scene, else the first scene, else every root node (a node that is
+//!   nobody's child). The hierarchy is walked iteratively; a node with two parents, a cycle,
+//!   or more than [`MAX_DEPTH`] levels is an error. World = parent × local, computed in f64
+//!   (the node `matrix`, or translation × rotation (normalised quaternion) × scale).
+//! - **Primitives**: modes TRIANGLES, TRIANGLE_STRIP (triangle `i` is `(i, i+1, i+2)`, with the
+//!   last two swapped for odd `i` to keep the winding) and TRIANGLE_FAN (`(0, i+1, i+2)`),
+//!   indexed (u8/u16/u32) or not. POINTS/LINES/LINE_LOOP/LINE_STRIP are skipped with a warning.
+//!   Positions must be float VEC3 (sparse accessors are applied); quantized positions
+//!   (KHR_mesh_quantization) are an error for now. Skins and morph targets are ignored (with a
+//!   warning); `EXT_mesh_gpu_instancing` is ignored with a warning unless required.
+//! - **Vertices**: every primitive instance contributes its own vertices, transformed to world
+//!   space in f64 (no merging across primitives or instances).
+//! - **Triangle order**: scene traversal order (depth-first pre-order over the scene's root
+//!   nodes in the order listed, children in listed order); within a node, its mesh's primitives
+//!   in order; within a primitive, index order.
+//! - **Objects**: one per node that draws a mesh (node × mesh), named by the node path from the
+//!   scene root joined with `/` (each node by its `name`, or `node<index>`), with
+//!   `gltf_mesh = Some(mesh index)` and `world = Some(world matrix)`. Instances that yield no
+//!   triangles get no object.
+
+use std::borrow::Cow;
+use std::path::Path;
+
+use ::gltf::mesh::Mode;
+use ::gltf::scene::Transform;
+use ::gltf::Document;
+use glam::{DMat4, DQuat, DVec3};
+
+use super::gltf_data::{load_buffers, parse_document, split_glb, Reader};
+use crate::error::{Error, Result};
+use crate::mesh::{Loaded, Mesh, Object};
+
+/// The deepest node hierarchy accepted.
+pub(crate) const MAX_DEPTH: usize = 1024;
+
+/// Loads `.gltf` or `.glb` `bytes` (the GLB magic decides); see the module doc.
+pub(crate) fn load(path: &Path, bytes: &[u8]) -> Result<Loaded> {
+    let (json, bin) = if bytes.starts_with(b"glTF") {
+        split_glb(path, bytes)?
+    } else {
+        (bytes, None)
+    };
+    let mut warnings = Vec::new();
+    let doc = parse_document(path, json, &mut warnings)?;
+    let buffers = load_buffers(path, &doc, bin)?;
+    let input_bytes = buffers
+        .iter()
+        .map(|b| b.len())
+        .fold(bytes.len(), usize::saturating_add);
+    let reader = Reader {
+        path,
+        buffers: &buffers,
+        input_bytes,
+    };
+    let instances = traverse(path, &doc, &mut warnings)?;
+
+    // Decode each mesh once, whatever its number of instances.
+    let mut decoded: Vec<Option<Vec<Prim>>> = vec![None; doc.meshes().len()];
+    let (mut total_v, mut total_t) = (0usize, 0usize);
+    for inst in &instances {
+        if decoded[inst.mesh].is_none() {
+            decoded[inst.mesh] = Some(decode_mesh(&reader, &doc, inst.mesh, &mut warnings)?);
+        }
+        for p in decoded[inst.mesh].iter().flatten() {
+            total_v = total_v.saturating_add(p.positions.len());
+            total_t = total_t.saturating_add(p.triangles.len());
+        }
+    }
+    if total_v > u32::MAX as usize {
+        return Err(Error::input(
+            path,
+            format!("glTF scene has {total_v} vertices after instancing, more than 4294967295"),
+        ));
+    }
+
+    let mut mesh = Mesh {
+        positions: Vec::with_capacity(total_v),
+        triangles: Vec::with_capacity(total_t),
+        tri_object: Vec::with_capacity(total_t),
+        objects: Vec::new(),
+    };
+    let names = node_names(&doc);
+    for inst in &instances {
+        let prims = decoded[inst.mesh].as_deref().unwrap_or(&[]);
+        if prims.iter().all(|p| p.triangles.is_empty()) {
+            continue;
+        }
+        let object = mesh.objects.len() as u32;
+        mesh.objects.push(Object {
+            name: node_path(&inst.path, &names),
+            gltf_mesh: Some(inst.mesh as u32),
+            world: Some(inst.world),
+        });
+        for p in prims {
+            let base = mesh.positions.len() as u32;
+            for (i, &v) in p.positions.iter().enumerate() {
+                let w = inst.world.transform_point3(v);
+                if let Some(bad) = super::non_finite(w.to_array()) {
+                    return Err(Error::input(
+                        path,
+                        format!(
+                            "position {i} of mesh {} is not finite ({bad}) after the transform of \
+                             node {}",
+                            inst.mesh, inst.node
+                        ),
+                    ));
+                }
+                mesh.positions.push(w);
+            }
+            for t in &p.triangles {
+                mesh.triangles.push([base + t[0], base + t[1], base + t[2]]);
+                mesh.tri_object.push(object);
+            }
+        }
+    }
+    Ok(Loaded { mesh, warnings })
+}
+
+/// One node drawing a mesh, in traversal order.
+struct Instance {
+    node: usize,
+    mesh: usize,
+    world: DMat4,
+    /// Node indices from the scene root down to `node`.
+    path: Vec<usize>,
+}
+
+/// One decoded primitive in mesh-local space (triangles index `positions`).
+#[derive(Clone)]
+struct Prim {
+    positions: Vec<DVec3>,
+    triangles: Vec<[u32; 3]>,
+}
+
+fn node_names(doc: &Document) -> Vec<Cow<'_, str>> {
+    doc.nodes()
+        .map(|n| match n.name() {
+            Some(s) if !s.is_empty() => Cow::Borrowed(s),
+            _ => Cow::Owned(format!("node{}", n.index())),
+        })
+        .collect()
+}
+
+fn node_path(path: &[usize], names: &[Cow<'_, str>]) -> String {
+    let parts: Vec<&str> = path
+        .iter()
+        .map(|&i| names.get(i).map_or("?", |s| s.as_ref()))
+        .collect();
+    parts.join("/")
+}
+
+/// Checks the node graph (single parents, no cycles, bounded depth) and lists the mesh
+/// instances of the chosen scene in depth-first pre-order.
+fn traverse(path: &Path, doc: &Document, warnings: &mut Vec<String>) -> Result<Vec<Instance>> {
+    let err = |m: String| Error::input(path, m);
+    let n = doc.nodes().len();
+    let mut parent: Vec<Option<usize>> = vec![None; n];
+    for node in doc.nodes() {
+        for child in node.children() {
+            let c = child.index();
+            if let Some(p) = parent[c] {
+                if p == node.index() {
+                    return Err(err(format!("glTF node {p} lists child {c} twice")));
+                }
+                return Err(err(format!(
+                    "glTF node {c} has two parents (nodes {p} and {})",
+                    node.index()
+                )));
+            }
+            parent[c] = Some(node.index());
+        }
+    }
+    if let Some(c) = find_cycle(&parent) {
+        return Err(err(format!("glTF node graph has a cycle at node {c}")));
+    }
+
+    let scene = doc.default_scene().or_else(|| doc.scenes().next());
+    let roots: Vec<usize> = match &scene {
+        Some(s) => s.nodes().map(|r| r.index()).collect(),
+        None => (0..n).filter(|&i| parent[i].is_none()).collect(),
+    };
+    let mut listed = vec![false; n];
+    for &r in &roots {
+        if let Some(p) = parent[r] {
+            return Err(err(format!(
+                "glTF node {r} is a scene root but also a child of node {p}"
+            )));
+        }
+        if std::mem::replace(&mut listed[r], true) {
+            return Err(err(format!("glTF scene lists node {r} twice")));
+        }
+    }
+
+    let nodes: Vec<::gltf::Node> = doc.nodes().collect();
+    let mut visited = vec![false; n];
+    let mut instances = Vec::new();
+    let mut skinned = false;
+    // (node, parent world, depth); `chain` holds the current root-to-node path.
+    let mut stack: Vec<(usize, DMat4, usize)> = roots
+        .iter()
+        .rev()
+        .map(|&r| (r, DMat4::IDENTITY, 1))
+        .collect();
+    let mut chain: Vec<usize> = Vec::new();
+    while let Some((i, parent_world, depth)) = stack.pop() {
+        if depth > MAX_DEPTH {
+            return Err(err(format!(
+                "glTF node hierarchy deeper than {MAX_DEPTH} levels (at node {i})"
+            )));
+        }
+        if std::mem::replace(&mut visited[i], true) {
+            return Err(err(format!("glTF node graph has a cycle at node {i}")));
+        }
+        chain.truncate(depth - 1);
+        chain.push(i);
+        let node = &nodes[i];
+        let world = parent_world * local_matrix(path, node)?;
+        if !world.is_finite() {
+            return Err(err(format!(
+                "glTF node {i}: world transform is not finite (overflow)"
+            )));
+        }
+        if let Some(mesh) = node.mesh() {
+            skinned |= node.skin().is_some();
+            instances.push(Instance {
+                node: i,
+                mesh: mesh.index(),
+                world,
+                path: chain.clone(),
+            });
+        }
+        let children: Vec<usize> = node.children().map(|c| c.index()).collect();
+        for &c in children.iter().rev() {
+            stack.push((c, world, depth + 1));
+        }
+    }
+    if skinned {
+        warnings.push("skins are ignored: skinned meshes are loaded in their bind pose".into());
+    }
+    Ok(instances)
+}
+
+/// A node on a cycle of the parent function, if any (iterative, O(n)).
+fn find_cycle(parent: &[Option<usize>]) -> Option<usize> {
+    // 0 = unseen, 1 = on the current walk, 2 = finished
+    let mut state = vec![0u8; parent.len()];
+    let mut walk = Vec::new();
+    for start in 0..parent.len() {
+        walk.clear();
+        let mut cur = Some(start);
+        while let Some(c) = cur {
+            match state[c] {
+                0 => {
+                    state[c] = 1;
+                    walk.push(c);
+                    cur = parent[c];
+                }
+                1 => return Some(c),
+                _ => break,
+            }
+        }
+        for &w in &walk {
+            state[w] = 2;
+        }
+    }
+    None
+}
+
+/// The node's local matrix in f64.
+fn local_matrix(path: &Path, node: &::gltf::Node) -> Result<DMat4> {
+    let bad = |what: &str| Error::input(path, format!("glTF node {} has {what}", node.index()));
+    match node.transform() {
+        Transform::Matrix { matrix } => {
+            let cols = matrix.map(|c| c.map(f64::from));
+            if cols.iter().flatten().any(|x| !x.is_finite()) {
+                return Err(bad("a non-finite matrix"));
+            }
+            Ok(DMat4::from_cols_array_2d(&cols))
+        }
+        Transform::Decomposed {
+            translation: t,
+            rotation: r,
+            scale: s,
+        } => {
+            let all = t.iter().chain(&r).chain(&s);
+            if all.map(|&x| f64::from(x)).any(|x| !x.is_finite()) {
+                return Err(bad("a non-finite translation, rotation or scale"));
+            }
+            let q = DQuat::from_xyzw(r[0].into(), r[1].into(), r[2].into(), r[3].into());
+            let len = q.length();
+            if len == 0.0 || !len.is_finite() {
+                return Err(bad("a zero rotation quaternion"));
+            }
+            Ok(DMat4::from_scale_rotation_translation(
+                DVec3::new(s[0].into(), s[1].into(), s[2].into()),
+                q / len,
+                DVec3::new(t[0].into(), t[1].into(), t[2].into()),
+            ))
+        }
+    }
+}
+
+/// Decodes every triangle primitive of mesh `m`; other modes are skipped with a warning.
+fn decode_mesh(
+    r: &Reader,
+    doc: &Document,
+    m: usize,
+    warnings: &mut Vec<String>,
+) -> Result<Vec<Prim>> {
+    let Some(mesh) = doc.meshes().nth(m) else {
+        return Ok(Vec::new());
+    };
+    let mut out = Vec::new();
+    for prim in mesh.primitives() {
+        let what = format!("mesh {m} primitive {}", prim.index());
+        let mode = prim.mode();
+        if !matches!(
+            mode,
+            Mode::Triangles | Mode::TriangleStrip | Mode::TriangleFan
+        ) {
+            warnings.push(format!(
+                "{what}: skipped {mode:?} primitive (only triangles are loaded)"
+            ));
+            continue;
+        }
+        let Some(acc) = prim.get(&::gltf::Semantic::Positions) else {
+            warnings.push(format!("{what}: skipped primitive without POSITION"));
+            continue;
+        };
+        if prim.morph_targets().len() > 0 {
+            warnings.push(format!(
+                "{what}: morph targets ignored (base positions used)"
+            ));
+        }
+        let positions = r.positions(&acc, &what)?;
+        let nv = positions.len();
+        let indices: Cow<[u32]> = match prim.indices() {
+            Some(ia) => Cow::Owned(r.indices(&ia, &what)?),
+            None => Cow::Owned((0..nv as u32).collect()),
+        };
+        if let Some((k, &v)) = indices.iter().enumerate().find(|(_, &v)| v as usize >= nv) {
+            return Err(Error::input(
+                r.path,
+                format!("{what}: index {k} refers to vertex {v} but there are {nv} vertices"),
+            ));
+        }
+        let triangles = triangulate(mode, &indices);
+        let leftover = match mode {
+            Mode::Triangles => indices.len() % 3,
+            _ if indices.len() < 3 => indices.len(),
+            _ => 0,
+        };
+        if leftover > 0 {
+            warnings.push(format!(
+                "{what}: {leftover} trailing indices do not form a triangle and were ignored"
+            ));
+        }
+        let positions = positions
+            .iter()
+            .map(|p| DVec3::from_array(p.map(f64::from)))
+            .collect();
+        out.push(Prim {
+            positions,
+            triangles,
+        });
+    }
+    Ok(out)
+}
+
+/// Triangles of a TRIANGLES / TRIANGLE_STRIP / TRIANGLE_FAN index list.
+fn triangulate(mode: Mode, idx: &[u32]) -> Vec<[u32; 3]> {
+    match mode {
+        Mode::Triangles => idx.chunks_exact(3).map(|c| [c[0], c[1], c[2]]).collect(),
+        Mode::TriangleStrip => (0..idx.len().saturating_sub(2))
+            .map(|i| {
+                if i % 2 == 0 {
+                    [idx[i], idx[i + 1], idx[i + 2]]
+                } else {
+                    [idx[i], idx[i + 2], idx[i + 1]]
+                }
+            })
+            .collect(),
+        Mode::TriangleFan => (0..idx.len().saturating_sub(2))
+            .map(|i| [idx[0], idx[i + 1], idx[i + 2]])
+            .collect(),
+        _ => Vec::new(),
+    }
+}
+
+#[cfg(test)]
+#[path = "gltf_tests.rs"]
+mod tests;

@@ -1,0 +1,506 @@
+//! File loaders: OBJ, STL (ASCII and binary), glTF 2.0 (`.gltf` and `.glb`).
+//!
+//! [`load_path`] reads a file, detects its format ([`detect_format`]: by extension, confirmed
+//! by content), parses it and validates the result. Every loader guarantees, or fails with a
+//! one-line [`Error::Input`] naming the file:
+//!
+//! - at least one triangle;
+//! - every triangle index in range;
+//! - every coordinate finite (NaN and ±infinity are reported);
+//! - `tri_object.len() == triangles.len()`, every `tri_object` entry indexes `objects`, and
+//!   every object has a non-empty name. Objects that end up without triangles are dropped.
+//!
+//! Degenerate triangles (zero area, repeated index) are kept: callers count them.
+//!
+//! Hostile input: no loader panics, and no loader allocates from a count declared in the file
+//! (STL triangle count, GLB chunk length, glTF buffer length, accessor count) before checking
+//! the data holding it is present.
+
+use std::path::Path;
+
+use crate::error::{Error, Result};
+use crate::mesh::Loaded;
+
+mod gltf;
+mod gltf_data;
+mod obj;
+mod stl;
+
+/// A supported input file format.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Format {
+    /// Wavefront OBJ (text).
+    Obj,
+    /// STL, ASCII or binary.
+    Stl,
+    /// glTF 2.0 JSON (`.gltf`), buffers embedded as data URIs or in external files.
+    Gltf,
+    /// glTF 2.0 binary container (`.glb`).
+    Glb,
+}
+
+impl Format {
+    /// The short lowercase name: `"obj"`, `"stl"`, `"gltf"` or `"glb"`.
+    pub fn name(&self) -> &'static str {
+        match self {
+            Format::Obj => "obj",
+            Format::Stl => "stl",
+            Format::Gltf => "gltf",
+            Format::Glb => "glb",
+        }
+    }
+}
+
+/// Reads `path`, detects its format, loads and validates it.
+///
+/// A missing or unreadable file is an [`Error::Input`] naming the path.
+pub fn load_path(path: &Path) -> Result<(Loaded, Format)> {
+    let bytes = std::fs::read(path)
+        .map_err(|e| Error::input(path, format!("cannot read file: {}", io_message(&e))))?;
+    let format = detect_format(path, &bytes)?;
+    let loaded = load_bytes(path, &bytes, format)?;
+    Ok((loaded, format))
+}
+
+/// Loads `bytes` as `format` and validates the result.
+///
+/// `path` is used in error messages and, for glTF, to resolve external buffers relative to
+/// the file's directory.
+pub fn load_bytes(path: &Path, bytes: &[u8], format: Format) -> Result<Loaded> {
+    if bytes.is_empty() {
+        return Err(Error::input(path, "file is empty"));
+    }
+    let loaded = match format {
+        Format::Obj => obj::load(path, bytes)?,
+        Format::Stl => stl::load(path, bytes)?,
+        Format::Gltf | Format::Glb => gltf::load(path, bytes)?,
+    };
+    validate(path, &loaded)?;
+    Ok(loaded)
+}
+
+/// Detects the format from the extension of `path` (case-insensitive `.obj`, `.stl`, `.gltf`,
+/// `.glb`) and confirms it from the content.
+///
+/// For `.stl` this also decides ASCII versus binary viability: a file that is neither an
+/// exactly-sized binary STL nor ASCII STL is reported as truncated here. For `.gltf`/`.glb`
+/// the content decides between [`Format::Gltf`] (JSON) and [`Format::Glb`] (binary magic).
+pub fn detect_format(path: &Path, bytes: &[u8]) -> Result<Format> {
+    let ext = match path.extension() {
+        Some(e) => e.to_string_lossy().to_ascii_lowercase(),
+        None => {
+            return Err(Error::input(
+                path,
+                "no file extension (expected .obj, .stl, .gltf or .glb)",
+            ))
+        }
+    };
+    let format = match ext.as_str() {
+        "obj" => Format::Obj,
+        "stl" => Format::Stl,
+        "gltf" => Format::Gltf,
+        "glb" => Format::Glb,
+        _ => {
+            return Err(Error::input(
+                path,
+                format!("unknown extension '.{ext}' (expected .obj, .stl, .gltf or .glb)"),
+            ))
+        }
+    };
+    if bytes.is_empty() {
+        return Err(Error::input(path, "file is empty"));
+    }
+    match format {
+        Format::Obj => {
+            let head = &bytes[..bytes.len().min(4096)];
+            if let Some(pos) = head.iter().position(|&b| b == 0) {
+                return Err(Error::input(
+                    path,
+                    format!("not an OBJ text file: NUL byte at byte {pos} (binary data)"),
+                ));
+            }
+            Ok(Format::Obj)
+        }
+        Format::Stl => {
+            stl::check_viable(path, bytes)?;
+            Ok(Format::Stl)
+        }
+        Format::Gltf | Format::Glb => {
+            if bytes.starts_with(b"glTF") {
+                Ok(Format::Glb)
+            } else if bytes.iter().find(|b| !b.is_ascii_whitespace()) == Some(&b'{')
+                || bytes.starts_with(&[0xEF, 0xBB, 0xBF, b'{'])
+            {
+                Ok(Format::Gltf)
+            } else {
+                Err(Error::input(
+                    path,
+                    format!(
+                        "not a glTF file: expected JSON starting with '{{' or the GLB magic \
+                         'glTF', found {}",
+                        describe_start(bytes)
+                    ),
+                ))
+            }
+        }
+    }
+}
+
+/// Checks the guarantees listed in the module doc.
+fn validate(path: &Path, loaded: &Loaded) -> Result<()> {
+    let mesh = &loaded.mesh;
+    if mesh.triangles.is_empty() {
+        return Err(Error::input(path, "no triangles"));
+    }
+    if mesh.tri_object.len() != mesh.triangles.len() {
+        return Err(Error::input(
+            path,
+            format!(
+                "internal loader error: {} triangles but {} object entries",
+                mesh.triangles.len(),
+                mesh.tri_object.len()
+            ),
+        ));
+    }
+    let n = mesh.positions.len();
+    for (t, tri) in mesh.triangles.iter().enumerate() {
+        for &v in tri {
+            if v as usize >= n {
+                return Err(Error::input(
+                    path,
+                    format!("triangle {t} refers to vertex {v} but there are {n} vertices"),
+                ));
+            }
+        }
+    }
+    for (i, p) in mesh.positions.iter().enumerate() {
+        if let Some(bad) = non_finite([p.x, p.y, p.z]) {
+            return Err(Error::input(
+                path,
+                format!("vertex {i} has a non-finite coordinate ({bad})"),
+            ));
+        }
+    }
+    for (t, &o) in mesh.tri_object.iter().enumerate() {
+        if o as usize >= mesh.objects.len() {
+            return Err(Error::input(
+                path,
+                format!(
+                    "internal loader error: triangle {t} belongs to object {o} but there are {} \
+                     objects",
+                    mesh.objects.len()
+                ),
+            ));
+        }
+    }
+    if let Some(i) = mesh.objects.iter().position(|o| o.name.is_empty()) {
+        return Err(Error::input(
+            path,
+            format!("internal loader error: object {i} has no name"),
+        ));
+    }
+    Ok(())
+}
+
+/// `Some("NaN")`, `Some("inf")` or `Some("-inf")` for the first non-finite value, else `None`.
+pub(crate) fn non_finite<const N: usize>(v: [f64; N]) -> Option<&'static str> {
+    v.iter().find(|x| !x.is_finite()).map(|x| {
+        if x.is_nan() {
+            "NaN"
+        } else if *x > 0.0 {
+            "inf"
+        } else {
+            "-inf"
+        }
+    })
+}
+
+/// An I/O error as text without the trailing ` (os error N)`.
+pub(crate) fn io_message(e: &std::io::Error) -> String {
+    let s = e.to_string();
+    match s.find(" (os error ") {
+        Some(i) if s.ends_with(')') => s[..i].to_string(),
+        _ => s,
+    }
+}
+
+/// A short printable rendering of a file's first bytes, for error messages.
+fn describe_start(bytes: &[u8]) -> String {
+    let head = &bytes[..bytes.len().min(8)];
+    if head.iter().all(|b| b.is_ascii_graphic() || *b == b' ') {
+        format!("'{}'", String::from_utf8_lossy(head))
+    } else {
+        let hex: Vec<String> = head.iter().map(|b| format!("{b:02x}")).collect();
+        format!("bytes {}", hex.join(" "))
+    }
+}
+
+/// Shortens `s` to at most `max` characters for a message, adding `…` when cut.
+pub(crate) fn clip(s: &str, max: usize) -> String {
+    if s.chars().count() <= max {
+        s.to_string()
+    } else {
+        let mut out: String = s.chars().take(max).collect();
+        out.push('…');
+        out
+    }
+}
+
+/// Drops objects without triangles and renumbers `tri_object`, keeping first-appearance order.
+pub(crate) fn drop_empty_objects(mesh: &mut crate::mesh::Mesh) {
+    let mut used = vec![false; mesh.objects.len()];
+    for &o in &mesh.tri_object {
+        if let Some(u) = used.get_mut(o as usize) {
+            *u = true;
+        }
+    }
+    if used.iter().all(|&u| u) {
+        return;
+    }
+    let mut remap = vec![u32::MAX; used.len()];
+    let mut kept = Vec::new();
+    for (i, obj) in std::mem::take(&mut mesh.objects).into_iter().enumerate() {
+        if used[i] {
+            remap[i] = kept.len() as u32;
+            kept.push(obj);
+        }
+    }
+    mesh.objects = kept;
+    for o in &mut mesh.tri_object {
+        if let Some(&r) = remap.get(*o as usize) {
+            *o = r;
+        }
+    }
+}
+
+/// Locates a file of the shared test corpus (`../shared/meshes` next to the crate, else
+/// `/work/shared/meshes`); `None` (test should skip) when it is absent.
+#[cfg(test)]
+pub(crate) fn shared(name: &str) -> Option<std::path::PathBuf> {
+    let candidates = [
+        std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../shared/meshes"),
+        std::path::PathBuf::from("/work/shared/meshes"),
+    ];
+    for dir in candidates {
+        let p = dir.join(name);
+        if p.is_file() {
+            return Some(p);
+        }
+    }
+    eprintln!("skipping: shared mesh {name} not found");
+    None
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use std::path::PathBuf;
+
+    fn p(s: &str) -> PathBuf {
+        PathBuf::from(s)
+    }
+
+    #[test]
+    fn format_names() {
+        assert_eq!(Format::Obj.name(), "obj");
+        assert_eq!(Format::Stl.name(), "stl");
+        assert_eq!(Format::Gltf.name(), "gltf");
+        assert_eq!(Format::Glb.name(), "glb");
+    }
+
+    #[test]
+    fn detect_by_extension_case_insensitive() {
+        assert_eq!(
+            detect_format(&p("a.OBJ"), b"v 0 0 0\n").unwrap(),
+            Format::Obj
+        );
+        assert_eq!(detect_format(&p("a.Gltf"), b" {}").unwrap(), Format::Gltf);
+        assert_eq!(
+            detect_format(&p("a.GLB"), b"glTF....").unwrap(),
+            Format::Glb
+        );
+        let stl = b"solid x\nfacet normal 0 0 1\nendfacet\nendsolid x\n";
+        assert_eq!(detect_format(&p("a.StL"), stl).unwrap(), Format::Stl);
+    }
+
+    #[test]
+    fn detect_errors() {
+        let e = detect_format(&p("mesh.ply"), b"ply")
+            .unwrap_err()
+            .to_string();
+        assert!(
+            e.contains("unknown extension '.ply' (expected .obj, .stl, .gltf or .glb)"),
+            "{e}"
+        );
+        assert!(e.starts_with("mesh.ply: "), "{e}");
+        let e = detect_format(&p("mesh"), b"x").unwrap_err().to_string();
+        assert!(e.contains("no file extension"), "{e}");
+        let e = detect_format(&p("a.obj"), b"").unwrap_err().to_string();
+        assert!(e.contains("file is empty"), "{e}");
+        let e = detect_format(&p("a.glb"), b"PK\x03\x04zip")
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("not a glTF file"), "{e}");
+        let e = detect_format(&p("a.obj"), b"v 1 2\0 3")
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("NUL byte at byte 5"), "{e}");
+    }
+
+    #[test]
+    fn load_path_missing_file_names_path() {
+        let e = load_path(Path::new("/nonexistent/dir/x.stl"))
+            .unwrap_err()
+            .to_string();
+        assert!(
+            e.starts_with("/nonexistent/dir/x.stl: cannot read file:"),
+            "{e}"
+        );
+        assert!(e.contains("No such file"), "{e}");
+    }
+
+    #[test]
+    fn empty_file_for_every_format() {
+        for (name, f) in [
+            ("e.obj", Format::Obj),
+            ("e.stl", Format::Stl),
+            ("e.gltf", Format::Gltf),
+            ("e.glb", Format::Glb),
+        ] {
+            let e = load_bytes(&p(name), b"", f).unwrap_err().to_string();
+            assert!(e.contains("file is empty"), "{e}");
+        }
+        let dir = tempfile::tempdir().unwrap();
+        let f = dir.path().join("empty.stl");
+        std::fs::write(&f, b"").unwrap();
+        let e = load_path(&f).unwrap_err().to_string();
+        assert!(e.contains("file is empty"), "{e}");
+    }
+
+    #[test]
+    fn load_path_every_shared_format() {
+        for (name, fmt, tris) in [
+            ("joined_tetrahedra.obj", Format::Obj, 8),
+            ("shared.STL", Format::Stl, 24),
+            ("SimpleMeshes.gltf", Format::Gltf, 2),
+            ("Box.glb", Format::Glb, 12),
+        ] {
+            let Some(path) = shared(name) else { return };
+            let (loaded, f) = load_path(&path).unwrap();
+            assert_eq!(f, fmt, "{name}");
+            assert_eq!(loaded.mesh.triangles.len(), tris, "{name}");
+        }
+    }
+
+    #[test]
+    fn validate_catches_bad_meshes() {
+        use crate::mesh::{Mesh, Object};
+        use glam::DVec3;
+        let obj = || Object {
+            name: "a".into(),
+            ..Default::default()
+        };
+        let mut m = Loaded {
+            mesh: Mesh {
+                positions: vec![DVec3::ZERO; 3],
+                triangles: vec![[0, 1, 5]],
+                tri_object: vec![0],
+                objects: vec![obj()],
+            },
+            warnings: vec![],
+        };
+        let e = validate(&p("x"), &m).unwrap_err().to_string();
+        assert!(
+            e.contains("triangle 0 refers to vertex 5 but there are 3 vertices"),
+            "{e}"
+        );
+        m.mesh.triangles[0] = [0, 1, 2];
+        m.mesh.positions[1].y = f64::NEG_INFINITY;
+        let e = validate(&p("x"), &m).unwrap_err().to_string();
+        assert!(
+            e.contains("vertex 1 has a non-finite coordinate (-inf)"),
+            "{e}"
+        );
+        m.mesh.positions[1].y = 0.0;
+        assert!(validate(&p("x"), &m).is_ok());
+        m.mesh.tri_object[0] = 1;
+        assert!(validate(&p("x"), &m).is_err());
+        m.mesh.tri_object.clear();
+        assert!(validate(&p("x"), &m).is_err());
+        m.mesh.triangles.clear();
+        let e = validate(&p("x"), &m).unwrap_err().to_string();
+        assert!(e.contains("no triangles"), "{e}");
+    }
+
+    /// Random mutations of real files (byte flips, digit changes, hostile u32s, truncation)
+    /// must give `Ok` or a one-line `Err`, never a panic.
+    #[test]
+    fn mutated_files_never_panic() {
+        let mut seed = 0x9E37_79B9_7F4A_7C15u64;
+        let mut rnd = move |n: usize| {
+            seed ^= seed << 13;
+            seed ^= seed >> 7;
+            seed ^= seed << 17;
+            (seed % n.max(1) as u64) as usize
+        };
+        let files = [
+            ("Box.glb", Format::Glb),
+            ("SimpleMeshes.gltf", Format::Gltf),
+            ("shared.STL", Format::Stl),
+            ("multibody.stl", Format::Stl),
+            ("joined_tetrahedra.obj", Format::Obj),
+        ];
+        for (name, format) in files {
+            let Some(path) = shared(name) else { return };
+            let orig = std::fs::read(&path).unwrap();
+            for _ in 0..3000 {
+                let mut b = orig.clone();
+                for _ in 0..1 + rnd(3) {
+                    let at = rnd(b.len());
+                    match rnd(5) {
+                        0 => b[at] = rnd(256) as u8,
+                        1 if b[at].is_ascii_digit() => b[at] = b'0' + rnd(10) as u8,
+                        1 => {
+                            if let Some(d) = b.iter().skip(at).position(|c| c.is_ascii_digit()) {
+                                b[at + d] = b"09"[rnd(2)];
+                            }
+                        }
+                        2 if at + 4 <= b.len() => {
+                            let v = [0u32, 1, 0x7FFF_FFFF, u32::MAX, 84, 12][rnd(6)];
+                            b[at..at + 4].copy_from_slice(&v.to_le_bytes());
+                        }
+                        3 => b.truncate(at),
+                        _ => b.insert(at, b"-9e0 /\n"[rnd(7)]),
+                    }
+                    if b.is_empty() {
+                        break;
+                    }
+                }
+                match load_bytes(&path, &b, format) {
+                    Ok(l) => assert!(!l.mesh.triangles.is_empty()),
+                    Err(e) => assert!(!e.to_string().contains('\n')),
+                }
+                let _ = detect_format(&path, &b);
+            }
+        }
+    }
+
+    #[test]
+    fn drop_empty_objects_renumbers() {
+        use crate::mesh::{Mesh, Object};
+        let o = |n: &str| Object {
+            name: n.into(),
+            ..Default::default()
+        };
+        let mut m = Mesh {
+            positions: vec![],
+            triangles: vec![[0, 0, 0]; 3],
+            tri_object: vec![1, 3, 1],
+            objects: vec![o("a"), o("b"), o("c"), o("d")],
+        };
+        drop_empty_objects(&mut m);
+        assert_eq!(m.tri_object, vec![0, 1, 0]);
+        let names: Vec<_> = m.objects.iter().map(|o| o.name.as_str()).collect();
+        assert_eq!(names, ["b", "d"]);
+    }
+}

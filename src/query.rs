@@ -1,0 +1,447 @@
+//! Orchestration: load and place both inputs, build both trees, walk them, classify, and return
+//! plain result structs ([`ClashResult`]) that [`crate::report`] turns into JSON.
+//!
+//! Every candidate pair is classified exactly ([`crate::tri_tri`]); distances (for tolerance
+//! bands, clearance and the closest pair) are f64 closed forms ([`crate::distance`]).
+
+use crate::bvh::{self, BuildOptions, Bvh};
+use crate::distance::triangle_distance;
+use crate::error::{Error, Result};
+use crate::geom::predicates::{self, Tolerances};
+use crate::geom::{Aabb, DVec3};
+use crate::load::{self, Format};
+use crate::mesh::Mesh;
+use crate::traverse::{self, Candidate};
+use crate::tri_tri::{self, Contact, Shape};
+use glam::DMat4;
+use rayon::prelude::*;
+use std::path::{Path, PathBuf};
+use std::time::Instant;
+
+/// One input file and where to put it.
+#[derive(Debug, Clone, PartialEq)]
+pub struct InputSpec {
+    /// The mesh file.
+    pub path: PathBuf,
+    /// Affine placement applied to every vertex (in f64) after loading.
+    pub transform: DMat4,
+}
+
+/// What to look for and how (default: exact contacts only, SAH tree with leaves of 4).
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct Settings {
+    /// Touch tolerance and clearance.
+    pub tolerances: Tolerances,
+    /// BVH build options.
+    pub bvh: BuildOptions,
+}
+
+/// A loaded, placed input.
+#[derive(Debug, Clone)]
+pub struct Input {
+    /// Where it came from.
+    pub path: PathBuf,
+    /// Its format.
+    pub format: Format,
+    /// The mesh in world coordinates.
+    pub mesh: Mesh,
+    /// Loader warnings (harmless oddities skipped).
+    pub warnings: Vec<String>,
+}
+
+/// Load `spec.path` and apply `spec.transform`.
+pub fn load_input(spec: &InputSpec) -> Result<Input> {
+    let (loaded, format) = load::load_path(&spec.path)?;
+    let mut mesh = loaded.mesh;
+    if spec.transform != DMat4::IDENTITY {
+        place(&mut mesh, &spec.transform, &spec.path)?;
+    }
+    Ok(Input {
+        path: spec.path.clone(),
+        format,
+        mesh,
+        warnings: loaded.warnings,
+    })
+}
+
+/// Apply an affine transform to every vertex (f64), rejecting non-finite results.
+pub fn place(mesh: &mut Mesh, m: &DMat4, path: &Path) -> Result<()> {
+    for (i, p) in mesh.positions.iter_mut().enumerate() {
+        *p = m.transform_point3(*p);
+        if !p.is_finite() {
+            return Err(Error::input(
+                path,
+                format!("vertex {i} is not finite after the transform"),
+            ));
+        }
+    }
+    Ok(())
+}
+
+/// How a listed pair meets.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord, Hash)]
+pub enum PairKind {
+    /// The interiors cross: a real penetration.
+    Crossing,
+    /// They share points without crossing, or (with a touch tolerance) come within it.
+    Touching,
+    /// Closer than the clearance, not touching.
+    Clearance,
+}
+
+impl PairKind {
+    /// Name in the report.
+    pub fn name(self) -> &'static str {
+        match self {
+            PairKind::Crossing => "crossing",
+            PairKind::Touching => "touching",
+            PairKind::Clearance => "clearance",
+        }
+    }
+}
+
+/// One triangle pair worth reporting.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct PairFinding {
+    /// Triangle index in input A.
+    pub a: u32,
+    /// Triangle index in input B.
+    pub b: u32,
+    /// How they meet.
+    pub kind: PairKind,
+    /// The exact contact shape; `None` for pairs that only come within a tolerance.
+    pub contact: Option<Contact>,
+    /// 0 for exact contacts, else the f64 distance.
+    pub distance: f64,
+    /// The shared segment (f64) for non-coplanar contacts.
+    pub segment: Option<[DVec3; 2]>,
+}
+
+/// The closest pair.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Closest {
+    /// The distance (0 when the inputs touch or cross).
+    pub distance: f64,
+    /// Triangle in A and the witness point on it.
+    pub a: (u32, DVec3),
+    /// Triangle in B and the witness point on it.
+    pub b: (u32, DVec3),
+}
+
+/// Overall answer, ordered by severity.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord, Hash)]
+pub enum Verdict {
+    /// Nothing within the clearance.
+    Clear,
+    /// Some pair closer than the clearance.
+    Clearance,
+    /// Some pair touches (exactly, or within the touch tolerance), none crosses.
+    Touching,
+    /// Some pair crosses.
+    Clash,
+}
+
+impl Verdict {
+    /// Name in the report.
+    pub fn name(self) -> &'static str {
+        match self {
+            Verdict::Clear => "clear",
+            Verdict::Clearance => "clearance",
+            Verdict::Touching => "touching",
+            Verdict::Clash => "clash",
+        }
+    }
+}
+
+/// Counts over all pairs (never truncated).
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct Counts {
+    /// Crossing pairs.
+    pub crossing: u64,
+    /// Touching pairs (exact contact or within the touch tolerance).
+    pub touching: u64,
+    /// Of the touching pairs, those that only come within the touch tolerance.
+    pub within_tolerance: u64,
+    /// Clearance pairs.
+    pub clearance: u64,
+}
+
+/// Facts about one input.
+#[derive(Debug, Clone, PartialEq)]
+pub struct MeshInfo {
+    /// Vertex count.
+    pub vertices: usize,
+    /// Triangle count.
+    pub triangles: usize,
+    /// Zero-area triangles (handled as segments or points).
+    pub degenerate_triangles: usize,
+    /// Objects: name and triangle count, in file order.
+    pub objects: Vec<(String, usize)>,
+    /// World bounds.
+    pub bounds: Aabb,
+}
+
+impl MeshInfo {
+    /// Summarise a mesh.
+    pub fn of(mesh: &Mesh) -> MeshInfo {
+        let degenerate_triangles = (0..mesh.triangles.len() as u32)
+            .into_par_iter()
+            .filter(|&t| Shape::of(&bvh::triangle(mesh, t)).is_degenerate())
+            .count();
+        let mut counts = vec![0usize; mesh.objects.len()];
+        for &o in &mesh.tri_object {
+            counts[o as usize] += 1;
+        }
+        MeshInfo {
+            vertices: mesh.positions.len(),
+            triangles: mesh.triangles.len(),
+            degenerate_triangles,
+            objects: mesh
+                .objects
+                .iter()
+                .map(|o| o.name.clone())
+                .zip(counts)
+                .collect(),
+            bounds: Aabb::of_points(&mesh.positions),
+        }
+    }
+}
+
+/// Phase times in milliseconds.
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct Timings {
+    /// Building both trees.
+    pub build_ms: f64,
+    /// Walking, classifying and the distance search.
+    pub query_ms: f64,
+}
+
+/// Size of one tree.
+pub type TreeStats = bvh::Stats;
+
+/// Everything a check finds: plain data, sorted, independent of the thread count.
+#[derive(Debug, Clone, PartialEq)]
+pub struct ClashResult {
+    /// Every pair found, sorted by (a, b).
+    pub pairs: Vec<PairFinding>,
+    /// Counts by kind.
+    pub counts: Counts,
+    /// The closest pair (`None` only if an input has no triangles).
+    pub closest: Option<Closest>,
+    /// The overall answer.
+    pub verdict: Verdict,
+    /// The two trees.
+    pub trees: [TreeStats; 2],
+    /// Phase times.
+    pub timings: Timings,
+}
+
+/// Run the check on two meshes in world coordinates.
+pub fn check(a: &Mesh, b: &Mesh, settings: &Settings) -> ClashResult {
+    let t0 = Instant::now();
+    let (ta, tb) = rayon::join(
+        || Bvh::build(a, settings.bvh),
+        || Bvh::build(b, settings.bvh),
+    );
+    let build_ms = ms(t0);
+    let t1 = Instant::now();
+    let tol = settings.tolerances;
+    let mut pairs = traverse::collect_pairs(
+        &ta,
+        &tb,
+        |x, y| tol.boxes_may_meet(x, y),
+        |la, lb, out| {
+            for &i in la {
+                let ti = bvh::triangle(a, i);
+                let bi = Aabb::of_triangle(&ti);
+                for &j in lb {
+                    let tj = bvh::triangle(b, j);
+                    if !tol.boxes_may_meet(&bi, &Aabb::of_triangle(&tj)) {
+                        continue;
+                    }
+                    if let Some(f) = classify_pair(i, &ti, j, &tj, &tol) {
+                        out.push(f);
+                    }
+                }
+            }
+        },
+    );
+    pairs.par_sort_unstable_by_key(|p| (p.a, p.b));
+    let mut counts = Counts::default();
+    for p in &pairs {
+        match p.kind {
+            PairKind::Crossing => counts.crossing += 1,
+            PairKind::Touching => {
+                counts.touching += 1;
+                counts.within_tolerance += p.contact.is_none() as u64;
+            }
+            PairKind::Clearance => counts.clearance += 1,
+        }
+    }
+    let closest = match pairs.iter().find(|p| p.contact.is_some()) {
+        Some(p) => Some(contact_witness(a, b, p)),
+        None => closest_pair(a, &ta, b, &tb),
+    };
+    let verdict = if counts.crossing > 0 {
+        Verdict::Clash
+    } else if counts.touching > 0 {
+        Verdict::Touching
+    } else if counts.clearance > 0 {
+        Verdict::Clearance
+    } else {
+        Verdict::Clear
+    };
+    ClashResult {
+        pairs,
+        counts,
+        closest,
+        verdict,
+        trees: [ta.stats(), tb.stats()],
+        timings: Timings {
+            build_ms,
+            query_ms: ms(t1),
+        },
+    }
+}
+
+fn ms(t: Instant) -> f64 {
+    t.elapsed().as_secs_f64() * 1e3
+}
+
+/// Exact classification, then the tolerance bands for pairs that do not meet.
+fn classify_pair(
+    i: u32,
+    ti: &[DVec3; 3],
+    j: u32,
+    tj: &[DVec3; 3],
+    tol: &Tolerances,
+) -> Option<PairFinding> {
+    if let Some(h) = tri_tri::classify(ti, tj) {
+        let kind = if h.crossing {
+            PairKind::Crossing
+        } else {
+            PairKind::Touching
+        };
+        return Some(PairFinding {
+            a: i,
+            b: j,
+            kind,
+            contact: Some(h.contact),
+            distance: 0.0,
+            segment: h.segment,
+        });
+    }
+    if tol.search_margin() == 0.0 {
+        return None;
+    }
+    let d = triangle_distance(ti, tj);
+    let kind = if tol.is_touch(d.distance) {
+        PairKind::Touching
+    } else if tol.is_clearance(d.distance) {
+        PairKind::Clearance
+    } else {
+        return None;
+    };
+    Some(PairFinding {
+        a: i,
+        b: j,
+        kind,
+        contact: None,
+        distance: d.distance,
+        segment: Some([d.on_a, d.on_b]),
+    })
+}
+
+/// Witness for an exact contact: a shared point.
+fn contact_witness(a: &Mesh, b: &Mesh, p: &PairFinding) -> Closest {
+    let point = match p.segment {
+        Some(s) => s[0],
+        // Coplanar contacts: the closed-form distance of touching triangles is 0 (up to
+        // rounding) at a shared point.
+        None => triangle_distance(&bvh::triangle(a, p.a), &bvh::triangle(b, p.b)).on_a,
+    };
+    Closest {
+        distance: 0.0,
+        a: (p.a, point),
+        b: (p.b, point),
+    }
+}
+
+/// Branch-and-bound closest pair of two meshes known not to touch.
+fn closest_pair(a: &Mesh, ta: &Bvh, b: &Mesh, tb: &Bvh) -> Option<Closest> {
+    let scale = ta.bounds().max_abs().max(tb.bounds().max_abs());
+    let slack = predicates::distance_rounding_slack(scale);
+    let best = traverse::min_pair(
+        ta,
+        tb,
+        |x, y| x.distance_sq(y).sqrt(),
+        slack,
+        |la, lb, bound| {
+            let mut best: Option<Candidate<(DVec3, DVec3)>> = None;
+            for &i in la {
+                let ti = bvh::triangle(a, i);
+                let bi = Aabb::of_triangle(&ti);
+                for &j in lb {
+                    let tj = bvh::triangle(b, j);
+                    if bi.distance_sq(&Aabb::of_triangle(&tj)).sqrt() > bound {
+                        continue;
+                    }
+                    let d = triangle_distance(&ti, &tj);
+                    let c = Candidate {
+                        distance: d.distance,
+                        key: (i, j),
+                        data: (d.on_a, d.on_b),
+                    };
+                    if best
+                        .as_ref()
+                        .is_none_or(|m| (c.distance, c.key) < (m.distance, m.key))
+                    {
+                        best = Some(c);
+                    }
+                }
+            }
+            best
+        },
+    )?;
+    Some(Closest {
+        distance: best.distance,
+        a: (best.key.0, best.data.0),
+        b: (best.key.1, best.data.1),
+    })
+}
+
+/// The severity at which a run fails (exit code 1).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum FailOn {
+    /// Fail on crossing pairs (default).
+    #[default]
+    Clash,
+    /// Fail on touching or crossing pairs.
+    Touching,
+    /// Fail on anything closer than the clearance.
+    Clearance,
+    /// Never fail on findings (exit 0 unless an error).
+    Never,
+}
+
+impl FailOn {
+    /// Name on the command line and in the report.
+    pub fn name(self) -> &'static str {
+        match self {
+            FailOn::Clash => "clash",
+            FailOn::Touching => "touching",
+            FailOn::Clearance => "clearance",
+            FailOn::Never => "never",
+        }
+    }
+
+    /// Does `v` fail the run?
+    pub fn fails(self, v: Verdict) -> bool {
+        match self {
+            FailOn::Clash => v >= Verdict::Clash,
+            FailOn::Touching => v >= Verdict::Touching,
+            FailOn::Clearance => v >= Verdict::Clearance,
+            FailOn::Never => false,
+        }
+    }
+}

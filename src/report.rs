@@ -1,0 +1,454 @@
+//! The JSON wire format, documented once here (README repeats it with an example).
+//!
+//! Schema `meshclash.report/1`. Field order is fixed; arrays are sorted; numbers are f64 printed
+//! shortest-round-trip. With `deterministic` (`--no-timings`) the run-dependent fields
+//! (`settings.threads`, `timings_ms`) are `null`, so the same inputs give byte-identical reports
+//! whatever the thread count.
+//!
+//! ```text
+//! {
+//!   "schema": "meshclash.report/1",
+//!   "tool": {"name": "meshclash", "version": "0.1.0"},
+//!   "inputs": {
+//!     "a": {"path", "format": "obj|stl|gltf|glb", "vertices", "triangles", "degenerate_triangles",
+//!           "objects": [{"name", "triangles"}], "bounds": {"min": [x,y,z], "max": [x,y,z]},
+//!           "transform": [16 numbers, row-major] | null},
+//!     "b": { ...same... }
+//!   },
+//!   "settings": {"touch_tolerance", "clearance", "fail_on", "bvh", "leaf_size", "max_pairs",
+//!                "threads": n | null},
+//!   "verdict": "clash" | "touching" | "clearance" | "clear",
+//!   "failed": bool,                  // verdict at or above fail_on (exit code 1)
+//!   "summary": {"crossing_pairs", "touching_pairs", "within_tolerance_pairs", "clearance_pairs",
+//!               "min_distance": number | null},
+//!   "closest": {"distance", "a": {"triangle", "object", "point": [x,y,z]}, "b": {...}} | null,
+//!   "pairs": [{"a", "b", "a_object", "b_object", "kind": "crossing|touching|clearance",
+//!              "contact": "point|segment|coplanar_area|coplanar_boundary|within_tolerance" | null,
+//!              "distance", "segment": [[x,y,z],[x,y,z]] | null}],
+//!   "pairs_truncated": bool,
+//!   "bvh": {"a": {"nodes", "leaves", "depth", "sah_cost", "bytes"}, "b": {...}},
+//!   "warnings": ["..."],
+//!   "timings_ms": {"load", "build", "query", "total"} | null
+//! }
+//! ```
+//! Triangle indices are 0-based in file order (see [`crate::load`]); `object` / `a_object`
+//! index into `inputs.*.objects`.
+
+use crate::error::{Error, Result};
+use crate::geom::{Aabb, DVec3};
+use crate::query::{ClashResult, Input, PairFinding, TreeStats, Verdict};
+use glam::DMat4;
+use serde::{Deserialize, Serialize};
+use std::io::Write;
+use std::path::Path;
+
+/// The schema identifier written in every report.
+pub const SCHEMA: &str = "meshclash.report/1";
+
+/// The whole report.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Report {
+    /// Always [`SCHEMA`].
+    pub schema: String,
+    /// Who wrote it.
+    pub tool: Tool,
+    /// The two inputs.
+    pub inputs: Inputs,
+    /// The settings used.
+    pub settings: SettingsReport,
+    /// `clash`, `touching`, `clearance` or `clear`.
+    pub verdict: String,
+    /// True if the verdict is at or above `settings.fail_on` (the process exits 1).
+    pub failed: bool,
+    /// Counts (complete even when `pairs` is truncated).
+    pub summary: Summary,
+    /// The closest pair of points.
+    pub closest: Option<ClosestReport>,
+    /// The pairs found, sorted by (a, b), at most `settings.max_pairs`.
+    pub pairs: Vec<PairReport>,
+    /// True if `pairs` was cut at `max_pairs`.
+    pub pairs_truncated: bool,
+    /// Tree sizes.
+    pub bvh: Trees,
+    /// Loader warnings, prefixed with the file.
+    pub warnings: Vec<String>,
+    /// Phase times (null in deterministic mode).
+    pub timings_ms: Option<TimingsReport>,
+}
+
+/// Tool name and version.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Tool {
+    /// "meshclash".
+    pub name: String,
+    /// Crate version.
+    pub version: String,
+}
+
+/// Inputs A and B.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Inputs {
+    /// First input.
+    pub a: InputReport,
+    /// Second input.
+    pub b: InputReport,
+}
+
+/// One input.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct InputReport {
+    /// Path as given.
+    pub path: String,
+    /// `obj`, `stl`, `gltf` or `glb`.
+    pub format: String,
+    /// Vertex count.
+    pub vertices: usize,
+    /// Triangle count.
+    pub triangles: usize,
+    /// Zero-area triangles.
+    pub degenerate_triangles: usize,
+    /// Objects in file order.
+    pub objects: Vec<ObjectReport>,
+    /// World bounds (after the transform).
+    pub bounds: Bounds,
+    /// The placement applied, row-major 4×4, or null for none.
+    pub transform: Option<Vec<f64>>,
+}
+
+/// An object (OBJ `o`/`g`, STL solid, glTF mesh instance).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ObjectReport {
+    /// Its name.
+    pub name: String,
+    /// Its triangle count.
+    pub triangles: usize,
+}
+
+/// An axis-aligned box.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Bounds {
+    /// Lower corner.
+    pub min: [f64; 3],
+    /// Upper corner.
+    pub max: [f64; 3],
+}
+
+/// Settings as used.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct SettingsReport {
+    /// Absolute touch tolerance (model units).
+    pub touch_tolerance: f64,
+    /// Absolute clearance (model units).
+    pub clearance: f64,
+    /// `clash`, `touching`, `clearance` or `never`.
+    pub fail_on: String,
+    /// `sah`, `median` or `equal`.
+    pub bvh: String,
+    /// Largest leaf.
+    pub leaf_size: u32,
+    /// Cap on listed pairs.
+    pub max_pairs: usize,
+    /// Worker threads (null in deterministic mode).
+    pub threads: Option<usize>,
+}
+
+/// Counts.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Summary {
+    /// Pairs whose interiors cross.
+    pub crossing_pairs: u64,
+    /// Pairs that touch (exactly or within the touch tolerance).
+    pub touching_pairs: u64,
+    /// Of those, pairs that only come within the touch tolerance.
+    pub within_tolerance_pairs: u64,
+    /// Pairs closer than the clearance.
+    pub clearance_pairs: u64,
+    /// The minimum distance between the two surfaces.
+    pub min_distance: Option<f64>,
+}
+
+/// The closest pair.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ClosestReport {
+    /// The distance.
+    pub distance: f64,
+    /// Witness on A.
+    pub a: Witness,
+    /// Witness on B.
+    pub b: Witness,
+}
+
+/// A point on a triangle.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Witness {
+    /// Triangle index.
+    pub triangle: u32,
+    /// Object index of that triangle.
+    pub object: u32,
+    /// The point.
+    pub point: [f64; 3],
+}
+
+/// One listed pair.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct PairReport {
+    /// Triangle in A.
+    pub a: u32,
+    /// Triangle in B.
+    pub b: u32,
+    /// Object of `a` (index into `inputs.a.objects`).
+    pub a_object: u32,
+    /// Object of `b`.
+    pub b_object: u32,
+    /// `crossing`, `touching` or `clearance`.
+    pub kind: String,
+    /// Contact shape, `within_tolerance`, or null for clearance pairs.
+    pub contact: Option<String>,
+    /// 0 for exact contacts.
+    pub distance: f64,
+    /// Shared segment, or (tolerance/clearance pairs) the two closest points.
+    pub segment: Option<[[f64; 3]; 2]>,
+}
+
+/// Tree sizes.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Trees {
+    /// A's tree.
+    pub a: TreeReport,
+    /// B's tree.
+    pub b: TreeReport,
+}
+
+/// One tree.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct TreeReport {
+    /// Nodes.
+    pub nodes: usize,
+    /// Leaves.
+    pub leaves: usize,
+    /// Depth.
+    pub depth: usize,
+    /// SAH cost.
+    pub sah_cost: f64,
+    /// Bytes.
+    pub bytes: usize,
+}
+
+/// Phase times.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct TimingsReport {
+    /// Reading and parsing both files.
+    pub load: f64,
+    /// Building both trees.
+    pub build: f64,
+    /// Pair search and distance.
+    pub query: f64,
+    /// Everything.
+    pub total: f64,
+}
+
+/// What the report needs beyond the result.
+#[derive(Debug, Clone)]
+pub struct Context<'a> {
+    /// The two inputs.
+    pub inputs: [&'a Input; 2],
+    /// The two transforms applied (identity = none).
+    pub transforms: [DMat4; 2],
+    /// Settings as shown.
+    pub settings: SettingsReport,
+    /// Whether the verdict fails the run.
+    pub failed: bool,
+    /// Load and total times, or None in deterministic mode.
+    pub times: Option<(f64, f64)>,
+}
+
+fn v3(p: DVec3) -> [f64; 3] {
+    p.to_array()
+}
+
+fn input_report(input: &Input, m: &DMat4, info: &crate::query::MeshInfo) -> InputReport {
+    let Aabb { min, max } = info.bounds;
+    InputReport {
+        path: input.path.display().to_string(),
+        format: input.format.name().to_string(),
+        vertices: info.vertices,
+        triangles: info.triangles,
+        degenerate_triangles: info.degenerate_triangles,
+        objects: info
+            .objects
+            .iter()
+            .map(|(n, t)| ObjectReport {
+                name: n.clone(),
+                triangles: *t,
+            })
+            .collect(),
+        bounds: Bounds {
+            min: v3(min),
+            max: v3(max),
+        },
+        transform: (*m != DMat4::IDENTITY).then(|| m.transpose().to_cols_array().to_vec()),
+    }
+}
+
+fn tree_report(s: &TreeStats) -> TreeReport {
+    TreeReport {
+        nodes: s.nodes,
+        leaves: s.leaves,
+        depth: s.depth,
+        sah_cost: s.sah_cost,
+        bytes: s.bytes,
+    }
+}
+
+fn pair_report(p: &PairFinding, ca: &[u32], cb: &[u32]) -> PairReport {
+    PairReport {
+        a: p.a,
+        b: p.b,
+        a_object: ca[p.a as usize],
+        b_object: cb[p.b as usize],
+        kind: p.kind.name().to_string(),
+        contact: match (p.contact, p.kind) {
+            (Some(c), _) => Some(c.name().to_string()),
+            (None, crate::query::PairKind::Touching) => Some("within_tolerance".to_string()),
+            (None, _) => None,
+        },
+        distance: p.distance,
+        segment: p.segment.map(|[s, t]| [v3(s), v3(t)]),
+    }
+}
+
+/// Assemble the report.
+pub fn build(ctx: &Context, r: &ClashResult) -> Report {
+    let [ia, ib] = ctx.inputs;
+    let (infa, infb) = (
+        crate::query::MeshInfo::of(&ia.mesh),
+        crate::query::MeshInfo::of(&ib.mesh),
+    );
+    let (oa, ob) = (&ia.mesh.tri_object, &ib.mesh.tri_object);
+    let max = ctx.settings.max_pairs;
+    let warnings = ctx
+        .inputs
+        .iter()
+        .flat_map(|i| {
+            i.warnings
+                .iter()
+                .map(move |w| format!("{}: {}", i.path.display(), w))
+        })
+        .collect();
+    Report {
+        schema: SCHEMA.to_string(),
+        tool: Tool {
+            name: "meshclash".into(),
+            version: env!("CARGO_PKG_VERSION").into(),
+        },
+        inputs: Inputs {
+            a: input_report(ia, &ctx.transforms[0], &infa),
+            b: input_report(ib, &ctx.transforms[1], &infb),
+        },
+        settings: ctx.settings.clone(),
+        verdict: r.verdict.name().to_string(),
+        failed: ctx.failed,
+        summary: Summary {
+            crossing_pairs: r.counts.crossing,
+            touching_pairs: r.counts.touching,
+            within_tolerance_pairs: r.counts.within_tolerance,
+            clearance_pairs: r.counts.clearance,
+            min_distance: r.closest.map(|c| c.distance),
+        },
+        closest: r.closest.map(|c| ClosestReport {
+            distance: c.distance,
+            a: Witness {
+                triangle: c.a.0,
+                object: oa[c.a.0 as usize],
+                point: v3(c.a.1),
+            },
+            b: Witness {
+                triangle: c.b.0,
+                object: ob[c.b.0 as usize],
+                point: v3(c.b.1),
+            },
+        }),
+        pairs: r
+            .pairs
+            .iter()
+            .take(max)
+            .map(|p| pair_report(p, oa, ob))
+            .collect(),
+        pairs_truncated: r.pairs.len() > max,
+        bvh: Trees {
+            a: tree_report(&r.trees[0]),
+            b: tree_report(&r.trees[1]),
+        },
+        warnings,
+        timings_ms: ctx.times.map(|(load, total)| TimingsReport {
+            load,
+            build: r.timings.build_ms,
+            query: r.timings.query_ms,
+            total,
+        }),
+    }
+}
+
+/// Verdict severity from its report name (for readers of old reports).
+pub fn verdict_from_name(s: &str) -> Option<Verdict> {
+    [
+        Verdict::Clear,
+        Verdict::Clearance,
+        Verdict::Touching,
+        Verdict::Clash,
+    ]
+    .into_iter()
+    .find(|v| v.name() == s)
+}
+
+/// The report as pretty JSON with a trailing newline.
+pub fn to_json(report: &Report) -> String {
+    let mut s = serde_json::to_string_pretty(report).expect("report serialises");
+    s.push('\n');
+    s
+}
+
+/// Write `bytes` to `path` completely or not at all: a temporary file beside it, flushed and
+/// synced, then renamed over the target.
+pub fn write_atomic(path: &Path, bytes: &[u8]) -> Result<()> {
+    let err = |e: std::io::Error| Error::Output {
+        path: path.to_path_buf(),
+        msg: e.to_string(),
+    };
+    let dir = path
+        .parent()
+        .filter(|d| !d.as_os_str().is_empty())
+        .unwrap_or(Path::new("."));
+    let name = path
+        .file_name()
+        .ok_or_else(|| err(std::io::Error::other("not a file name")))?;
+    let tmp = dir.join(format!(
+        ".{}.{}.tmp",
+        name.to_string_lossy(),
+        std::process::id()
+    ));
+    let result = (|| {
+        let mut f = std::fs::File::create(&tmp)?;
+        f.write_all(bytes)?;
+        f.sync_all()?;
+        std::fs::rename(&tmp, path)
+    })();
+    if result.is_err() {
+        let _ = std::fs::remove_file(&tmp);
+    }
+    result.map_err(err)
+}

@@ -1,0 +1,306 @@
+//! The real binary: exit codes, report file, one-line errors, determinism, schema.
+
+use assert_cmd::Command;
+use meshclash::report::Report;
+use std::path::{Path, PathBuf};
+
+fn root() -> PathBuf {
+    PathBuf::from(env!("CARGO_MANIFEST_DIR"))
+}
+
+fn shipped(name: &str) -> String {
+    root().join("meshes").join(name).display().to_string()
+}
+
+fn shared(name: &str) -> PathBuf {
+    root().join("../shared/meshes").join(name)
+}
+
+fn bin() -> Command {
+    Command::cargo_bin("meshclash").unwrap()
+}
+
+/// Parse with unknown fields denied (the report types say `deny_unknown_fields`), and check the
+/// top-level keys against the documented list independently of those types.
+fn parse(stdout: &[u8]) -> Report {
+    let v: serde_json::Value = serde_json::from_slice(stdout).expect("stdout is JSON");
+    let keys: Vec<&str> = v.as_object().unwrap().keys().map(String::as_str).collect();
+    let documented = [
+        "schema",
+        "tool",
+        "inputs",
+        "settings",
+        "verdict",
+        "failed",
+        "summary",
+        "closest",
+        "pairs",
+        "pairs_truncated",
+        "bvh",
+        "warnings",
+        "timings_ms",
+    ];
+    let mut k = keys.clone();
+    k.sort();
+    let mut d = documented.to_vec();
+    d.sort();
+    assert_eq!(k, d);
+    serde_json::from_value(v).expect("report matches the documented schema")
+}
+
+#[test]
+fn main_job_on_shipped_meshes_reports_the_clash_and_exits_1() {
+    let out = bin()
+        .args([shipped("fcl_env.obj"), shipped("fcl_rob.obj")])
+        .output()
+        .unwrap();
+    assert_eq!(out.status.code(), Some(1));
+    let r = parse(&out.stdout);
+    assert_eq!(r.schema, "meshclash.report/1");
+    assert_eq!(r.verdict, "clash");
+    assert!(r.failed);
+    assert_eq!(r.summary.min_distance, Some(0.0));
+    assert_eq!(r.inputs.a.triangles, 2180);
+    assert_eq!(
+        r.pairs.len() as u64,
+        r.summary.crossing_pairs + r.summary.touching_pairs
+    );
+    // Sorted by (a, b), every listed pair a crossing with its segment.
+    assert!(r
+        .pairs
+        .windows(2)
+        .all(|w| (w[0].a, w[0].b) < (w[1].a, w[1].b)));
+    assert!(r
+        .pairs
+        .iter()
+        .all(|p| p.kind == "crossing" && p.segment.is_some()));
+    // The count line of the FCL file is reported as a warning on stderr, once per file.
+    let err = String::from_utf8(out.stderr).unwrap();
+    assert_eq!(
+        err.lines().filter(|l| l.contains("warning")).count(),
+        2,
+        "{err}"
+    );
+    assert_eq!(r.warnings.len(), 2);
+}
+
+#[test]
+fn fail_on_never_and_far_apart_exit_0() {
+    let out = bin()
+        .args([
+            &shipped("fcl_env.obj"),
+            &shipped("fcl_rob.obj"),
+            "--fail-on",
+            "never",
+            "-q",
+        ])
+        .output()
+        .unwrap();
+    assert_eq!(out.status.code(), Some(0));
+    assert!(out.stderr.is_empty(), "--quiet silences warnings");
+    let out = bin()
+        .args([
+            &shipped("fcl_env.obj"),
+            &shipped("fcl_rob.obj"),
+            "--translate-b",
+            "0,0,10000",
+        ])
+        .output()
+        .unwrap();
+    assert_eq!(out.status.code(), Some(0));
+    let r = parse(&out.stdout);
+    assert_eq!(r.verdict, "clear");
+    let c = r.closest.unwrap();
+    let d: f64 = (0..3)
+        .map(|k| (c.a.point[k] - c.b.point[k]).powi(2))
+        .sum::<f64>()
+        .sqrt();
+    assert!((d - c.distance).abs() <= 1e-9 * c.distance);
+    assert!(c.distance > 0.0 && r.pairs.is_empty());
+}
+
+#[test]
+fn clearance_and_fail_on_clearance() {
+    // multibody: two bodies 0.507 apart in one file; compare the file with itself moved far
+    // enough that only the clearance band catches it.
+    let f = shipped("multibody.stl");
+    let base = bin()
+        .args([&f, &f, "--translate-b", "0,0,100", "-q"])
+        .output()
+        .unwrap();
+    let d = parse(&base.stdout).summary.min_distance.unwrap();
+    let clearance = format!("{}", d * 1.01);
+    let out = bin()
+        .args([
+            &f,
+            &f,
+            "--translate-b",
+            "0,0,100",
+            "--clearance",
+            &clearance,
+            "--fail-on",
+            "clearance",
+        ])
+        .output()
+        .unwrap();
+    assert_eq!(out.status.code(), Some(1));
+    let r = parse(&out.stdout);
+    assert_eq!(r.verdict, "clearance");
+    assert!(r.summary.clearance_pairs > 0);
+    assert!(r
+        .pairs
+        .iter()
+        .all(|p| p.kind == "clearance" && p.distance < d * 1.01 && p.distance >= d));
+}
+
+#[test]
+fn output_file_is_written_and_stdout_stays_empty() {
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("report.json");
+    let out = bin()
+        .args([
+            &shipped("fcl_env.obj"),
+            &shipped("fcl_rob.obj"),
+            "-q",
+            "-o",
+            path.to_str().unwrap(),
+        ])
+        .output()
+        .unwrap();
+    assert_eq!(out.status.code(), Some(1));
+    assert!(out.stdout.is_empty());
+    let r = parse(&std::fs::read(&path).unwrap());
+    assert_eq!(r.verdict, "clash");
+    // Nothing but the report is left behind (the temporary file was renamed).
+    assert_eq!(std::fs::read_dir(dir.path()).unwrap().count(), 1);
+}
+
+#[test]
+fn max_pairs_truncates_the_list_not_the_counts() {
+    let out = bin()
+        .args([
+            &shipped("fcl_env.obj"),
+            &shipped("fcl_rob.obj"),
+            "-q",
+            "--max-pairs",
+            "5",
+        ])
+        .output()
+        .unwrap();
+    let r = parse(&out.stdout);
+    assert_eq!(r.pairs.len(), 5);
+    assert!(r.pairs_truncated);
+    assert!(r.summary.crossing_pairs > 5);
+}
+
+fn error_line(args: &[&str]) -> String {
+    let out = bin().args(args).output().unwrap();
+    assert_eq!(out.status.code(), Some(2), "args {args:?}");
+    assert!(out.stdout.is_empty());
+    let err = String::from_utf8(out.stderr).unwrap();
+    assert_eq!(err.lines().count(), 1, "one line: {err}");
+    err
+}
+
+#[test]
+fn bad_input_is_one_line_exit_2() {
+    let dir = tempfile::tempdir().unwrap();
+    let ok = shipped("fcl_rob.obj");
+    let missing = dir.path().join("nope.obj");
+    let err = error_line(&[missing.to_str().unwrap(), &ok]);
+    assert!(err.contains("nope.obj"), "{err}");
+    let ply = dir.path().join("x.ply");
+    std::fs::write(&ply, "ply\n").unwrap();
+    assert!(error_line(&[&ok, ply.to_str().unwrap()]).contains("x.ply"));
+    let empty = dir.path().join("empty.stl");
+    std::fs::write(&empty, "").unwrap();
+    assert!(error_line(&[&ok, empty.to_str().unwrap()]).contains("empty.stl"));
+    let nan = dir.path().join("nan.obj");
+    std::fs::write(&nan, "v 0 0 0\nv 1 0 nan\nv 0 1 0\nf 1 2 3\n").unwrap();
+    assert!(error_line(&[&ok, nan.to_str().unwrap()]).contains("nan.obj"));
+    let idx = dir.path().join("idx.obj");
+    std::fs::write(&idx, "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 9\n").unwrap();
+    assert!(error_line(&[&ok, idx.to_str().unwrap()]).contains("idx.obj"));
+}
+
+#[test]
+fn bad_arguments_exit_2() {
+    let ok = shipped("fcl_rob.obj");
+    assert!(error_line(&[&ok, &ok, "--transform-a", "1,0,0"]).contains("transform-a"));
+    assert!(
+        error_line(&[&ok, &ok, "--transform-b", "1,0,0,0,0,1,0,0,0,0,1,0,0,0,1,1"])
+            .contains("last row")
+    );
+    assert!(error_line(&[&ok, &ok, "--translate-a", "1,2"]).contains("translate-a"));
+    assert!(error_line(&[&ok, &ok, "--clearance", "-1"]).contains("clearance"));
+    assert!(error_line(&[&ok, &ok, "--leaf-size", "0"]).contains("leaf-size"));
+    let out = bin().args([&ok]).output().unwrap();
+    assert_eq!(out.status.code(), Some(2));
+}
+
+#[test]
+fn transform_and_translate_agree() {
+    let a = shipped("fcl_env.obj");
+    let b = shipped("fcl_rob.obj");
+    let t = bin()
+        .args([&a, &b, "-q", "--no-timings", "--translate-a", "10,-20,30"])
+        .output()
+        .unwrap();
+    let m = bin()
+        .args([
+            &a,
+            &b,
+            "-q",
+            "--no-timings",
+            "--transform-a",
+            "1,0,0,10,0,1,0,-20,0,0,1,30",
+        ])
+        .output()
+        .unwrap();
+    let (t, m) = (parse(&t.stdout), parse(&m.stdout));
+    assert_eq!(t.summary, m.summary);
+    assert_eq!(t.pairs, m.pairs);
+}
+
+#[test]
+fn byte_identical_across_thread_counts_on_the_bunny() {
+    let bunny = shared("stanford-bunny.obj");
+    if !bunny.exists() {
+        panic!(
+            "{} is missing: CI runs with ../shared beside the repo",
+            bunny.display()
+        );
+    }
+    let b = bunny.to_str().unwrap();
+    // A moved, rotated copy that cuts through the original.
+    let m = "0.8,-0.6,0,0.01,0.6,0.8,0,0.005,0,0,1,0.002";
+    let run = |threads: &str| {
+        let out = bin()
+            .args([
+                b,
+                b,
+                "--transform-b",
+                m,
+                "--no-timings",
+                "--threads",
+                threads,
+                "--clearance",
+                "0.0005",
+            ])
+            .output()
+            .unwrap();
+        assert_eq!(out.status.code(), Some(1));
+        out.stdout
+    };
+    let one = run("1");
+    let r = parse(&one);
+    assert!(r.summary.crossing_pairs > 0 && r.summary.clearance_pairs > 0);
+    assert!(r.timings_ms.is_none() && r.settings.threads.is_none());
+    assert_eq!(run("2"), one);
+    assert_eq!(run("4"), one);
+}
+
+#[allow(dead_code)]
+fn exists(p: &Path) -> bool {
+    p.exists()
+}
