@@ -38,20 +38,10 @@ pub struct Args {
     #[arg(long, value_name = "M", allow_hyphen_values = true)]
     pub transform_b: Option<String>,
     /// Pairs that do not touch but are within this distance count as touching (model units).
-    #[arg(
-        long,
-        value_name = "E",
-        default_value_t = 0.0,
-        allow_negative_numbers = true
-    )]
+    #[arg(long, value_name = "E", default_value_t = 0.0, allow_negative_numbers = true)]
     pub touch_tolerance: f64,
     /// Also report every pair closer than D that does not touch (model units).
-    #[arg(
-        long,
-        value_name = "D",
-        default_value_t = 0.0,
-        allow_negative_numbers = true
-    )]
+    #[arg(long, value_name = "D", default_value_t = 0.0, allow_negative_numbers = true)]
     pub clearance: f64,
     /// Exit 1 when the verdict is at or above this.
     #[arg(long, value_enum, default_value_t = FailOnArg::Clash)]
@@ -125,9 +115,7 @@ fn numbers(flag: &str, s: &str) -> Result<Vec<f64>> {
             let t = t.trim();
             match t.parse::<f64>() {
                 Ok(v) if v.is_finite() => Ok(v),
-                _ => Err(Error::Usage(format!(
-                    "--{flag}: '{t}' is not a finite number"
-                ))),
+                _ => Err(Error::Usage(format!("--{flag}: '{t}' is not a finite number"))),
             }
         })
         .collect()
@@ -137,15 +125,10 @@ fn numbers(flag: &str, s: &str) -> Result<Vec<f64>> {
 pub fn parse_transform(flag: &str, s: &str) -> Result<DMat4> {
     let v = numbers(flag, s)?;
     if v.len() != 12 && v.len() != 16 {
-        return Err(Error::Usage(format!(
-            "--{flag} takes 12 or 16 numbers, got {}",
-            v.len()
-        )));
+        return Err(Error::Usage(format!("--{flag} takes 12 or 16 numbers, got {}", v.len())));
     }
     if v.len() == 16 && v[12..] != [0.0, 0.0, 0.0, 1.0] {
-        return Err(Error::Usage(format!(
-            "--{flag}: the last row must be 0,0,0,1 (affine only)"
-        )));
+        return Err(Error::Usage(format!("--{flag}: the last row must be 0,0,0,1 (affine only)")));
     }
     let row = |r: usize| DVec4::new(v[4 * r], v[4 * r + 1], v[4 * r + 2], v[4 * r + 3]);
     Ok(DMat4::from_cols(row(0), row(1), row(2), DVec4::W).transpose())
@@ -156,10 +139,7 @@ pub fn parse_translation(flag: &str, s: &str) -> Result<DVec3> {
     let v = numbers(flag, s)?;
     match v[..] {
         [x, y, z] => Ok(DVec3::new(x, y, z)),
-        _ => Err(Error::Usage(format!(
-            "--{flag} takes x,y,z, got {} numbers",
-            v.len()
-        ))),
+        _ => Err(Error::Usage(format!("--{flag} takes x,y,z, got {} numbers", v.len()))),
     }
 }
 
@@ -178,9 +158,7 @@ fn tolerance(flag: &str, v: f64) -> Result<f64> {
     if v.is_finite() && v >= 0.0 {
         Ok(v)
     } else {
-        Err(Error::Usage(format!(
-            "--{flag} must be a finite number >= 0, got {v}"
-        )))
+        Err(Error::Usage(format!("--{flag} must be a finite number >= 0, got {v}")))
     }
 }
 
@@ -188,10 +166,7 @@ impl Args {
     /// Validate into a [`Config`].
     pub fn into_config(self) -> Result<Config> {
         if !(1..=64).contains(&self.leaf_size) {
-            return Err(Error::Usage(format!(
-                "--leaf-size must be 1..=64, got {}",
-                self.leaf_size
-            )));
+            return Err(Error::Usage(format!("--leaf-size must be 1..=64, got {}", self.leaf_size)));
         }
         let tolerances = Tolerances {
             touch: tolerance("touch-tolerance", self.touch_tolerance)?,
@@ -199,14 +174,8 @@ impl Args {
         };
         Ok(Config {
             inputs: [
-                InputSpec {
-                    path: self.a,
-                    transform: placement('a', &self.transform_a, &self.translate_a)?,
-                },
-                InputSpec {
-                    path: self.b,
-                    transform: placement('b', &self.transform_b, &self.translate_b)?,
-                },
+                InputSpec { path: self.a, transform: placement('a', &self.transform_a, &self.translate_a)? },
+                InputSpec { path: self.b, transform: placement('b', &self.transform_b, &self.translate_b)? },
             ],
             output: self.output,
             settings: Settings {
@@ -255,10 +224,7 @@ pub fn run(cfg: &Config) -> Result<Outcome> {
 
 fn run_in_pool(cfg: &Config, threads: usize) -> Result<Outcome> {
     let t0 = Instant::now();
-    let (a, b) = rayon::join(
-        || query::load_input(&cfg.inputs[0]),
-        || query::load_input(&cfg.inputs[1]),
-    );
+    let (a, b) = rayon::join(|| query::load_input(&cfg.inputs[0]), || query::load_input(&cfg.inputs[1]));
     let (a, b) = (a?, b?);
     let load_ms = t0.elapsed().as_secs_f64() * 1e3;
     let result = query::check(&a.mesh, &b.mesh, &cfg.settings);
@@ -288,9 +254,5 @@ fn run_in_pool(cfg: &Config, threads: usize) -> Result<Outcome> {
         }
         None => Some(json),
     };
-    Ok(Outcome {
-        stdout,
-        warnings,
-        exit_code: failed as u8,
-    })
+    Ok(Outcome { stdout, warnings, exit_code: failed as u8 })
 }

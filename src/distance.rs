@@ -90,14 +90,11 @@ pub fn closest_point_on_triangle(p: DVec3, a: DVec3, b: DVec3, c: DVec3) -> DVec
     edge
 }
 
-/// Ericson §5.1.9 without canonical ordering; see [`closest_points_segments`].
-#[inline]
-fn segments_raw(p1: DVec3, q1: DVec3, p2: DVec3, q2: DVec3) -> (DVec3, DVec3) {
-    let d1 = q1 - p1;
-    let d2 = q2 - p2;
+/// Ericson §5.1.9 for segments `p1 + s·d1` and `p2 + t·d2`, `s, t ∈ [0, 1]`, given
+/// `a = |d1|²` and `e = |d2|²`; see [`closest_points_segments`].
+#[inline(always)]
+fn segments_core(p1: DVec3, d1: DVec3, a: f64, p2: DVec3, d2: DVec3, e: f64) -> (DVec3, DVec3) {
     let r = p1 - p2;
-    let a = d1.dot(d1);
-    let e = d2.dot(d2);
     let f = d2.dot(r);
     let (s, t);
     if a <= 0.0 {
@@ -136,12 +133,12 @@ fn segments_raw(p1: DVec3, q1: DVec3, p2: DVec3, q2: DVec3) -> (DVec3, DVec3) {
     (p1 + d1 * s, p2 + d2 * t)
 }
 
-/// `true` when segment `x` precedes segment `y` in the lexicographic order of their coordinates
-/// (`f64::total_cmp`), used to make the segment query exactly symmetric.
+/// `true` when the point list `x` precedes `y` in the lexicographic order of their coordinates
+/// (`f64::total_cmp`): the canonical argument order that makes the queries exactly symmetric.
 #[inline]
-fn seg_precedes(x: [DVec3; 2], y: [DVec3; 2]) -> bool {
-    for k in 0..2 {
-        for (u, v) in x[k].to_array().into_iter().zip(y[k].to_array()) {
+fn precedes(x: &[DVec3], y: &[DVec3]) -> bool {
+    for (p, q) in x.iter().zip(y) {
+        for (u, v) in p.to_array().into_iter().zip(q.to_array()) {
             match u.total_cmp(&v) {
                 std::cmp::Ordering::Less => return true,
                 std::cmp::Ordering::Greater => return false,
@@ -162,11 +159,13 @@ fn seg_precedes(x: [DVec3; 2], y: [DVec3; 2]) -> bool {
 /// segments). The pair is computed with the lexicographically smaller segment first, so
 /// swapping the arguments swaps the result bit for bit.
 pub fn closest_points_segments(p1: DVec3, q1: DVec3, p2: DVec3, q2: DVec3) -> (DVec3, DVec3) {
-    if seg_precedes([p2, q2], [p1, q1]) {
-        let (y, x) = segments_raw(p2, q2, p1, q1);
+    let (d1, d2) = (q1 - p1, q2 - p2);
+    let (a, e) = (d1.dot(d1), d2.dot(d2));
+    if precedes(&[p2, q2], &[p1, q1]) {
+        let (y, x) = segments_core(p2, d2, e, p1, d1, a);
         (x, y)
     } else {
-        segments_raw(p1, q1, p2, q2)
+        segments_core(p1, d1, a, p2, d2, e)
     }
 }
 
@@ -220,7 +219,8 @@ fn face_candidate(t: &[DVec3; 3], m: &[DVec3; 3], p: DVec3) -> Option<DVec3> {
 /// elsewhere and uses 0 then), with witness points on each triangle: the minimum over the 6
 /// vertex–triangle and 9 edge–edge candidates. Degenerate triangles (segments, points) work.
 ///
-/// Candidates, in tie-breaking order (the first minimum wins):
+/// Candidates, in tie-breaking order (the first minimum wins), with `a` and `b` in canonical
+/// order (see below):
 /// 1. the 9 edge pairs, `a`'s edges outer and `b`'s inner, edge `i` being `[t[i], t[(i+1)%3]]`
 ///    ([`closest_points_segments`]);
 /// 2. `b[0]`, `b[1]`, `b[2]` against the face of `a`, then `a[0]`, `a[1]`, `a[2]` against the face
@@ -229,9 +229,9 @@ fn face_candidate(t: &[DVec3; 3], m: &[DVec3; 3], p: DVec3) -> Option<DVec3> {
 /// A vertex whose closest point on the other triangle lies on an edge is covered by the edge
 /// pairs, so vertex–triangle candidates need only the face interior; for a zero-area triangle
 /// the edge pairs alone cover everything. Squared distances are compared and one `sqrt` taken,
-/// so `distance == |on_a − on_b|`. `distance` is bitwise symmetric:
-/// `triangle_distance(b, a).distance == triangle_distance(a, b).distance` (the witnesses swap,
-/// except that exact ties may resolve to a different pair).
+/// so `distance == |on_a − on_b|`. The pair is evaluated with the lexicographically smaller
+/// triangle (by coordinates, `f64::total_cmp`) first, so `triangle_distance(b, a)` is
+/// `triangle_distance(a, b)` with `on_a` and `on_b` swapped, bit for bit, ties included.
 ///
 /// If the triangles do intersect, the true distance is 0 but the result is still the minimum of
 /// these same 15 candidates: `distance >= 0`, `on_a` is a point of `a` and `on_b` a point of
@@ -239,6 +239,16 @@ fn face_candidate(t: &[DVec3; 3], m: &[DVec3; 3], p: DVec3) -> Option<DVec3> {
 /// the boundaries touch (edges crossing, a vertex on the other triangle) and in general positive
 /// when an edge pierces the other triangle's interior, which no candidate measures.
 pub fn triangle_distance(a: &[DVec3; 3], b: &[DVec3; 3]) -> TriDistance {
+    if precedes(b, a) {
+        let r = triangle_distance_ordered(b, a);
+        TriDistance { on_a: r.on_b, on_b: r.on_a, ..r }
+    } else {
+        triangle_distance_ordered(a, b)
+    }
+}
+
+/// [`triangle_distance`] without the canonical argument order.
+fn triangle_distance_ordered(a: &[DVec3; 3], b: &[DVec3; 3]) -> TriDistance {
     let mut best = f64::INFINITY;
     let (mut on_a, mut on_b) = (a[0], b[0]);
     let mut consider = |x: DVec3, y: DVec3| {
@@ -249,10 +259,13 @@ pub fn triangle_distance(a: &[DVec3; 3], b: &[DVec3; 3]) -> TriDistance {
             on_b = y;
         }
     };
+    let ea = [a[1] - a[0], a[2] - a[1], a[0] - a[2]];
+    let eb = [b[1] - b[0], b[2] - b[1], b[0] - b[2]];
+    let lb = eb.map(|e| e.dot(e));
     for i in 0..3 {
-        let (p1, q1) = (a[i], a[(i + 1) % 3]);
+        let la = ea[i].dot(ea[i]);
         for j in 0..3 {
-            let (x, y) = closest_points_segments(p1, q1, b[j], b[(j + 1) % 3]);
+            let (x, y) = segments_core(a[i], ea[i], la, b[j], eb[j], lb[j]);
             consider(x, y);
         }
     }
@@ -268,11 +281,7 @@ pub fn triangle_distance(a: &[DVec3; 3], b: &[DVec3; 3]) -> TriDistance {
             consider(p, q);
         }
     }
-    TriDistance {
-        distance: best.sqrt(),
-        on_a,
-        on_b,
-    }
+    TriDistance { distance: best.sqrt(), on_a, on_b }
 }
 
 #[cfg(test)]
@@ -287,10 +296,7 @@ mod tests {
     /// Exact-case check: distance and both witnesses to 1e-12.
     fn check(r: TriDistance, d: f64, on_a: DVec3, on_b: DVec3) {
         assert!((r.distance - d).abs() <= 1e-12, "{r:?} != {d}");
-        assert!(
-            r.on_a.distance(on_a) <= 1e-12 && r.on_b.distance(on_b) <= 1e-12,
-            "{r:?}"
-        );
+        assert!(r.on_a.distance(on_a) <= 1e-12 && r.on_b.distance(on_b) <= 1e-12, "{r:?}");
     }
 
     #[test]
@@ -320,12 +326,7 @@ mod tests {
         let a = [v(-1., 0., 0.), v(1., 0., 0.), v(0., 0.3, -1.)];
         let (c, s) = (0.5, 0.75f64.sqrt());
         let b = [v(-s + 0.25, c, 1.), v(s + 0.25, -c, 1.), v(0.2, 0.1, 2.)];
-        check(
-            triangle_distance(&a, &b),
-            1.0,
-            v(0.25, 0., 0.),
-            v(0.25, 0., 1.),
-        );
+        check(triangle_distance(&a, &b), 1.0, v(0.25, 0., 0.), v(0.25, 0., 1.));
     }
 
     #[test]
@@ -341,20 +342,10 @@ mod tests {
         // Collinear, hull (1,1,1)-(3,1,1) above the interior of t's hypotenuse's outside: the
         // closest pair is the hull's end (1,1,1) and t's hypotenuse point (1,1,0).
         let col = [v(2., 1., 1.), v(3., 1., 1.), v(1., 1., 1.)];
-        check(
-            triangle_distance(&col, &t),
-            1.0,
-            v(1., 1., 1.),
-            v(1., 1., 0.),
-        );
+        check(triangle_distance(&col, &t), 1.0, v(1., 1., 1.), v(1., 1., 0.));
         // Segment passing above the face interior: only its endpoint against the face is exact.
         let seg = [v(0.5, 0.5, 1.), v(0.5, 0.5, 1.), v(3., 3., 4.)];
-        check(
-            triangle_distance(&seg, &t),
-            1.0,
-            v(0.5, 0.5, 1.),
-            v(0.5, 0.5, 0.),
-        );
+        check(triangle_distance(&seg, &t), 1.0, v(0.5, 0.5, 1.), v(0.5, 0.5, 0.));
         // All three equal (a point) above the face interior and beyond the hypotenuse.
         let pt = [v(0.25, 0.5, -2.); 3];
         check(triangle_distance(&t, &pt), 2.0, v(0.25, 0.5, 0.), pt[0]);
@@ -367,14 +358,8 @@ mod tests {
         // closest_point_on_triangle on degenerate triangles.
         let (a, b, c) = (v(0., 0., 0.), v(1., 1., 1.), v(3., 3., 3.));
         assert_eq!(closest_point_on_triangle(v(5., 5., 5.), a, b, c), c);
-        assert_eq!(
-            closest_point_on_triangle(v(2., 2., 2.), a, b, c),
-            v(2., 2., 2.)
-        );
-        assert_eq!(
-            closest_point_on_triangle(v(0., 2., 4.), a, a, c),
-            v(2., 2., 2.)
-        );
+        assert_eq!(closest_point_on_triangle(v(2., 2., 2.), a, b, c), v(2., 2., 2.));
+        assert_eq!(closest_point_on_triangle(v(0., 2., 4.), a, a, c), v(2., 2., 2.));
         assert_eq!(closest_point_on_triangle(v(-1., 0., 0.), b, b, b), b);
         let q = closest_point_on_triangle(v(1., 1., 0.), a, a, v(2., 0., 0.));
         assert_eq!(q, v(1., 0., 0.));
@@ -383,13 +368,11 @@ mod tests {
     #[test]
     fn segments_exact() {
         // Parallel, overlapping over x in [1, 2]: distance 1, first point on the overlap.
-        let (x, y) =
-            closest_points_segments(v(0., 0., 0.), v(2., 0., 0.), v(1., 1., 0.), v(3., 1., 0.));
+        let (x, y) = closest_points_segments(v(0., 0., 0.), v(2., 0., 0.), v(1., 1., 0.), v(3., 1., 0.));
         assert_eq!(x.distance(y), 1.0);
         assert!(x.y == 0.0 && (1.0..=2.0).contains(&x.x) && y == x + v(0., 1., 0.));
         // Anti-parallel, disjoint: endpoint to endpoint.
-        let (x, y) =
-            closest_points_segments(v(0., 0., 0.), v(1., 0., 0.), v(5., 1., 0.), v(3., 1., 0.));
+        let (x, y) = closest_points_segments(v(0., 0., 0.), v(1., 0., 0.), v(5., 1., 0.), v(3., 1., 0.));
         assert!(x == v(1., 0., 0.) && y == v(3., 1., 0.));
         // Zero-length against segment, segment against zero-length, two points.
         let p = v(0.5, 2., 0.);
@@ -400,12 +383,7 @@ mod tests {
         let (x, y) = closest_points_segments(p, p, v(1., 1., 1.), v(1., 1., 1.));
         assert!(x == p && y == v(1., 1., 1.));
         // Skew: x-axis against the line (0.5, t, 3), t in [-1, 1].
-        let (x, y) = closest_points_segments(
-            v(-1., 0., 0.),
-            v(1., 0., 0.),
-            v(0.5, -1., 3.),
-            v(0.5, 1., 3.),
-        );
+        let (x, y) = closest_points_segments(v(-1., 0., 0.), v(1., 0., 0.), v(0.5, -1., 3.), v(0.5, 1., 3.));
         assert!(x == v(0.5, 0., 0.) && y == v(0.5, 0., 3.));
     }
 
@@ -414,12 +392,8 @@ mod tests {
         // Crossing in top view at angle 1e-9, 1e-9 apart: closest pair at x = 0. In the
         // dot-product form a·e − b² rounds to 0 here and the parallel branch returns x = −1.
         let (th, h) = (1e-9, 1e-9);
-        let (x, y) =
-            closest_points_segments(v(-1., 0., 0.), v(1., 0., 0.), v(-1., -th, h), v(1., th, h));
-        assert!(
-            (x.distance(y) - h).abs() <= 1e-6 * h && x.x.abs() <= 1e-6,
-            "{x} {y}"
-        );
+        let (x, y) = closest_points_segments(v(-1., 0., 0.), v(1., 0., 0.), v(-1., -th, h), v(1., th, h));
+        assert!((x.distance(y) - h).abs() <= 1e-6 * h && x.x.abs() <= 1e-6, "{x} {y}");
     }
 
     // ---------- property tests ----------
@@ -428,10 +402,7 @@ mod tests {
     struct Lcg(u64);
     impl Lcg {
         fn next(&mut self) -> f64 {
-            self.0 = self
-                .0
-                .wrapping_mul(6364136223846793005)
-                .wrapping_add(1442695040888963407);
+            self.0 = self.0.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
             (self.0 >> 11) as f64 / (1u64 << 53) as f64
         }
         /// Uniform point of triangle t.
@@ -445,9 +416,7 @@ mod tests {
     }
 
     fn scale(ts: &[&[DVec3; 3]]) -> f64 {
-        ts.iter()
-            .flat_map(|t| t.iter())
-            .fold(1.0, |m, p| m.max(p.abs().max_element()))
+        ts.iter().flat_map(|t| t.iter()).fold(1.0, |m, p| m.max(p.abs().max_element()))
     }
 
     /// Distance from q to triangle t, independent of the code under test for non-degenerate t:
@@ -457,9 +426,7 @@ mod tests {
         let (g11, g12, g22) = (ab.dot(ab), ab.dot(ac), ac.dot(ac));
         let det = g11 * g22 - g12 * g12;
         let edges = [(t[0], t[1]), (t[1], t[2]), (t[2], t[0])];
-        let on_edges = edges
-            .iter()
-            .map(|&(s, e)| q.distance(closest_on_segment(q, s, e)));
+        let on_edges = edges.iter().map(|&(s, e)| q.distance(closest_on_segment(q, s, e)));
         let edge_d = on_edges.fold(f64::INFINITY, f64::min);
         if det > 1e-6 * g11 * g22 {
             let (r1, r2) = (ab.dot(aq), ac.dot(aq));
@@ -478,8 +445,7 @@ mod tests {
         [pt(), pt(), pt()]
     }
     fn unit() -> impl Strategy<Value = DVec3> {
-        pt().prop_filter("non-zero", |p| p.length() > 0.1)
-            .prop_map(|p| p.normalize())
+        pt().prop_filter("non-zero", |p| p.length() > 0.1).prop_map(|p| p.normalize())
     }
 
     /// Moves b along `dir` so that a plane normal to `dir` separates it from a by `gap`.
@@ -499,30 +465,23 @@ mod tests {
             closest_point_on_triangle(r.on_a, a[0], a[1], a[2]),
             closest_point_on_triangle(r.on_b, b[0], b[1], b[2]),
         );
-        assert!(
-            r.on_a.distance(ca) <= 1e-12 * s && r.on_b.distance(cb) <= 1e-12 * s,
-            "{r:?}"
-        );
+        assert!(r.on_a.distance(ca) <= 1e-12 * s && r.on_b.distance(cb) <= 1e-12 * s, "{r:?}");
         let mut g = Lcg(seed);
         for k in 0..300 {
             let x = if k < 3 { a[k] } else { g.on(a) };
             let y = if k < 3 { b[k] } else { g.on(b) };
             assert!(r.distance <= x.distance(y) + 1e-12 * s, "{r:?} vs {x} {y}");
         }
-        assert_eq!(r.distance, triangle_distance(b, a).distance);
+        let swapped = triangle_distance(b, a);
+        assert_eq!((swapped.distance, swapped.on_a, swapped.on_b), (r.distance, r.on_b, r.on_a));
         let pa = parry3d_f64::shape::Triangle::new(a[0], a[1], a[2]);
         let pb = parry3d_f64::shape::Triangle::new(b[0], b[1], b[2]);
         let id = parry3d_f64::math::Pose::IDENTITY;
-        let d = parry3d_f64::query::distance(&id, &pa, &id, &pb)
-            .unwrap()
-            .distance;
+        let d = parry3d_f64::query::distance(&id, &pa, &id, &pb).unwrap().distance;
         // Ours is attained by on-triangle points, so it can never exceed parry's (GJK) value by
         // more than rounding; parry may exceed ours by up to `parry_rel`.
         assert!(r.distance <= d * (1.0 + 1e-12), "parry {d} vs {r:?}");
-        assert!(
-            d - r.distance <= parry_rel * r.distance,
-            "parry {d} vs {r:?}"
-        );
+        assert!(d - r.distance <= parry_rel * r.distance, "parry {d} vs {r:?}");
     }
 
     proptest! {

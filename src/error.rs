@@ -29,10 +29,7 @@ pub enum Error {
 impl Error {
     /// A problem with input file `path`.
     pub fn input(path: &Path, msg: impl Into<String>) -> Self {
-        Error::Input {
-            path: path.to_path_buf(),
-            msg: msg.into(),
-        }
+        Error::Input { path: path.to_path_buf(), msg: msg.into() }
     }
 
     /// The process exit code for this error (always 2: bad input, I/O or usage).
@@ -46,12 +43,7 @@ impl fmt::Display for Error {
         match self {
             Error::Input { path, msg } => write!(f, "{}: {}", path.display(), one_line(msg)),
             Error::Output { path, msg } => {
-                write!(
-                    f,
-                    "{}: cannot write report: {}",
-                    path.display(),
-                    one_line(msg)
-                )
+                write!(f, "{}: cannot write report: {}", path.display(), one_line(msg))
             }
             Error::Usage(msg) => write!(f, "usage: {}", one_line(msg)),
         }

@@ -12,10 +12,7 @@ fn main() -> ExitCode {
             // Usage errors: one line, exit 2, like every other error.
             let msg = e.to_string();
             let first = msg.lines().next().unwrap_or("bad arguments");
-            eprintln!(
-                "meshclash: {} (see --help)",
-                first.trim_start_matches("error: ").trim()
-            );
+            eprintln!("meshclash: {} (see --help)", first.trim_start_matches("error: ").trim());
             return ExitCode::from(2);
         }
         Err(e) => {

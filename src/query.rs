@@ -56,12 +56,7 @@ pub fn load_input(spec: &InputSpec) -> Result<Input> {
     if spec.transform != DMat4::IDENTITY {
         place(&mut mesh, &spec.transform, &spec.path)?;
     }
-    Ok(Input {
-        path: spec.path.clone(),
-        format,
-        mesh,
-        warnings: loaded.warnings,
-    })
+    Ok(Input { path: spec.path.clone(), format, mesh, warnings: loaded.warnings })
 }
 
 /// Apply an affine transform to every vertex (f64), rejecting non-finite results.
@@ -69,10 +64,7 @@ pub fn place(mesh: &mut Mesh, m: &DMat4, path: &Path) -> Result<()> {
     for (i, p) in mesh.positions.iter_mut().enumerate() {
         *p = m.transform_point3(*p);
         if !p.is_finite() {
-            return Err(Error::input(
-                path,
-                format!("vertex {i} is not finite after the transform"),
-            ));
+            return Err(Error::input(path, format!("vertex {i} is not finite after the transform")));
         }
     }
     Ok(())
@@ -196,12 +188,7 @@ impl MeshInfo {
             vertices: mesh.positions.len(),
             triangles: mesh.triangles.len(),
             degenerate_triangles,
-            objects: mesh
-                .objects
-                .iter()
-                .map(|o| o.name.clone())
-                .zip(counts)
-                .collect(),
+            objects: mesh.objects.iter().map(|o| o.name.clone()).zip(counts).collect(),
             bounds: Aabb::of_points(&mesh.positions),
         }
     }
@@ -239,10 +226,7 @@ pub struct ClashResult {
 /// Run the check on two meshes in world coordinates.
 pub fn check(a: &Mesh, b: &Mesh, settings: &Settings) -> ClashResult {
     let t0 = Instant::now();
-    let (ta, tb) = rayon::join(
-        || Bvh::build(a, settings.bvh),
-        || Bvh::build(b, settings.bvh),
-    );
+    let (ta, tb) = rayon::join(|| Bvh::build(a, settings.bvh), || Bvh::build(b, settings.bvh));
     let build_ms = ms(t0);
     let t1 = Instant::now();
     let tol = settings.tolerances;
@@ -297,10 +281,7 @@ pub fn check(a: &Mesh, b: &Mesh, settings: &Settings) -> ClashResult {
         closest,
         verdict,
         trees: [ta.stats(), tb.stats()],
-        timings: Timings {
-            build_ms,
-            query_ms: ms(t1),
-        },
+        timings: Timings { build_ms, query_ms: ms(t1) },
     }
 }
 
@@ -309,19 +290,9 @@ fn ms(t: Instant) -> f64 {
 }
 
 /// Exact classification, then the tolerance bands for pairs that do not meet.
-fn classify_pair(
-    i: u32,
-    ti: &[DVec3; 3],
-    j: u32,
-    tj: &[DVec3; 3],
-    tol: &Tolerances,
-) -> Option<PairFinding> {
+fn classify_pair(i: u32, ti: &[DVec3; 3], j: u32, tj: &[DVec3; 3], tol: &Tolerances) -> Option<PairFinding> {
     if let Some(h) = tri_tri::classify(ti, tj) {
-        let kind = if h.crossing {
-            PairKind::Crossing
-        } else {
-            PairKind::Touching
-        };
+        let kind = if h.crossing { PairKind::Crossing } else { PairKind::Touching };
         return Some(PairFinding {
             a: i,
             b: j,
@@ -360,11 +331,7 @@ fn contact_witness(a: &Mesh, b: &Mesh, p: &PairFinding) -> Closest {
         // rounding) at a shared point.
         None => triangle_distance(&bvh::triangle(a, p.a), &bvh::triangle(b, p.b)).on_a,
     };
-    Closest {
-        distance: 0.0,
-        a: (p.a, point),
-        b: (p.b, point),
-    }
+    Closest { distance: 0.0, a: (p.a, point), b: (p.b, point) }
 }
 
 /// Branch-and-bound closest pair of two meshes known not to touch.
@@ -387,15 +354,8 @@ fn closest_pair(a: &Mesh, ta: &Bvh, b: &Mesh, tb: &Bvh) -> Option<Closest> {
                         continue;
                     }
                     let d = triangle_distance(&ti, &tj);
-                    let c = Candidate {
-                        distance: d.distance,
-                        key: (i, j),
-                        data: (d.on_a, d.on_b),
-                    };
-                    if best
-                        .as_ref()
-                        .is_none_or(|m| (c.distance, c.key) < (m.distance, m.key))
-                    {
+                    let c = Candidate { distance: d.distance, key: (i, j), data: (d.on_a, d.on_b) };
+                    if best.as_ref().is_none_or(|m| (c.distance, c.key) < (m.distance, m.key)) {
                         best = Some(c);
                     }
                 }
@@ -403,11 +363,7 @@ fn closest_pair(a: &Mesh, ta: &Bvh, b: &Mesh, tb: &Bvh) -> Option<Closest> {
             best
         },
     )?;
-    Some(Closest {
-        distance: best.distance,
-        a: (best.key.0, best.data.0),
-        b: (best.key.1, best.data.1),
-    })
+    Some(Closest { distance: best.distance, a: (best.key.0, best.data.0), b: (best.key.1, best.data.1) })
 }
 
 /// The severity at which a run fails (exit code 1).

@@ -288,30 +288,14 @@ fn input_report(input: &Input, m: &DMat4, info: &crate::query::MeshInfo) -> Inpu
         vertices: info.vertices,
         triangles: info.triangles,
         degenerate_triangles: info.degenerate_triangles,
-        objects: info
-            .objects
-            .iter()
-            .map(|(n, t)| ObjectReport {
-                name: n.clone(),
-                triangles: *t,
-            })
-            .collect(),
-        bounds: Bounds {
-            min: v3(min),
-            max: v3(max),
-        },
+        objects: info.objects.iter().map(|(n, t)| ObjectReport { name: n.clone(), triangles: *t }).collect(),
+        bounds: Bounds { min: v3(min), max: v3(max) },
         transform: (*m != DMat4::IDENTITY).then(|| m.transpose().to_cols_array().to_vec()),
     }
 }
 
 fn tree_report(s: &TreeStats) -> TreeReport {
-    TreeReport {
-        nodes: s.nodes,
-        leaves: s.leaves,
-        depth: s.depth,
-        sah_cost: s.sah_cost,
-        bytes: s.bytes,
-    }
+    TreeReport { nodes: s.nodes, leaves: s.leaves, depth: s.depth, sah_cost: s.sah_cost, bytes: s.bytes }
 }
 
 fn pair_report(p: &PairFinding, ca: &[u32], cb: &[u32]) -> PairReport {
@@ -334,27 +318,17 @@ fn pair_report(p: &PairFinding, ca: &[u32], cb: &[u32]) -> PairReport {
 /// Assemble the report.
 pub fn build(ctx: &Context, r: &ClashResult) -> Report {
     let [ia, ib] = ctx.inputs;
-    let (infa, infb) = (
-        crate::query::MeshInfo::of(&ia.mesh),
-        crate::query::MeshInfo::of(&ib.mesh),
-    );
+    let (infa, infb) = (crate::query::MeshInfo::of(&ia.mesh), crate::query::MeshInfo::of(&ib.mesh));
     let (oa, ob) = (&ia.mesh.tri_object, &ib.mesh.tri_object);
     let max = ctx.settings.max_pairs;
     let warnings = ctx
         .inputs
         .iter()
-        .flat_map(|i| {
-            i.warnings
-                .iter()
-                .map(move |w| format!("{}: {}", i.path.display(), w))
-        })
+        .flat_map(|i| i.warnings.iter().map(move |w| format!("{}: {}", i.path.display(), w)))
         .collect();
     Report {
         schema: SCHEMA.to_string(),
-        tool: Tool {
-            name: "meshclash".into(),
-            version: env!("CARGO_PKG_VERSION").into(),
-        },
+        tool: Tool { name: "meshclash".into(), version: env!("CARGO_PKG_VERSION").into() },
         inputs: Inputs {
             a: input_report(ia, &ctx.transforms[0], &infa),
             b: input_report(ib, &ctx.transforms[1], &infb),
@@ -371,28 +345,12 @@ pub fn build(ctx: &Context, r: &ClashResult) -> Report {
         },
         closest: r.closest.map(|c| ClosestReport {
             distance: c.distance,
-            a: Witness {
-                triangle: c.a.0,
-                object: oa[c.a.0 as usize],
-                point: v3(c.a.1),
-            },
-            b: Witness {
-                triangle: c.b.0,
-                object: ob[c.b.0 as usize],
-                point: v3(c.b.1),
-            },
+            a: Witness { triangle: c.a.0, object: oa[c.a.0 as usize], point: v3(c.a.1) },
+            b: Witness { triangle: c.b.0, object: ob[c.b.0 as usize], point: v3(c.b.1) },
         }),
-        pairs: r
-            .pairs
-            .iter()
-            .take(max)
-            .map(|p| pair_report(p, oa, ob))
-            .collect(),
+        pairs: r.pairs.iter().take(max).map(|p| pair_report(p, oa, ob)).collect(),
         pairs_truncated: r.pairs.len() > max,
-        bvh: Trees {
-            a: tree_report(&r.trees[0]),
-            b: tree_report(&r.trees[1]),
-        },
+        bvh: Trees { a: tree_report(&r.trees[0]), b: tree_report(&r.trees[1]) },
         warnings,
         timings_ms: ctx.times.map(|(load, total)| TimingsReport {
             load,
@@ -405,14 +363,9 @@ pub fn build(ctx: &Context, r: &ClashResult) -> Report {
 
 /// Verdict severity from its report name (for readers of old reports).
 pub fn verdict_from_name(s: &str) -> Option<Verdict> {
-    [
-        Verdict::Clear,
-        Verdict::Clearance,
-        Verdict::Touching,
-        Verdict::Clash,
-    ]
-    .into_iter()
-    .find(|v| v.name() == s)
+    [Verdict::Clear, Verdict::Clearance, Verdict::Touching, Verdict::Clash]
+        .into_iter()
+        .find(|v| v.name() == s)
 }
 
 /// The report as pretty JSON with a trailing newline.
@@ -425,22 +378,10 @@ pub fn to_json(report: &Report) -> String {
 /// Write `bytes` to `path` completely or not at all: a temporary file beside it, flushed and
 /// synced, then renamed over the target.
 pub fn write_atomic(path: &Path, bytes: &[u8]) -> Result<()> {
-    let err = |e: std::io::Error| Error::Output {
-        path: path.to_path_buf(),
-        msg: e.to_string(),
-    };
-    let dir = path
-        .parent()
-        .filter(|d| !d.as_os_str().is_empty())
-        .unwrap_or(Path::new("."));
-    let name = path
-        .file_name()
-        .ok_or_else(|| err(std::io::Error::other("not a file name")))?;
-    let tmp = dir.join(format!(
-        ".{}.{}.tmp",
-        name.to_string_lossy(),
-        std::process::id()
-    ));
+    let err = |e: std::io::Error| Error::Output { path: path.to_path_buf(), msg: e.to_string() };
+    let dir = path.parent().filter(|d| !d.as_os_str().is_empty()).unwrap_or(Path::new("."));
+    let name = path.file_name().ok_or_else(|| err(std::io::Error::other("not a file name")))?;
+    let tmp = dir.join(format!(".{}.{}.tmp", name.to_string_lossy(), std::process::id()));
     let result = (|| {
         let mut f = std::fs::File::create(&tmp)?;
         f.write_all(bytes)?;

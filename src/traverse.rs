@@ -30,17 +30,12 @@ fn open_a(a: &Node, b: &Node) -> Option<bool> {
 #[inline]
 fn children(ta: &Bvh, tb: &Bvh, i: u32, j: u32) -> Option<[(u32, u32); 2]> {
     let (a, b) = (&ta.nodes[i as usize], &tb.nodes[j as usize]);
-    Some(if open_a(a, b)? {
-        [(i + 1, j), (a.a, j)]
-    } else {
-        [(i, j + 1), (i, b.a)]
-    })
+    Some(if open_a(a, b)? { [(i + 1, j), (a.a, j)] } else { [(i, j + 1), (i, b.a)] })
 }
 
 /// Breadth-first expansion of the root pair into about `SEED_TASKS` pairs that pass `keep`.
 fn seed(ta: &Bvh, tb: &Bvh, keep: &dyn Fn(&Aabb, &Aabb) -> bool) -> Vec<(u32, u32)> {
-    if ta.nodes.is_empty() || tb.nodes.is_empty() || !keep(&ta.nodes[0].bounds, &tb.nodes[0].bounds)
-    {
+    if ta.nodes.is_empty() || tb.nodes.is_empty() || !keep(&ta.nodes[0].bounds, &tb.nodes[0].bounds) {
         return Vec::new();
     }
     let mut level = vec![(0u32, 0u32)];
@@ -124,13 +119,7 @@ fn better<R>(x: &Candidate<R>, y: &Candidate<R>) -> bool {
 /// caller's bound on f64 rounding of distances, so that no pair that could tie is pruned). The
 /// winner is the minimum of (distance, key) over all candidates that could be it, so the answer
 /// does not depend on the thread count or on the order in which threads find candidates.
-pub fn min_pair<R, D, L>(
-    ta: &Bvh,
-    tb: &Bvh,
-    box_distance: D,
-    slack: f64,
-    leaf: L,
-) -> Option<Candidate<R>>
+pub fn min_pair<R, D, L>(ta: &Bvh, tb: &Bvh, box_distance: D, slack: f64, leaf: L) -> Option<Candidate<R>>
 where
     R: Send + Copy,
     D: Fn(&Aabb, &Aabb) -> f64 + Sync,
@@ -141,13 +130,7 @@ where
     let bound = |best: &AtomicU64| f64::from_bits(best.load(Ordering::Relaxed)) + slack;
     let mut seeds: Vec<(f64, u32, u32)> = seed(ta, tb, &|_, _| true)
         .into_iter()
-        .map(|(i, j)| {
-            (
-                box_distance(&ta.nodes[i as usize].bounds, &tb.nodes[j as usize].bounds),
-                i,
-                j,
-            )
-        })
+        .map(|(i, j)| (box_distance(&ta.nodes[i as usize].bounds, &tb.nodes[j as usize].bounds), i, j))
         .collect();
     seeds.sort_by(|x, y| x.0.total_cmp(&y.0).then((x.1, x.2).cmp(&(y.1, y.2))));
     let found: Vec<Option<Candidate<R>>> = seeds
@@ -175,10 +158,7 @@ where
                     }
                     Some(kids) => {
                         let d = kids.map(|(ci, cj)| {
-                            box_distance(
-                                &ta.nodes[ci as usize].bounds,
-                                &tb.nodes[cj as usize].bounds,
-                            )
+                            box_distance(&ta.nodes[ci as usize].bounds, &tb.nodes[cj as usize].bounds)
                         });
                         // Push the farther first so the nearer is opened first.
                         let order = if d[0] <= d[1] { [1, 0] } else { [0, 1] };
@@ -193,10 +173,7 @@ where
             mine
         })
         .collect();
-    found
-        .into_iter()
-        .flatten()
-        .reduce(|x, y| if better(&y, &x) { y } else { x })
+    found.into_iter().flatten().reduce(|x, y| if better(&y, &x) { y } else { x })
 }
 
 #[cfg(test)]
@@ -210,10 +187,7 @@ mod tests {
         (0..n)
             .map(|i| {
                 let x = offset + 2.0 * i as f64;
-                Aabb {
-                    min: DVec3::new(x, 0.0, 0.0),
-                    max: DVec3::new(x + 1.0, 1.0, 1.0),
-                }
+                Aabb { min: DVec3::new(x, 0.0, 0.0), max: DVec3::new(x + 1.0, 1.0, 1.0) }
             })
             .collect()
     }
@@ -224,14 +198,8 @@ mod tests {
         let b = unit_boxes(200, 1.0); // b_k touches a_k and a_{k+1} at faces
         for strategy in [Strategy::Sah, Strategy::Median, Strategy::Equal] {
             for leaf_size in [1, 4] {
-                let opts = BuildOptions {
-                    strategy,
-                    leaf_size,
-                };
-                let (ta, tb) = (
-                    Bvh::build_from_boxes(&a, opts),
-                    Bvh::build_from_boxes(&b, opts),
-                );
+                let opts = BuildOptions { strategy, leaf_size };
+                let (ta, tb) = (Bvh::build_from_boxes(&a, opts), Bvh::build_from_boxes(&b, opts));
                 let mut got = collect_pairs(
                     &ta,
                     &tb,
@@ -266,16 +234,10 @@ mod tests {
         let a = unit_boxes(100, 0.0);
         let b: Vec<Aabb> = unit_boxes(100, 0.0)
             .into_iter()
-            .map(|x| Aabb {
-                min: x.min + DVec3::new(0.3, 0.0, 5.0),
-                max: x.max + DVec3::new(0.3, 0.0, 5.0),
-            })
+            .map(|x| Aabb { min: x.min + DVec3::new(0.3, 0.0, 5.0), max: x.max + DVec3::new(0.3, 0.0, 5.0) })
             .collect();
         let opts = BuildOptions::default();
-        let (ta, tb) = (
-            Bvh::build_from_boxes(&a, opts),
-            Bvh::build_from_boxes(&b, opts),
-        );
+        let (ta, tb) = (Bvh::build_from_boxes(&a, opts), Bvh::build_from_boxes(&b, opts));
         let got = min_pair(
             &ta,
             &tb,

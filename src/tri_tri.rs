@@ -119,19 +119,11 @@ pub fn classify_shapes(a: &Shape, b: &Shape) -> Option<Hit> {
 }
 
 fn point_hit(p: DVec3) -> Hit {
-    Hit {
-        crossing: false,
-        contact: Contact::Point,
-        segment: Some([p, p]),
-    }
+    Hit { crossing: false, contact: Contact::Point, segment: Some([p, p]) }
 }
 
 fn touch(contact: Contact, segment: Option<[DVec3; 2]>) -> Option<Hit> {
-    Some(Hit {
-        crossing: false,
-        contact,
-        segment,
-    })
+    Some(Hit { crossing: false, contact, segment })
 }
 
 /// An endpoint of a triangle's section by the other plane: the point where edge
@@ -168,29 +160,14 @@ fn section(s: [Sign; 3], first: bool) -> Section {
             let (ij, ik) = (End { apex: i, other: j }, End { apex: i, other: k });
             let forward = (sigma > 0) != first;
             let (lo, hi) = if forward { (ij, ik) } else { (ik, ij) };
-            return Section {
-                lo,
-                hi,
-                sigma,
-                single: false,
-                split,
-            };
+            return Section { lo, hi, sigma, single: false, split };
         }
     }
     // Pattern (σ, σ, 0) in some order: the section is the zero vertex.
-    let z = s
-        .iter()
-        .position(|&v| v == 0)
-        .expect("section: one vertex on the plane");
+    let z = s.iter().position(|&v| v == 0).expect("section: one vertex on the plane");
     let i = (z + 1) % 3;
     let e = End { apex: i, other: z };
-    Section {
-        lo: e,
-        hi: e,
-        sigma: s[i],
-        single: true,
-        split: false,
-    }
+    Section { lo: e, hi: e, sigma: s[i], single: true, split: false }
 }
 
 /// Order along `L` of `x` (an end of `a`'s section) and `y` (an end of `b`'s section):
@@ -238,25 +215,13 @@ fn tri_tri(a: &[DVec3; 3], b: &[DVec3; 3]) -> Option<Hit> {
     let da = a.map(|p| pr::orient3d_value(b[0], b[1], b[2], p));
     let db = b.map(|p| pr::orient3d_value(a[0], a[1], a[2], p));
     let lo_cmp = cmp_ends(a, &ia, ia.lo, b, &ib, ib.lo);
-    let lo = if lo_cmp >= 0 {
-        end_point(a, &da, ia.lo)
-    } else {
-        end_point(b, &db, ib.lo)
-    };
+    let lo = if lo_cmp >= 0 { end_point(a, &da, ia.lo) } else { end_point(b, &db, ib.lo) };
     let hi_cmp = cmp_ends(a, &ia, ia.hi, b, &ib, ib.hi);
-    let hi = if hi_cmp <= 0 {
-        end_point(a, &da, ia.hi)
-    } else {
-        end_point(b, &db, ib.hi)
-    };
+    let hi = if hi_cmp <= 0 { end_point(a, &da, ia.hi) } else { end_point(b, &db, ib.hi) };
     let segment = Some(if positive { [lo, hi] } else { [lo, lo] });
     Some(Hit {
         crossing: positive && ia.split && ib.split,
-        contact: if positive {
-            Contact::Segment
-        } else {
-            Contact::Point
-        },
+        contact: if positive { Contact::Segment } else { Contact::Point },
         segment,
     })
 }
@@ -290,14 +255,7 @@ fn coplanar(a: &[DVec3; 3], b: &[DVec3; 3]) -> Option<Hit> {
     if sa || sb {
         return None;
     }
-    touch(
-        if wa || wb {
-            Contact::CoplanarBoundary
-        } else {
-            Contact::CoplanarArea
-        },
-        None,
-    )
+    touch(if wa || wb { Contact::CoplanarBoundary } else { Contact::CoplanarArea }, None)
 }
 
 /// Point in closed triangle, the point known to be in the triangle's plane.
@@ -320,11 +278,7 @@ fn on_segment(p: DVec3, q: DVec3, r: DVec3) -> bool {
         return false;
     }
     let k = pr::line_axis(q, r);
-    let (lo, hi) = if q[k] <= r[k] {
-        (q[k], r[k])
-    } else {
-        (r[k], q[k])
-    };
+    let (lo, hi) = if q[k] <= r[k] { (q[k], r[k]) } else { (r[k], q[k]) };
     lo <= p[k] && p[k] <= hi
 }
 
@@ -368,11 +322,7 @@ fn seg_seg(p: DVec3, q: DVec3, r: DVec3, s: DVec3) -> Option<Hit> {
         let (d1, d2) = (q - p, s - r);
         let n = d1.cross(d2);
         let nn = n.dot(n);
-        let m = if nn > 0.0 {
-            p + d1 * ((r - p).cross(d2).dot(n) / nn)
-        } else {
-            p
-        };
+        let m = if nn > 0.0 { p + d1 * ((r - p).cross(d2).dot(n) / nn) } else { p };
         return touch(Contact::Point, Some([m, m]));
     }
     for (x, y, z) in [(p, r, s), (q, r, s), (r, p, q), (s, p, q)] {
@@ -409,11 +359,7 @@ fn seg_tri(p: DVec3, q: DVec3, t: &[DVec3; 3]) -> Option<Hit> {
     let dq = pr::orient3d_value(t[0], t[1], t[2], q);
     let x = p + (q - p) * (dp / (dp - dq));
     let crossing = s.iter().all(|&v| v != 0);
-    Some(Hit {
-        crossing,
-        contact: Contact::Point,
-        segment: Some([x, x]),
-    })
+    Some(Hit { crossing, contact: Contact::Point, segment: Some([x, x]) })
 }
 
 /// Segment in the plane of proper triangle `t` (ccw in projection `k`).

@@ -13,14 +13,9 @@ use proptest::prelude::*;
 fn mesh(tris: &[[DVec3; 3]]) -> Mesh {
     Mesh {
         positions: tris.iter().flatten().copied().collect(),
-        triangles: (0..tris.len() as u32)
-            .map(|i| [3 * i, 3 * i + 1, 3 * i + 2])
-            .collect(),
+        triangles: (0..tris.len() as u32).map(|i| [3 * i, 3 * i + 1, 3 * i + 2]).collect(),
         tri_object: vec![0; tris.len()],
-        objects: vec![Object {
-            name: "o".into(),
-            ..Default::default()
-        }],
+        objects: vec![Object { name: "o".into(), ..Default::default() }],
     }
 }
 
@@ -28,24 +23,16 @@ fn mesh(tris: &[[DVec3; 3]]) -> Mesh {
 /// edges, coplanar pairs and zero-area triangles, all exact in binary.
 fn grid_tri(scale: f64, offset: f64) -> impl Strategy<Value = [DVec3; 3]> {
     let c = -2i32..=2;
-    [
-        (c.clone(), c.clone(), c.clone()),
-        (c.clone(), c.clone(), c.clone()),
-        (c.clone(), c.clone(), c),
-    ]
-    .prop_map(move |v| {
-        v.map(|(x, y, z)| DVec3::new(x as f64, y as f64, z as f64) * scale + DVec3::splat(offset))
-    })
+    [(c.clone(), c.clone(), c.clone()), (c.clone(), c.clone(), c.clone()), (c.clone(), c.clone(), c)]
+        .prop_map(move |v| {
+            v.map(|(x, y, z)| DVec3::new(x as f64, y as f64, z as f64) * scale + DVec3::splat(offset))
+        })
 }
 
 fn float_tri() -> impl Strategy<Value = [DVec3; 3]> {
     let c = -1.0f64..1.0;
-    [
-        (c.clone(), c.clone(), c.clone()),
-        (c.clone(), c.clone(), c.clone()),
-        (c.clone(), c.clone(), c),
-    ]
-    .prop_map(|v| v.map(|(x, y, z)| DVec3::new(x, y, z)))
+    [(c.clone(), c.clone(), c.clone()), (c.clone(), c.clone(), c.clone()), (c.clone(), c.clone(), c)]
+        .prop_map(|v| v.map(|(x, y, z)| DVec3::new(x, y, z)))
 }
 
 struct Brute {
@@ -71,31 +58,17 @@ fn brute(a: &[[DVec3; 3]], b: &[[DVec3; 3]]) -> Brute {
 }
 
 fn compare(a: &[[DVec3; 3]], b: &[[DVec3; 3]], opts: BuildOptions) -> Result<(), TestCaseError> {
-    let settings = Settings {
-        tolerances: Tolerances::default(),
-        bvh: opts,
-    };
+    let settings = Settings { tolerances: Tolerances::default(), bvh: opts };
     let r = check(&mesh(a), &mesh(b), &settings);
     let want = brute(a, b);
-    let got: Vec<(u32, u32, bool)> = r
-        .pairs
-        .iter()
-        .map(|p| (p.a, p.b, p.kind == PairKind::Crossing))
-        .collect();
+    let got: Vec<(u32, u32, bool)> =
+        r.pairs.iter().map(|p| (p.a, p.b, p.kind == PairKind::Crossing)).collect();
     prop_assert_eq!(&got, &want.pairs);
-    let d = r
-        .closest
-        .expect("non-empty meshes have a closest pair")
-        .distance;
+    let d = r.closest.expect("non-empty meshes have a closest pair").distance;
     if want.min == 0.0 {
         prop_assert_eq!(d, 0.0);
     } else {
-        prop_assert!(
-            (d - want.min).abs() <= 1e-12 * want.min.max(1.0),
-            "bvh {} vs brute {}",
-            d,
-            want.min
-        );
+        prop_assert!((d - want.min).abs() <= 1e-12 * want.min.max(1.0), "bvh {} vs brute {}", d, want.min);
     }
     Ok(())
 }
@@ -137,13 +110,8 @@ proptest! {
 fn thread_count_does_not_change_the_result() {
     // Two overlapping bumpy grids, big enough to be split across many sub-walks.
     let grid = |n: usize, dz: f64, k: usize| -> Vec<[DVec3; 3]> {
-        let f = |x: usize, y: usize| {
-            DVec3::new(
-                x as f64,
-                y as f64,
-                ((x * k + y * 13) % 5) as f64 * 0.25 + dz,
-            )
-        };
+        let f =
+            |x: usize, y: usize| DVec3::new(x as f64, y as f64, ((x * k + y * 13) % 5) as f64 * 0.25 + dz);
         let mut t = Vec::new();
         for x in 0..n {
             for y in 0..n {
@@ -154,18 +122,10 @@ fn thread_count_does_not_change_the_result() {
         t
     };
     let (a, b) = (mesh(&grid(60, 0.0, 7)), mesh(&grid(60, 0.3, 3)));
-    let settings = Settings {
-        tolerances: Tolerances {
-            touch: 0.0,
-            clearance: 0.2,
-        },
-        bvh: BuildOptions::default(),
-    };
+    let settings =
+        Settings { tolerances: Tolerances { touch: 0.0, clearance: 0.2 }, bvh: BuildOptions::default() };
     let run = |threads: usize| {
-        let pool = rayon::ThreadPoolBuilder::new()
-            .num_threads(threads)
-            .build()
-            .unwrap();
+        let pool = rayon::ThreadPoolBuilder::new().num_threads(threads).build().unwrap();
         let mut r = pool.install(|| check(&a, &b, &settings));
         r.timings = Default::default();
         r

@@ -50,10 +50,7 @@ fn parse(stdout: &[u8]) -> Report {
 
 #[test]
 fn main_job_on_shipped_meshes_reports_the_clash_and_exits_1() {
-    let out = bin()
-        .args([shipped("fcl_env.obj"), shipped("fcl_rob.obj")])
-        .output()
-        .unwrap();
+    let out = bin().args([shipped("fcl_env.obj"), shipped("fcl_rob.obj")]).output().unwrap();
     assert_eq!(out.status.code(), Some(1));
     let r = parse(&out.stdout);
     assert_eq!(r.schema, "meshclash.report/1");
@@ -61,60 +58,33 @@ fn main_job_on_shipped_meshes_reports_the_clash_and_exits_1() {
     assert!(r.failed);
     assert_eq!(r.summary.min_distance, Some(0.0));
     assert_eq!(r.inputs.a.triangles, 2180);
-    assert_eq!(
-        r.pairs.len() as u64,
-        r.summary.crossing_pairs + r.summary.touching_pairs
-    );
+    assert_eq!(r.pairs.len() as u64, r.summary.crossing_pairs + r.summary.touching_pairs);
     // Sorted by (a, b), every listed pair a crossing with its segment.
-    assert!(r
-        .pairs
-        .windows(2)
-        .all(|w| (w[0].a, w[0].b) < (w[1].a, w[1].b)));
-    assert!(r
-        .pairs
-        .iter()
-        .all(|p| p.kind == "crossing" && p.segment.is_some()));
+    assert!(r.pairs.windows(2).all(|w| (w[0].a, w[0].b) < (w[1].a, w[1].b)));
+    assert!(r.pairs.iter().all(|p| p.kind == "crossing" && p.segment.is_some()));
     // The count line of the FCL file is reported as a warning on stderr, once per file.
     let err = String::from_utf8(out.stderr).unwrap();
-    assert_eq!(
-        err.lines().filter(|l| l.contains("warning")).count(),
-        2,
-        "{err}"
-    );
+    assert_eq!(err.lines().filter(|l| l.contains("warning")).count(), 2, "{err}");
     assert_eq!(r.warnings.len(), 2);
 }
 
 #[test]
 fn fail_on_never_and_far_apart_exit_0() {
     let out = bin()
-        .args([
-            &shipped("fcl_env.obj"),
-            &shipped("fcl_rob.obj"),
-            "--fail-on",
-            "never",
-            "-q",
-        ])
+        .args([&shipped("fcl_env.obj"), &shipped("fcl_rob.obj"), "--fail-on", "never", "-q"])
         .output()
         .unwrap();
     assert_eq!(out.status.code(), Some(0));
     assert!(out.stderr.is_empty(), "--quiet silences warnings");
     let out = bin()
-        .args([
-            &shipped("fcl_env.obj"),
-            &shipped("fcl_rob.obj"),
-            "--translate-b",
-            "0,0,10000",
-        ])
+        .args([&shipped("fcl_env.obj"), &shipped("fcl_rob.obj"), "--translate-b", "0,0,10000"])
         .output()
         .unwrap();
     assert_eq!(out.status.code(), Some(0));
     let r = parse(&out.stdout);
     assert_eq!(r.verdict, "clear");
     let c = r.closest.unwrap();
-    let d: f64 = (0..3)
-        .map(|k| (c.a.point[k] - c.b.point[k]).powi(2))
-        .sum::<f64>()
-        .sqrt();
+    let d: f64 = (0..3).map(|k| (c.a.point[k] - c.b.point[k]).powi(2)).sum::<f64>().sqrt();
     assert!((d - c.distance).abs() <= 1e-9 * c.distance);
     assert!(c.distance > 0.0 && r.pairs.is_empty());
 }
@@ -124,33 +94,18 @@ fn clearance_and_fail_on_clearance() {
     // multibody: two bodies 0.507 apart in one file; compare the file with itself moved far
     // enough that only the clearance band catches it.
     let f = shipped("multibody.stl");
-    let base = bin()
-        .args([&f, &f, "--translate-b", "0,0,100", "-q"])
-        .output()
-        .unwrap();
+    let base = bin().args([&f, &f, "--translate-b", "0,0,100", "-q"]).output().unwrap();
     let d = parse(&base.stdout).summary.min_distance.unwrap();
     let clearance = format!("{}", d * 1.01);
     let out = bin()
-        .args([
-            &f,
-            &f,
-            "--translate-b",
-            "0,0,100",
-            "--clearance",
-            &clearance,
-            "--fail-on",
-            "clearance",
-        ])
+        .args([&f, &f, "--translate-b", "0,0,100", "--clearance", &clearance, "--fail-on", "clearance"])
         .output()
         .unwrap();
     assert_eq!(out.status.code(), Some(1));
     let r = parse(&out.stdout);
     assert_eq!(r.verdict, "clearance");
     assert!(r.summary.clearance_pairs > 0);
-    assert!(r
-        .pairs
-        .iter()
-        .all(|p| p.kind == "clearance" && p.distance < d * 1.01 && p.distance >= d));
+    assert!(r.pairs.iter().all(|p| p.kind == "clearance" && p.distance < d * 1.01 && p.distance >= d));
 }
 
 #[test]
@@ -158,13 +113,7 @@ fn output_file_is_written_and_stdout_stays_empty() {
     let dir = tempfile::tempdir().unwrap();
     let path = dir.path().join("report.json");
     let out = bin()
-        .args([
-            &shipped("fcl_env.obj"),
-            &shipped("fcl_rob.obj"),
-            "-q",
-            "-o",
-            path.to_str().unwrap(),
-        ])
+        .args([&shipped("fcl_env.obj"), &shipped("fcl_rob.obj"), "-q", "-o", path.to_str().unwrap()])
         .output()
         .unwrap();
     assert_eq!(out.status.code(), Some(1));
@@ -178,13 +127,7 @@ fn output_file_is_written_and_stdout_stays_empty() {
 #[test]
 fn max_pairs_truncates_the_list_not_the_counts() {
     let out = bin()
-        .args([
-            &shipped("fcl_env.obj"),
-            &shipped("fcl_rob.obj"),
-            "-q",
-            "--max-pairs",
-            "5",
-        ])
+        .args([&shipped("fcl_env.obj"), &shipped("fcl_rob.obj"), "-q", "--max-pairs", "5"])
         .output()
         .unwrap();
     let r = parse(&out.stdout);
@@ -227,10 +170,7 @@ fn bad_input_is_one_line_exit_2() {
 fn bad_arguments_exit_2() {
     let ok = shipped("fcl_rob.obj");
     assert!(error_line(&[&ok, &ok, "--transform-a", "1,0,0"]).contains("transform-a"));
-    assert!(
-        error_line(&[&ok, &ok, "--transform-b", "1,0,0,0,0,1,0,0,0,0,1,0,0,0,1,1"])
-            .contains("last row")
-    );
+    assert!(error_line(&[&ok, &ok, "--transform-b", "1,0,0,0,0,1,0,0,0,0,1,0,0,0,1,1"]).contains("last row"));
     assert!(error_line(&[&ok, &ok, "--translate-a", "1,2"]).contains("translate-a"));
     assert!(error_line(&[&ok, &ok, "--clearance", "-1"]).contains("clearance"));
     assert!(error_line(&[&ok, &ok, "--leaf-size", "0"]).contains("leaf-size"));
@@ -242,19 +182,9 @@ fn bad_arguments_exit_2() {
 fn transform_and_translate_agree() {
     let a = shipped("fcl_env.obj");
     let b = shipped("fcl_rob.obj");
-    let t = bin()
-        .args([&a, &b, "-q", "--no-timings", "--translate-a", "10,-20,30"])
-        .output()
-        .unwrap();
+    let t = bin().args([&a, &b, "-q", "--no-timings", "--translate-a", "10,-20,30"]).output().unwrap();
     let m = bin()
-        .args([
-            &a,
-            &b,
-            "-q",
-            "--no-timings",
-            "--transform-a",
-            "1,0,0,10,0,1,0,-20,0,0,1,30",
-        ])
+        .args([&a, &b, "-q", "--no-timings", "--transform-a", "1,0,0,10,0,1,0,-20,0,0,1,30"])
         .output()
         .unwrap();
     let (t, m) = (parse(&t.stdout), parse(&m.stdout));
@@ -266,27 +196,14 @@ fn transform_and_translate_agree() {
 fn byte_identical_across_thread_counts_on_the_bunny() {
     let bunny = shared("stanford-bunny.obj");
     if !bunny.exists() {
-        panic!(
-            "{} is missing: CI runs with ../shared beside the repo",
-            bunny.display()
-        );
+        panic!("{} is missing: CI runs with ../shared beside the repo", bunny.display());
     }
     let b = bunny.to_str().unwrap();
     // A moved, rotated copy that cuts through the original.
     let m = "0.8,-0.6,0,0.01,0.6,0.8,0,0.005,0,0,1,0.002";
     let run = |threads: &str| {
         let out = bin()
-            .args([
-                b,
-                b,
-                "--transform-b",
-                m,
-                "--no-timings",
-                "--threads",
-                threads,
-                "--clearance",
-                "0.0005",
-            ])
+            .args([b, b, "--transform-b", m, "--no-timings", "--threads", threads, "--clearance", "0.0005"])
             .output()
             .unwrap();
         assert_eq!(out.status.code(), Some(1));

@@ -9,28 +9,16 @@ use serde_json::Value;
 use std::path::PathBuf;
 
 fn shared(name: &str) -> PathBuf {
-    PathBuf::from(env!("CARGO_MANIFEST_DIR"))
-        .join("../shared/meshes")
-        .join(name)
+    PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../shared/meshes").join(name)
 }
 
 fn load(name: &str) -> meshclash::mesh::Mesh {
-    load_input(&InputSpec {
-        path: shared(name),
-        transform: DMat4::IDENTITY,
-    })
-    .unwrap()
-    .mesh
+    load_input(&InputSpec { path: shared(name), transform: DMat4::IDENTITY }).unwrap().mesh
 }
 
 fn row_major(m: &Value) -> DMat4 {
     let r = |i: usize| {
-        let row: Vec<f64> = m[i]
-            .as_array()
-            .unwrap()
-            .iter()
-            .map(|x| x.as_f64().unwrap())
-            .collect();
+        let row: Vec<f64> = m[i].as_array().unwrap().iter().map(|x| x.as_f64().unwrap()).collect();
         DVec4::new(row[0], row[1], row[2], row[3])
     };
     DMat4::from_cols(r(0), r(1), r(2), r(3)).transpose()
@@ -39,20 +27,14 @@ fn row_major(m: &Value) -> DMat4 {
 #[test]
 fn all_32_reference_poses_agree_with_fcl() {
     let reference: Value =
-        serde_json::from_slice(&std::fs::read(shared("fcl_env_rob_reference.json")).unwrap())
-            .unwrap();
+        serde_json::from_slice(&std::fs::read(shared("fcl_env_rob_reference.json")).unwrap()).unwrap();
     let (env, rob) = (load("fcl_env.obj"), load("fcl_rob.obj"));
     let cases = reference["cases"].as_array().unwrap();
     assert_eq!(cases.len(), 32);
     let mut colliding = 0;
     for case in cases {
         let mut moved = env.clone();
-        place(
-            &mut moved,
-            &row_major(&case["env_transform_row_major"]),
-            &shared("fcl_env.obj"),
-        )
-        .unwrap();
+        place(&mut moved, &row_major(&case["env_transform_row_major"]), &shared("fcl_env.obj")).unwrap();
         let r = check(&moved, &rob, &Settings::default());
         let i = &case["index"];
         let fcl_hit = case["fcl_in_collision"].as_bool().unwrap();
@@ -68,14 +50,8 @@ fn all_32_reference_poses_agree_with_fcl() {
         if let Some(pts) = case["fcl_nearest_points_world"].as_array() {
             // FCL's protocol: nearest points agree to 1e-3 per coordinate unless the distance is 0.
             let c = r.closest.unwrap();
-            let p = |k: usize| {
-                pts[k]
-                    .as_array()
-                    .unwrap()
-                    .iter()
-                    .map(|x| x.as_f64().unwrap())
-                    .collect::<Vec<_>>()
-            };
+            let p =
+                |k: usize| pts[k].as_array().unwrap().iter().map(|x| x.as_f64().unwrap()).collect::<Vec<_>>();
             for k in 0..3 {
                 assert!((c.a.1[k] - p(0)[k]).abs() <= 1e-3, "case {i}: env point");
                 assert!((c.b.1[k] - p(1)[k]).abs() <= 1e-3, "case {i}: rob point");
@@ -112,8 +88,5 @@ fn identity_pose_clashes_and_matches_exhaustive_search() {
     // contact per triangle pair), not distinct pairs; on the 32 moved poses, where the reference
     // records distinct pairs, the counts agree exactly (test above).
     assert_eq!(r.counts.touching, 0);
-    assert!(
-        nearest_other > 1.0,
-        "nearest non-meeting pair at {nearest_other}"
-    );
+    assert!(nearest_other > 1.0, "nearest non-meeting pair at {nearest_other}");
 }

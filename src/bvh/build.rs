@@ -12,45 +12,40 @@ const PAR_THRESHOLD: usize = 16 * 1024;
 /// Beyond this depth parallel recursion stops (bounds the call stack on lopsided splits).
 const PAR_MAX_DEPTH: usize = 32;
 
-struct Input<'a> {
-    boxes: &'a [Aabb],
-    cents: &'a [DVec3],
+/// A triangle's box, centroid and index, moved around as one so that every pass over a
+/// subtree's triangles reads memory in order (random access by index was the build's bottleneck).
+#[derive(Clone, Copy)]
+struct Item {
+    bounds: Aabb,
+    cent: DVec3,
+    idx: u32,
+}
+
+struct Input {
     opts: BuildOptions,
 }
 
 pub(super) fn build(boxes: &[Aabb], opts: BuildOptions) -> Bvh {
-    let opts = BuildOptions {
-        leaf_size: opts.leaf_size.clamp(1, 255),
-        ..opts
-    };
-    let cents: Vec<DVec3> = boxes.iter().map(Aabb::center).collect();
-    let mut prims: Vec<u32> = (0..boxes.len() as u32).collect();
+    let opts = BuildOptions { leaf_size: opts.leaf_size.clamp(1, 255), ..opts };
     if boxes.is_empty() {
-        return Bvh {
-            nodes: Vec::new(),
-            prims,
-        };
+        return Bvh { nodes: Vec::new(), prims: Vec::new() };
     }
-    let input = Input {
-        boxes,
-        cents: &cents,
-        opts,
-    };
-    let nodes = subtree(&input, &mut prims, 0, 0);
-    Bvh { nodes, prims }
+    let mut items: Vec<Item> =
+        boxes.iter().enumerate().map(|(i, b)| Item { bounds: *b, cent: b.center(), idx: i as u32 }).collect();
+    let input = Input { opts };
+    let nodes = subtree(&input, &mut items, 0, 0);
+    Bvh { nodes, prims: items.iter().map(|it| it.idx).collect() }
 }
 
-fn bounds_of(input: &Input, prims: &[u32]) -> Aabb {
-    prims
-        .iter()
-        .fold(Aabb::EMPTY, |b, &p| b.union(input.boxes[p as usize]))
+fn bounds_of(items: &[Item]) -> Aabb {
+    items.iter().fold(Aabb::EMPTY, |b, it| b.union(it.bounds))
 }
 
-fn subtree(input: &Input, prims: &mut [u32], base: u32, depth: usize) -> Vec<Node> {
+fn subtree(input: &Input, prims: &mut [Item], base: u32, depth: usize) -> Vec<Node> {
     if prims.len() <= PAR_THRESHOLD || depth >= PAR_MAX_DEPTH {
         return sequential(input, prims, base);
     }
-    let bounds = bounds_of(input, prims);
+    let bounds = bounds_of(prims);
     let mid = split(input, prims);
     let (l, r) = prims.split_at_mut(mid);
     let (ln, rn) = rayon::join(
@@ -58,11 +53,7 @@ fn subtree(input: &Input, prims: &mut [u32], base: u32, depth: usize) -> Vec<Nod
         || subtree(input, r, base + mid as u32, depth + 1),
     );
     let mut nodes = Vec::with_capacity(1 + ln.len() + rn.len());
-    nodes.push(Node {
-        bounds,
-        a: 1 + ln.len() as u32,
-        count: 0,
-    });
+    nodes.push(Node { bounds, a: 1 + ln.len() as u32, count: 0 });
     for part in [ln, rn] {
         let off = nodes.len() as u32;
         nodes.extend(part.into_iter().map(|mut n| {
@@ -76,9 +67,8 @@ fn subtree(input: &Input, prims: &mut [u32], base: u32, depth: usize) -> Vec<Nod
 }
 
 /// Depth-first build of one subtree with an explicit stack. Node indices are local.
-fn sequential(input: &Input, prims: &mut [u32], base: u32) -> Vec<Node> {
-    let mut nodes: Vec<Node> =
-        Vec::with_capacity(2 * prims.len() / input.opts.leaf_size as usize + 1);
+fn sequential(input: &Input, prims: &mut [Item], base: u32) -> Vec<Node> {
+    let mut nodes: Vec<Node> = Vec::with_capacity(2 * prims.len() / input.opts.leaf_size as usize + 1);
     // (start, end, parent whose right child this is)
     let mut stack: Vec<(usize, usize, Option<usize>)> = vec![(0, prims.len(), None)];
     while let Some((start, end, right_of)) = stack.pop() {
@@ -87,21 +77,13 @@ fn sequential(input: &Input, prims: &mut [u32], base: u32) -> Vec<Node> {
             nodes[p].a = idx as u32;
         }
         let slice = &mut prims[start..end];
-        let bounds = bounds_of(input, slice);
+        let bounds = bounds_of(slice);
         if slice.len() <= input.opts.leaf_size as usize {
-            nodes.push(Node {
-                bounds,
-                a: base + start as u32,
-                count: slice.len() as u32,
-            });
+            nodes.push(Node { bounds, a: base + start as u32, count: slice.len() as u32 });
             continue;
         }
         let mid = start + split(input, slice);
-        nodes.push(Node {
-            bounds,
-            a: 0,
-            count: 0,
-        });
+        nodes.push(Node { bounds, a: 0, count: 0 });
         stack.push((mid, end, Some(idx)));
         stack.push((start, mid, None));
     }
@@ -109,11 +91,9 @@ fn sequential(input: &Input, prims: &mut [u32], base: u32) -> Vec<Node> {
 }
 
 /// Partition `prims` in place and return the split point, in `1..prims.len()`.
-fn split(input: &Input, prims: &mut [u32]) -> usize {
+fn split(input: &Input, prims: &mut [Item]) -> usize {
     let n = prims.len();
-    let cb = prims
-        .iter()
-        .fold(Aabb::EMPTY, |b, &p| b.grow(input.cents[p as usize]));
+    let cb = prims.iter().fold(Aabb::EMPTY, |b, it| b.grow(it.cent));
     let ext = cb.extent();
     let axis = if ext.x >= ext.y && ext.x >= ext.z {
         0
@@ -126,18 +106,15 @@ fn split(input: &Input, prims: &mut [u32]) -> usize {
         return n / 2; // all centroids coincide: any split is as good as another
     }
     let mid = match input.opts.strategy {
-        Strategy::Sah => sah_split(input, prims, &cb),
+        Strategy::Sah => sah_split(prims, &cb),
         Strategy::Median => {
             let plane = cb.center()[axis];
-            partition(prims, |p| input.cents[p as usize][axis] < plane)
+            partition(prims, |it| it.cent[axis] < plane)
         }
         Strategy::Equal => {
             let k = n / 2;
-            let c = input.cents;
-            prims.select_nth_unstable_by(k, |&p, &q| {
-                c[p as usize][axis]
-                    .total_cmp(&c[q as usize][axis])
-                    .then(p.cmp(&q))
+            prims.select_nth_unstable_by(k, |p, q| {
+                p.cent[axis].total_cmp(&q.cent[axis]).then(p.idx.cmp(&q.idx))
             });
             k
         }
@@ -154,22 +131,28 @@ fn bin_of(c: f64, min: f64, scale: f64) -> usize {
     (((c - min) * scale) as usize).min(BINS - 1)
 }
 
-/// Binned SAH over all three axes; returns the partition point.
-fn sah_split(input: &Input, prims: &mut [u32], cb: &Aabb) -> usize {
+/// Binned SAH over all three axes (one pass over the triangles bins them on all three);
+/// returns the partition point.
+fn sah_split(prims: &mut [Item], cb: &Aabb) -> usize {
+    let ext = cb.extent();
+    let scale = DVec3::splat(BINS as f64) / ext; // inf on flat axes: those are skipped below
+    let mut counts = [[0usize; BINS]; 3];
+    let mut boxes = [[Aabb::EMPTY; BINS]; 3];
+    for it in prims.iter() {
+        for axis in 0..3 {
+            if ext[axis] > 0.0 {
+                let b = bin_of(it.cent[axis], cb.min[axis], scale[axis]);
+                counts[axis][b] += 1;
+                boxes[axis][b] = boxes[axis][b].union(it.bounds);
+            }
+        }
+    }
     let mut best = (f64::INFINITY, 0usize, 0usize); // (cost, axis, first bin of the right side)
     for axis in 0..3 {
-        let (min, ext) = (cb.min[axis], cb.extent()[axis]);
-        if ext <= 0.0 {
+        if ext[axis] <= 0.0 {
             continue;
         }
-        let scale = BINS as f64 / ext;
-        let mut counts = [0usize; BINS];
-        let mut boxes = [Aabb::EMPTY; BINS];
-        for &p in prims.iter() {
-            let b = bin_of(input.cents[p as usize][axis], min, scale);
-            counts[b] += 1;
-            boxes[b] = boxes[b].union(input.boxes[p as usize]);
-        }
+        let (counts, boxes) = (&counts[axis], &boxes[axis]);
         // Right-to-left sweep: area and count of bins[i..].
         let mut right = [(0.0f64, 0usize); BINS];
         let (mut acc, mut cnt) = (Aabb::EMPTY, 0);
@@ -196,17 +179,15 @@ fn sah_split(input: &Input, prims: &mut [u32], cb: &Aabb) -> usize {
         return prims.len() / 2;
     }
     let (_, axis, split_bin) = best;
-    let (min, scale) = (cb.min[axis], BINS as f64 / cb.extent()[axis]);
-    partition(prims, |p| {
-        bin_of(input.cents[p as usize][axis], min, scale) < split_bin
-    })
+    let (min, scale) = (cb.min[axis], scale[axis]);
+    partition(prims, |it| bin_of(it.cent[axis], min, scale) < split_bin)
 }
 
 /// In-place partition (deterministic): elements satisfying `left` first; returns their count.
-fn partition(prims: &mut [u32], left: impl Fn(u32) -> bool) -> usize {
+fn partition(prims: &mut [Item], left: impl Fn(&Item) -> bool) -> usize {
     let mut i = 0;
     for j in 0..prims.len() {
-        if left(prims[j]) {
+        if left(&prims[j]) {
             prims.swap(i, j);
             i += 1;
         }

@@ -71,10 +71,7 @@ pub struct BuildOptions {
 
 impl Default for BuildOptions {
     fn default() -> Self {
-        BuildOptions {
-            strategy: Strategy::Sah,
-            leaf_size: 4,
-        }
+        BuildOptions { strategy: Strategy::Sah, leaf_size: 4 }
     }
 }
 

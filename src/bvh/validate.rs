@@ -9,11 +9,7 @@ pub(super) fn validate(bvh: &Bvh, tri_boxes: &[Aabb], leaf_size: u32) -> Result<
         return Err(format!("{} prims for {} triangles", bvh.prims.len(), n));
     }
     if n == 0 {
-        return if bvh.nodes.is_empty() {
-            Ok(())
-        } else {
-            Err("nodes without triangles".into())
-        };
+        return if bvh.nodes.is_empty() { Ok(()) } else { Err("nodes without triangles".into()) };
     }
     let mut seen = vec![false; n];
     let mut visited = 0usize;
@@ -22,25 +18,17 @@ pub(super) fn validate(bvh: &Bvh, tri_boxes: &[Aabb], leaf_size: u32) -> Result<
     let mut expect_next = 0usize; // depth-first order: nodes are visited in index order
     while let Some((i, parent)) = stack.pop() {
         if i != expect_next {
-            return Err(format!(
-                "node {i} out of depth-first order (expected {expect_next})"
-            ));
+            return Err(format!("node {i} out of depth-first order (expected {expect_next})"));
         }
         expect_next += 1;
         visited += 1;
-        let node = bvh
-            .nodes
-            .get(i)
-            .ok_or_else(|| format!("child index {i} out of range"))?;
+        let node = bvh.nodes.get(i).ok_or_else(|| format!("child index {i} out of range"))?;
         if !parent.contains(&node.bounds) {
             return Err(format!("node {i} box is not inside its parent's"));
         }
         if node.is_leaf() {
             if node.count > leaf_size.max(1) {
-                return Err(format!(
-                    "leaf {i} holds {} > {leaf_size} triangles",
-                    node.count
-                ));
+                return Err(format!("leaf {i} holds {} > {leaf_size} triangles", node.count));
             }
             let end = (node.a + node.count) as usize;
             if end > n {
@@ -84,13 +72,7 @@ pub(super) fn validate(bvh: &Bvh, tri_boxes: &[Aabb], leaf_size: u32) -> Result<
 
 pub(super) fn stats(bvh: &Bvh) -> Stats {
     let bytes = bvh.nodes.len() * std::mem::size_of::<super::Node>() + bvh.prims.len() * 4;
-    let mut s = Stats {
-        nodes: bvh.nodes.len(),
-        leaves: 0,
-        depth: 0,
-        sah_cost: 0.0,
-        bytes,
-    };
+    let mut s = Stats { nodes: bvh.nodes.len(), leaves: 0, depth: 0, sah_cost: 0.0, bytes };
     let Some(root) = bvh.nodes.first() else {
         return s;
     };
@@ -99,11 +81,7 @@ pub(super) fn stats(bvh: &Bvh) -> Stats {
     let mut cost = 0.0;
     while let Some((i, d)) = stack.pop() {
         let node = &bvh.nodes[i];
-        let rel = if root_area > 0.0 {
-            node.bounds.half_area() / root_area
-        } else {
-            1.0
-        };
+        let rel = if root_area > 0.0 { node.bounds.half_area() / root_area } else { 1.0 };
         if node.is_leaf() {
             s.leaves += 1;
             s.depth = s.depth.max(d);

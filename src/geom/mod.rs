@@ -17,18 +17,12 @@ pub struct Aabb {
 
 impl Aabb {
     /// The empty box (min = +inf, max = -inf): the identity of [`Aabb::union`].
-    pub const EMPTY: Aabb = Aabb {
-        min: DVec3::INFINITY,
-        max: DVec3::NEG_INFINITY,
-    };
+    pub const EMPTY: Aabb = Aabb { min: DVec3::INFINITY, max: DVec3::NEG_INFINITY };
 
     /// The box of a triangle.
     #[inline]
     pub fn of_triangle(t: &[DVec3; 3]) -> Aabb {
-        Aabb {
-            min: t[0].min(t[1]).min(t[2]),
-            max: t[0].max(t[1]).max(t[2]),
-        }
+        Aabb { min: t[0].min(t[1]).min(t[2]), max: t[0].max(t[1]).max(t[2]) }
     }
 
     /// The box of a set of points (EMPTY for none).
@@ -39,19 +33,13 @@ impl Aabb {
     /// This box grown to contain `p`.
     #[inline]
     pub fn grow(self, p: DVec3) -> Aabb {
-        Aabb {
-            min: self.min.min(p),
-            max: self.max.max(p),
-        }
+        Aabb { min: self.min.min(p), max: self.max.max(p) }
     }
 
     /// The smallest box containing both.
     #[inline]
     pub fn union(self, o: Aabb) -> Aabb {
-        Aabb {
-            min: self.min.min(o.min),
-            max: self.max.max(o.max),
-        }
+        Aabb { min: self.min.min(o.min), max: self.max.max(o.max) }
     }
 
     /// True for the empty box.
@@ -114,35 +102,20 @@ mod tests {
 
     #[test]
     fn overlap_is_closed_and_distance_is_zero_inside() {
-        let a = Aabb {
-            min: DVec3::ZERO,
-            max: DVec3::ONE,
-        };
-        let b = Aabb {
-            min: DVec3::new(1.0, 0.5, 0.5),
-            max: DVec3::splat(2.0),
-        };
+        let a = Aabb { min: DVec3::ZERO, max: DVec3::ONE };
+        let b = Aabb { min: DVec3::new(1.0, 0.5, 0.5), max: DVec3::splat(2.0) };
         assert!(a.overlaps(&b) && b.overlaps(&a));
         assert_eq!(a.distance_sq(&b), 0.0);
-        let c = Aabb {
-            min: DVec3::new(1.0 + f64::EPSILON, 0.0, 0.0),
-            max: DVec3::splat(2.0),
-        };
+        let c = Aabb { min: DVec3::new(1.0 + f64::EPSILON, 0.0, 0.0), max: DVec3::splat(2.0) };
         assert!(!a.overlaps(&c));
         assert!(a.distance_sq(&c) > 0.0);
-        let d = Aabb {
-            min: DVec3::new(4.0, 5.0, 0.0),
-            max: DVec3::new(5.0, 6.0, 1.0),
-        };
+        let d = Aabb { min: DVec3::new(4.0, 5.0, 0.0), max: DVec3::new(5.0, 6.0, 1.0) };
         assert_eq!(a.distance_sq(&d), 9.0 + 16.0);
     }
 
     #[test]
     fn empty_box_is_union_identity() {
-        let a = Aabb {
-            min: DVec3::new(-1.0, 2.0, 3.0),
-            max: DVec3::new(0.0, 4.0, 5.0),
-        };
+        let a = Aabb { min: DVec3::new(-1.0, 2.0, 3.0), max: DVec3::new(0.0, 4.0, 5.0) };
         assert_eq!(Aabb::EMPTY.union(a), a);
         assert!(Aabb::EMPTY.is_empty());
         assert_eq!(Aabb::EMPTY.half_area(), 0.0);

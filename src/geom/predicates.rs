@@ -19,11 +19,7 @@ pub type Sign = i8;
 
 #[inline]
 fn c3(p: DVec3) -> Coord3D<f64> {
-    Coord3D {
-        x: p.x,
-        y: p.y,
-        z: p.z,
-    }
+    Coord3D { x: p.x, y: p.y, z: p.z }
 }
 
 #[inline]
@@ -61,11 +57,7 @@ pub fn project(p: DVec3, axis: usize) -> Coord<f64> {
 /// projected along `axis`.
 #[inline]
 pub fn orient2d(a: DVec3, b: DVec3, c: DVec3, axis: usize) -> Sign {
-    sign(robust::orient2d(
-        project(a, axis),
-        project(b, axis),
-        project(c, axis),
-    ))
+    sign(robust::orient2d(project(a, axis), project(b, axis), project(c, axis)))
 }
 
 /// Exact: are the three points collinear (or coincident)? True iff every component of
@@ -184,20 +176,13 @@ mod tests {
         let b = DVec3::new(0.0, 1.0e8 + 3.0, z);
         let c = DVec3::new(-1.0e8 + 0.5, -7.0, z);
         let up = f64::from_bits(z.to_bits() + 1);
-        assert_eq!(
-            orient3d(a, b, c, DVec3::new(0.25, 0.75, up)),
-            orient3d(a, b, c, a + DVec3::Z)
-        );
+        assert_eq!(orient3d(a, b, c, DVec3::new(0.25, 0.75, up)), orient3d(a, b, c, a + DVec3::Z));
         assert_eq!(orient3d(a, b, c, DVec3::new(0.25, 0.75, z)), 0);
     }
 
     #[test]
     fn orient2d_projection_matches_normal_component() {
-        let (a, b, c) = (
-            DVec3::ZERO,
-            DVec3::new(1.0, 2.0, 3.0),
-            DVec3::new(-2.0, 0.5, 1.0),
-        );
+        let (a, b, c) = (DVec3::ZERO, DVec3::new(1.0, 2.0, 3.0), DVec3::new(-2.0, 0.5, 1.0));
         let n = (b - a).cross(c - a);
         for k in 0..3 {
             assert_eq!(orient2d(a, b, c, k) as f64, n[k].signum());
@@ -221,20 +206,11 @@ mod tests {
         let t = Tolerances::default();
         assert!(!t.is_touch(0.0), "zero tolerance never consults distances");
         assert!(!t.is_clearance(0.0));
-        let t = Tolerances {
-            touch: 0.5,
-            clearance: 2.0,
-        };
+        let t = Tolerances { touch: 0.5, clearance: 2.0 };
         assert!(t.is_touch(0.5) && !t.is_touch(0.51));
         assert!(t.is_clearance(1.99) && !t.is_clearance(2.0));
-        let a = Aabb {
-            min: DVec3::ZERO,
-            max: DVec3::ONE,
-        };
-        let b = Aabb {
-            min: DVec3::new(3.0, 0.0, 0.0),
-            max: DVec3::new(4.0, 1.0, 1.0),
-        };
+        let a = Aabb { min: DVec3::ZERO, max: DVec3::ONE };
+        let b = Aabb { min: DVec3::new(3.0, 0.0, 0.0), max: DVec3::new(4.0, 1.0, 1.0) };
         assert!(t.boxes_may_meet(&a, &b));
         assert!(!Tolerances::default().boxes_may_meet(&a, &b));
     }

@@ -14,7 +14,8 @@
 //!   (KHR_mesh_quantization) are an error for now. Skins and morph targets are ignored (with a
 //!   warning); `EXT_mesh_gpu_instancing` is ignored with a warning unless required.
 //! - **Vertices**: every primitive instance contributes its own vertices, transformed to world
-//!   space in f64 (no merging across primitives or instances).
+//!   space in f64 (no merging across primitives or instances). A scene expanding to more than
+//!   [`MAX_SCENE_VERTICES`] vertices is refused before anything is allocated for it.
 //! - **Triangle order**: scene traversal order (depth-first pre-order over the scene's root
 //!   nodes in the order listed, children in listed order); within a node, its mesh's primitives
 //!   in order; within a primitive, index order.
@@ -38,25 +39,18 @@ use crate::mesh::{Loaded, Mesh, Object};
 /// The deepest node hierarchy accepted.
 pub(crate) const MAX_DEPTH: usize = 1024;
 
+/// The most vertices a scene may expand to through instancing (2^28, 6 GiB of f64
+/// positions): a small file instancing a big mesh many times must fail, not exhaust memory.
+pub(crate) const MAX_SCENE_VERTICES: usize = 1 << 28;
+
 /// Loads `.gltf` or `.glb` `bytes` (the GLB magic decides); see the module doc.
 pub(crate) fn load(path: &Path, bytes: &[u8]) -> Result<Loaded> {
-    let (json, bin) = if bytes.starts_with(b"glTF") {
-        split_glb(path, bytes)?
-    } else {
-        (bytes, None)
-    };
+    let (json, bin) = if bytes.starts_with(b"glTF") { split_glb(path, bytes)? } else { (bytes, None) };
     let mut warnings = Vec::new();
     let doc = parse_document(path, json, &mut warnings)?;
     let buffers = load_buffers(path, &doc, bin)?;
-    let input_bytes = buffers
-        .iter()
-        .map(|b| b.len())
-        .fold(bytes.len(), usize::saturating_add);
-    let reader = Reader {
-        path,
-        buffers: &buffers,
-        input_bytes,
-    };
+    let input_bytes = buffers.iter().map(|b| b.len()).fold(bytes.len(), usize::saturating_add);
+    let reader = Reader { path, buffers: &buffers, input_bytes };
     let instances = traverse(path, &doc, &mut warnings)?;
 
     // Decode each mesh once, whatever its number of instances.
@@ -66,15 +60,18 @@ pub(crate) fn load(path: &Path, bytes: &[u8]) -> Result<Loaded> {
         if decoded[inst.mesh].is_none() {
             decoded[inst.mesh] = Some(decode_mesh(&reader, &doc, inst.mesh, &mut warnings)?);
         }
-        for p in decoded[inst.mesh].iter().flatten() {
+        for p in decoded[inst.mesh].iter().flatten().filter(|p| !p.triangles.is_empty()) {
             total_v = total_v.saturating_add(p.positions.len());
             total_t = total_t.saturating_add(p.triangles.len());
         }
     }
-    if total_v > u32::MAX as usize {
+    if total_v > MAX_SCENE_VERTICES {
         return Err(Error::input(
             path,
-            format!("glTF scene has {total_v} vertices after instancing, more than 4294967295"),
+            format!(
+                "glTF scene has {total_v} vertices after instancing, more than the \
+                 {MAX_SCENE_VERTICES} supported"
+            ),
         ));
     }
 
@@ -96,7 +93,7 @@ pub(crate) fn load(path: &Path, bytes: &[u8]) -> Result<Loaded> {
             gltf_mesh: Some(inst.mesh as u32),
             world: Some(inst.world),
         });
-        for p in prims {
+        for p in prims.iter().filter(|p| !p.triangles.is_empty()) {
             let base = mesh.positions.len() as u32;
             for (i, &v) in p.positions.iter().enumerate() {
                 let w = inst.world.transform_point3(v);
@@ -147,10 +144,7 @@ fn node_names(doc: &Document) -> Vec<Cow<'_, str>> {
 }
 
 fn node_path(path: &[usize], names: &[Cow<'_, str>]) -> String {
-    let parts: Vec<&str> = path
-        .iter()
-        .map(|&i| names.get(i).map_or("?", |s| s.as_ref()))
-        .collect();
+    let parts: Vec<&str> = path.iter().map(|&i| names.get(i).map_or("?", |s| s.as_ref())).collect();
     parts.join("/")
 }
 
@@ -167,10 +161,7 @@ fn traverse(path: &Path, doc: &Document, warnings: &mut Vec<String>) -> Result<V
                 if p == node.index() {
                     return Err(err(format!("glTF node {p} lists child {c} twice")));
                 }
-                return Err(err(format!(
-                    "glTF node {c} has two parents (nodes {p} and {})",
-                    node.index()
-                )));
+                return Err(err(format!("glTF node {c} has two parents (nodes {p} and {})", node.index())));
             }
             parent[c] = Some(node.index());
         }
@@ -187,9 +178,7 @@ fn traverse(path: &Path, doc: &Document, warnings: &mut Vec<String>) -> Result<V
     let mut listed = vec![false; n];
     for &r in &roots {
         if let Some(p) = parent[r] {
-            return Err(err(format!(
-                "glTF node {r} is a scene root but also a child of node {p}"
-            )));
+            return Err(err(format!("glTF node {r} is a scene root but also a child of node {p}")));
         }
         if std::mem::replace(&mut listed[r], true) {
             return Err(err(format!("glTF scene lists node {r} twice")));
@@ -201,17 +190,12 @@ fn traverse(path: &Path, doc: &Document, warnings: &mut Vec<String>) -> Result<V
     let mut instances = Vec::new();
     let mut skinned = false;
     // (node, parent world, depth); `chain` holds the current root-to-node path.
-    let mut stack: Vec<(usize, DMat4, usize)> = roots
-        .iter()
-        .rev()
-        .map(|&r| (r, DMat4::IDENTITY, 1))
-        .collect();
+    let mut stack: Vec<(usize, DMat4, usize)> =
+        roots.iter().rev().map(|&r| (r, DMat4::IDENTITY, 1)).collect();
     let mut chain: Vec<usize> = Vec::new();
     while let Some((i, parent_world, depth)) = stack.pop() {
         if depth > MAX_DEPTH {
-            return Err(err(format!(
-                "glTF node hierarchy deeper than {MAX_DEPTH} levels (at node {i})"
-            )));
+            return Err(err(format!("glTF node hierarchy deeper than {MAX_DEPTH} levels (at node {i})")));
         }
         if std::mem::replace(&mut visited[i], true) {
             return Err(err(format!("glTF node graph has a cycle at node {i}")));
@@ -221,18 +205,11 @@ fn traverse(path: &Path, doc: &Document, warnings: &mut Vec<String>) -> Result<V
         let node = &nodes[i];
         let world = parent_world * local_matrix(path, node)?;
         if !world.is_finite() {
-            return Err(err(format!(
-                "glTF node {i}: world transform is not finite (overflow)"
-            )));
+            return Err(err(format!("glTF node {i}: world transform is not finite (overflow)")));
         }
         if let Some(mesh) = node.mesh() {
             skinned |= node.skin().is_some();
-            instances.push(Instance {
-                node: i,
-                mesh: mesh.index(),
-                world,
-                path: chain.clone(),
-            });
+            instances.push(Instance { node: i, mesh: mesh.index(), world, path: chain.clone() });
         }
         let children: Vec<usize> = node.children().map(|c| c.index()).collect();
         for &c in children.iter().rev() {
@@ -282,11 +259,7 @@ fn local_matrix(path: &Path, node: &::gltf::Node) -> Result<DMat4> {
             }
             Ok(DMat4::from_cols_array_2d(&cols))
         }
-        Transform::Decomposed {
-            translation: t,
-            rotation: r,
-            scale: s,
-        } => {
+        Transform::Decomposed { translation: t, rotation: r, scale: s } => {
             let all = t.iter().chain(&r).chain(&s);
             if all.map(|&x| f64::from(x)).any(|x| !x.is_finite()) {
                 return Err(bad("a non-finite translation, rotation or scale"));
@@ -306,12 +279,7 @@ fn local_matrix(path: &Path, node: &::gltf::Node) -> Result<DMat4> {
 }
 
 /// Decodes every triangle primitive of mesh `m`; other modes are skipped with a warning.
-fn decode_mesh(
-    r: &Reader,
-    doc: &Document,
-    m: usize,
-    warnings: &mut Vec<String>,
-) -> Result<Vec<Prim>> {
+fn decode_mesh(r: &Reader, doc: &Document, m: usize, warnings: &mut Vec<String>) -> Result<Vec<Prim>> {
     let Some(mesh) = doc.meshes().nth(m) else {
         return Ok(Vec::new());
     };
@@ -319,13 +287,8 @@ fn decode_mesh(
     for prim in mesh.primitives() {
         let what = format!("mesh {m} primitive {}", prim.index());
         let mode = prim.mode();
-        if !matches!(
-            mode,
-            Mode::Triangles | Mode::TriangleStrip | Mode::TriangleFan
-        ) {
-            warnings.push(format!(
-                "{what}: skipped {mode:?} primitive (only triangles are loaded)"
-            ));
+        if !matches!(mode, Mode::Triangles | Mode::TriangleStrip | Mode::TriangleFan) {
+            warnings.push(format!("{what}: skipped {mode:?} primitive (only triangles are loaded)"));
             continue;
         }
         let Some(acc) = prim.get(&::gltf::Semantic::Positions) else {
@@ -333,9 +296,7 @@ fn decode_mesh(
             continue;
         };
         if prim.morph_targets().len() > 0 {
-            warnings.push(format!(
-                "{what}: morph targets ignored (base positions used)"
-            ));
+            warnings.push(format!("{what}: morph targets ignored (base positions used)"));
         }
         let positions = r.positions(&acc, &what)?;
         let nv = positions.len();
@@ -356,18 +317,11 @@ fn decode_mesh(
             _ => 0,
         };
         if leftover > 0 {
-            warnings.push(format!(
-                "{what}: {leftover} trailing indices do not form a triangle and were ignored"
-            ));
+            warnings
+                .push(format!("{what}: {leftover} trailing indices do not form a triangle and were ignored"));
         }
-        let positions = positions
-            .iter()
-            .map(|p| DVec3::from_array(p.map(f64::from)))
-            .collect();
-        out.push(Prim {
-            positions,
-            triangles,
-        });
+        let positions = positions.iter().map(|p| DVec3::from_array(p.map(f64::from))).collect();
+        out.push(Prim { positions, triangles });
     }
     Ok(out)
 }
@@ -376,18 +330,20 @@ fn decode_mesh(
 fn triangulate(mode: Mode, idx: &[u32]) -> Vec<[u32; 3]> {
     match mode {
         Mode::Triangles => idx.chunks_exact(3).map(|c| [c[0], c[1], c[2]]).collect(),
-        Mode::TriangleStrip => (0..idx.len().saturating_sub(2))
-            .map(|i| {
-                if i % 2 == 0 {
-                    [idx[i], idx[i + 1], idx[i + 2]]
-                } else {
-                    [idx[i], idx[i + 2], idx[i + 1]]
-                }
-            })
-            .collect(),
-        Mode::TriangleFan => (0..idx.len().saturating_sub(2))
-            .map(|i| [idx[0], idx[i + 1], idx[i + 2]])
-            .collect(),
+        Mode::TriangleStrip => {
+            (0..idx.len().saturating_sub(2))
+                .map(|i| {
+                    if i % 2 == 0 {
+                        [idx[i], idx[i + 1], idx[i + 2]]
+                    } else {
+                        [idx[i], idx[i + 2], idx[i + 1]]
+                    }
+                })
+                .collect()
+        }
+        Mode::TriangleFan => {
+            (0..idx.len().saturating_sub(2)).map(|i| [idx[0], idx[i + 1], idx[i + 2]]).collect()
+        }
         _ => Vec::new(),
     }
 }

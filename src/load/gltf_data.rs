@@ -34,18 +34,14 @@ pub(crate) fn split_glb<'a>(path: &Path, bytes: &'a [u8]) -> Result<(&'a [u8], O
     let err = |m: String| Error::input(path, m);
     let have = bytes.len();
     if have < 12 {
-        return Err(err(format!(
-            "truncated GLB: {have} bytes, the header alone needs 12"
-        )));
+        return Err(err(format!("truncated GLB: {have} bytes, the header alone needs 12")));
     }
     if &bytes[..4] != b"glTF" {
         return Err(err("not a GLB file: missing 'glTF' magic".into()));
     }
     let version = le_u32(bytes, 4).unwrap_or(0);
     if version != 2 {
-        return Err(err(format!(
-            "GLB version {version} is not supported (expected 2)"
-        )));
+        return Err(err(format!("GLB version {version} is not supported (expected 2)")));
     }
     let declared = le_u32(bytes, 8).unwrap_or(0);
     if declared > have {
@@ -60,15 +56,11 @@ pub(crate) fn split_glb<'a>(path: &Path, bytes: &'a [u8]) -> Result<(&'a [u8], O
     let mut index = 0;
     while pos < data.len() {
         let (Some(len), Some(kind)) = (le_u32(data, pos), data.get(pos + 4..pos + 8)) else {
-            return Err(err(format!(
-                "truncated GLB: chunk {index} header at byte {pos} is cut off"
-            )));
+            return Err(err(format!("truncated GLB: chunk {index} header at byte {pos} is cut off")));
         };
         let start = pos + 8;
         if len > data.len() - start {
-            let what = String::from_utf8_lossy(kind)
-                .trim_end_matches('\0')
-                .to_string();
+            let what = super::clip(String::from_utf8_lossy(kind).trim_end_matches('\0'), 4);
             return Err(err(format!(
                 "truncated GLB: chunk {index} ('{what}') declares {len} bytes but only {} remain",
                 data.len() - start
@@ -95,11 +87,7 @@ fn le_u32(b: &[u8], o: usize) -> Option<usize> {
 
 /// Parses and validates the glTF JSON. Required extensions are checked here (named in the
 /// error when unsupported); `EXT_mesh_gpu_instancing` used but not required gives a warning.
-pub(crate) fn parse_document(
-    path: &Path,
-    json: &[u8],
-    warnings: &mut Vec<String>,
-) -> Result<Document> {
+pub(crate) fn parse_document(path: &Path, json: &[u8], warnings: &mut Vec<String>) -> Result<Document> {
     let json = json.strip_prefix(&[0xEF, 0xBB, 0xBF]).unwrap_or(json);
     let mut root = ::gltf::json::Root::from_slice(json)
         .map_err(|e| Error::input(path, format!("invalid glTF JSON: {e}")))?;
@@ -118,11 +106,7 @@ pub(crate) fn parse_document(
     }
     // Checked above; the gltf crate would reject any it does not itself implement.
     root.extensions_required.clear();
-    if root
-        .extensions_used
-        .iter()
-        .any(|e| e == "EXT_mesh_gpu_instancing")
-    {
+    if root.extensions_used.iter().any(|e| e == "EXT_mesh_gpu_instancing") {
         warnings.push(
             "EXT_mesh_gpu_instancing is not supported: instanced meshes are loaded once, at \
              their node's transform"
@@ -131,8 +115,7 @@ pub(crate) fn parse_document(
     }
     // gltf-json's validation indexes `accessors` with the POSITION index unchecked (a panic on a
     // dangling index), so check those references before validating.
-    let positions =
-        ::gltf::json::validation::Checked::Valid(::gltf::json::mesh::Semantic::Positions);
+    let positions = ::gltf::json::validation::Checked::Valid(::gltf::json::mesh::Semantic::Positions);
     for (m, mesh) in root.meshes.iter().enumerate() {
         for (p, prim) in mesh.primitives.iter().enumerate() {
             if let Some(a) = prim.attributes.get(&positions) {
@@ -199,9 +182,8 @@ pub(crate) fn load_buffers<'a>(
                 Cow::Borrowed(b)
             }
             ::gltf::buffer::Source::Uri(uri) if uri.starts_with("data:") => {
-                let data = decode_data_uri(uri).map_err(|m| {
-                    Error::input(path, format!("glTF buffer {i} data URI is invalid: {m}"))
-                })?;
+                let data = decode_data_uri(uri)
+                    .map_err(|m| Error::input(path, format!("glTF buffer {i} data URI is invalid: {m}")))?;
                 if data.len() < declared {
                     return Err(short("its data URI", data.len()));
                 }
@@ -219,19 +201,14 @@ fn decode_data_uri(uri: &str) -> std::result::Result<Vec<u8>, String> {
         return Err("no ',' after the media type".into());
     };
     if !header.ends_with(";base64") {
-        return Err(format!(
-            "'{}' is not base64-encoded",
-            super::clip(header, 60)
-        ));
+        return Err(format!("'{}' is not base64-encoded", super::clip(header, 60)));
     }
     let engine = base64::engine::GeneralPurpose::new(
         &base64::alphabet::STANDARD,
         base64::engine::GeneralPurposeConfig::new()
             .with_decode_padding_mode(base64::engine::DecodePaddingMode::Indifferent),
     );
-    engine
-        .decode(payload.trim())
-        .map_err(|e| format!("bad base64: {e}"))
+    engine.decode(payload.trim()).map_err(|e| format!("bad base64: {e}"))
 }
 
 fn read_external(path: &Path, i: usize, uri: &str, declared: usize) -> Result<Vec<u8>> {
@@ -247,20 +224,11 @@ fn read_external(path: &Path, i: usize, uri: &str, declared: usize) -> Result<Ve
         ));
     }
     let name = percent_decode(uri).map_err(|()| {
-        Error::input(
-            path,
-            format!("glTF buffer {i} URI '{shown}' is not valid UTF-8 when percent-decoded"),
-        )
+        Error::input(path, format!("glTF buffer {i} URI '{shown}' is not valid UTF-8 when percent-decoded"))
     })?;
     let file = path.parent().unwrap_or(Path::new("")).join(&name);
     let cannot = |e: std::io::Error| {
-        Error::input(
-            path,
-            format!(
-                "glTF external buffer '{shown}' cannot be read: {}",
-                io_message(&e)
-            ),
-        )
+        Error::input(path, format!("glTF external buffer '{shown}' cannot be read: {}", io_message(&e)))
     };
     let f = std::fs::File::open(&file).map_err(cannot)?;
     let have = f.metadata().map_err(cannot)?.len();
@@ -274,9 +242,7 @@ fn read_external(path: &Path, i: usize, uri: &str, declared: usize) -> Result<Ve
         ));
     }
     let mut data = Vec::with_capacity(declared);
-    f.take(declared as u64)
-        .read_to_end(&mut data)
-        .map_err(cannot)?;
+    f.take(declared as u64).read_to_end(&mut data).map_err(cannot)?;
     if data.len() < declared {
         return Err(Error::input(
             path,
@@ -366,9 +332,7 @@ impl Reader<'_, '_> {
         let out = self.read(acc, what, 12, |b| [f(b, 0), f(b, 4), f(b, 8)])?;
         for (i, p) in out.iter().enumerate() {
             if let Some(bad) = super::non_finite([p[0] as f64, p[1] as f64, p[2] as f64]) {
-                return Err(self.err(format!(
-                    "position {i} of {what} has a non-finite coordinate ({bad})"
-                )));
+                return Err(self.err(format!("position {i} of {what} has a non-finite coordinate ({bad})")));
             }
         }
         Ok(out)
@@ -385,9 +349,7 @@ impl Reader<'_, '_> {
         match acc.data_type() {
             DataType::U8 => self.read(acc, what, 1, |b| b[0] as u32),
             DataType::U16 => self.read(acc, what, 2, |b| u16::from_le_bytes([b[0], b[1]]) as u32),
-            DataType::U32 => self.read(acc, what, 4, |b| {
-                u32::from_le_bytes([b[0], b[1], b[2], b[3]])
-            }),
+            DataType::U32 => self.read(acc, what, 4, |b| u32::from_le_bytes([b[0], b[1], b[2], b[3]])),
             t => Err(self.err(format!(
                 "indices accessor of {what} uses component type {} (expected UNSIGNED_BYTE, \
                  UNSIGNED_SHORT or UNSIGNED_INT)",
@@ -483,33 +445,18 @@ impl Reader<'_, '_> {
         if let Some(sparse) = acc.sparse() {
             let n = sparse.count();
             if n > count {
-                return Err(self.err(format!(
-                    "{}: sparse count {n} exceeds the accessor count {count}",
-                    label()
-                )));
+                return Err(
+                    self.err(format!("{}: sparse count {n} exceeds the accessor count {count}", label()))
+                );
             }
             let ind = sparse.indices();
             let isize = ind.index_type().size();
             let ibytes = self.view_bytes(&ind.view())?;
-            self.fits(
-                n,
-                isize,
-                isize,
-                ind.offset(),
-                ibytes.len(),
-                format!("{} sparse indices", label()),
-            )?;
+            self.fits(n, isize, isize, ind.offset(), ibytes.len(), format!("{} sparse indices", label()))?;
             let ibytes = &ibytes[ind.offset().min(ibytes.len())..];
             let vals = sparse.values();
             let vbytes = self.view_bytes(&vals.view())?;
-            self.fits(
-                n,
-                elem,
-                elem,
-                vals.offset(),
-                vbytes.len(),
-                format!("{} sparse values", label()),
-            )?;
+            self.fits(n, elem, elem, vals.offset(), vbytes.len(), format!("{} sparse values", label()))?;
             let vbytes = &vbytes[vals.offset().min(vbytes.len())..];
             for k in 0..n {
                 let b = &ibytes[k * isize..(k + 1) * isize];
@@ -519,10 +466,8 @@ impl Reader<'_, '_> {
                     _ => u32::from_le_bytes([b[0], b[1], b[2], b[3]]) as usize,
                 };
                 let Some(slot) = out.get_mut(idx) else {
-                    return Err(self.err(format!(
-                        "{}: sparse index {idx} is out of range ({count} elements)",
-                        label()
-                    )));
+                    return Err(self
+                        .err(format!("{}: sparse index {idx} is out of range ({count} elements)", label())));
                 };
                 *slot = decode(&vbytes[k * elem..(k + 1) * elem]);
             }
@@ -546,18 +491,9 @@ mod tests {
 
     #[test]
     fn data_uris() {
-        assert_eq!(
-            decode_data_uri("data:application/octet-stream;base64,AAEC").unwrap(),
-            [0, 1, 2]
-        );
-        assert_eq!(
-            decode_data_uri("data:application/gltf-buffer;base64,AAE=").unwrap(),
-            [0, 1]
-        );
-        assert_eq!(
-            decode_data_uri("data:application/gltf-buffer;base64,AAE").unwrap(),
-            [0, 1]
-        );
+        assert_eq!(decode_data_uri("data:application/octet-stream;base64,AAEC").unwrap(), [0, 1, 2]);
+        assert_eq!(decode_data_uri("data:application/gltf-buffer;base64,AAE=").unwrap(), [0, 1]);
+        assert_eq!(decode_data_uri("data:application/gltf-buffer;base64,AAE").unwrap(), [0, 1]);
         assert!(decode_data_uri("data:text/plain,hello").is_err());
         assert!(decode_data_uri("data:;base64,!!!!").is_err());
         assert!(decode_data_uri("data:nocomma").is_err());
@@ -573,18 +509,12 @@ mod tests {
         b.extend_from_slice(&u32::MAX.to_le_bytes());
         b.extend_from_slice(&[0; 20]);
         let e = split_glb(p, &b).unwrap_err().to_string();
-        assert!(
-            e.contains("header declares 4294967295 bytes but the file has 32 bytes"),
-            "{e}"
-        );
+        assert!(e.contains("header declares 4294967295 bytes but the file has 32 bytes"), "{e}");
         b[8..12].copy_from_slice(&32u32.to_le_bytes());
         b[12..16].copy_from_slice(&u32::MAX.to_le_bytes());
         b[16..20].copy_from_slice(b"JSON");
         let e = split_glb(p, &b).unwrap_err().to_string();
-        assert!(
-            e.contains("chunk 0 ('JSON') declares 4294967295 bytes but only 12 remain"),
-            "{e}"
-        );
+        assert!(e.contains("chunk 0 ('JSON') declares 4294967295 bytes but only 12 remain"), "{e}");
         b[12..16].copy_from_slice(&4u32.to_le_bytes());
         b[16..20].copy_from_slice(b"BIN\0");
         let e = split_glb(p, &b).unwrap_err().to_string();

@@ -54,9 +54,7 @@ fn ok(bytes: &[u8]) -> Loaded {
 }
 
 fn err(bytes: &[u8]) -> String {
-    let e = load_bytes(&path(), bytes, Format::Gltf)
-        .unwrap_err()
-        .to_string();
+    let e = load_bytes(&path(), bytes, Format::Gltf).unwrap_err().to_string();
     assert!(e.starts_with("t.gltf: ") && !e.contains('\n'), "{e}");
     e
 }
@@ -89,10 +87,10 @@ fn glb(json: &[u8], bin: Option<&[u8]>) -> Vec<u8> {
 }
 
 fn bounds(l: &Loaded) -> (DVec3, DVec3) {
-    l.mesh.positions.iter().fold(
-        (DVec3::splat(f64::MAX), DVec3::splat(f64::MIN)),
-        |(lo, hi), p| (lo.min(*p), hi.max(*p)),
-    )
+    l.mesh
+        .positions
+        .iter()
+        .fold((DVec3::splat(f64::MAX), DVec3::splat(f64::MIN)), |(lo, hi), p| (lo.min(*p), hi.max(*p)))
 }
 
 #[test]
@@ -120,12 +118,7 @@ fn no_scene_uses_root_nodes_and_glb_works() {
         r#"{{"asset":{{"version":"2.0"}},"buffers":[{{"byteLength":44}}],{TRI_VIEWS},
         "nodes":[{{"mesh":0,"matrix":[1,0,0,0, 0,1,0,0, 0,0,1,0, 0,0,5,1]}},{{"mesh":0,"children":[0]}}]}}"#
     );
-    let l = load_bytes(
-        Path::new("t.glb"),
-        &glb(json.as_bytes(), Some(&tri_bin())),
-        Format::Glb,
-    )
-    .unwrap();
+    let l = load_bytes(Path::new("t.glb"), &glb(json.as_bytes(), Some(&tri_bin())), Format::Glb).unwrap();
     // node 1 is the only root; node 0 is its child
     let names: Vec<_> = l.mesh.objects.iter().map(|o| o.name.as_str()).collect();
     assert_eq!(names, ["node1", "node1/node0"]);
@@ -150,11 +143,7 @@ fn strips_fans_and_skipped_modes() {
     assert_eq!(l.mesh.triangles, [strip, fan].concat());
     assert_eq!(l.mesh.positions.len(), 10);
     assert_eq!(l.warnings.len(), 2, "{:?}", l.warnings);
-    assert!(
-        l.warnings[0].contains("mesh 0 primitive 2: skipped Points"),
-        "{:?}",
-        l.warnings
-    );
+    assert!(l.warnings[0].contains("mesh 0 primitive 2: skipped Points"), "{:?}", l.warnings);
     assert!(l.warnings[1].contains("Lines"), "{:?}", l.warnings);
 }
 
@@ -206,10 +195,7 @@ fn sparse_positions() {
     let mut bad = bin.clone();
     bad[36..38].copy_from_slice(&7u16.to_le_bytes());
     let e = err(&gltf(&bad, body));
-    assert!(
-        e.contains("sparse index 7 is out of range (3 elements)"),
-        "{e}"
-    );
+    assert!(e.contains("sparse index 7 is out of range (3 elements)"), "{e}");
 }
 
 #[test]
@@ -217,102 +203,57 @@ fn non_finite_positions() {
     for (val, word) in [(f32::NAN, "NaN"), (f32::INFINITY, "inf")] {
         let mut bin = tri_bin();
         bin[16..20].copy_from_slice(&val.to_le_bytes()); // vertex 1, y
-        let e = err(&gltf(
-            &bin,
-            &format!("{TRI_VIEWS},\"nodes\":[{{\"mesh\":0}}]"),
-        ));
+        let e = err(&gltf(&bin, &format!("{TRI_VIEWS},\"nodes\":[{{\"mesh\":0}}]")));
         assert!(
-            e.contains(&format!(
-                "position 1 of mesh 0 primitive 0 has a non-finite coordinate ({word})"
-            )),
+            e.contains(&format!("position 1 of mesh 0 primitive 0 has a non-finite coordinate ({word})")),
             "{e}"
         );
     }
     // finite positions overflowing under the node transform (f64: needs a product > 1e308)
     let mut bin = tri_bin();
     bin[12..16].copy_from_slice(&f32::MAX.to_le_bytes());
-    let nodes: Vec<String> = (0..7)
-        .map(|i| format!(r#"{{"children":[{}],"scale":[3e38,1,1]}}"#, i + 1))
-        .collect();
-    let body = format!(
-        r#"{TRI_VIEWS},"nodes":[{},{{"mesh":0,"scale":[3e38,1,1]}}]"#,
-        nodes.join(",")
-    );
+    let nodes: Vec<String> =
+        (0..7).map(|i| format!(r#"{{"children":[{}],"scale":[3e38,1,1]}}"#, i + 1)).collect();
+    let body = format!(r#"{TRI_VIEWS},"nodes":[{},{{"mesh":0,"scale":[3e38,1,1]}}]"#, nodes.join(","));
     let e = err(&gltf(&bin, &body));
-    assert!(
-        e.contains("position 1 of mesh 0 is not finite (inf) after the transform of node 7"),
-        "{e}"
-    );
+    assert!(e.contains("position 1 of mesh 0 is not finite (inf) after the transform of node 7"), "{e}");
     // a world matrix overflowing
-    let nodes: Vec<String> = (0..10)
-        .map(|i| format!(r#"{{"children":[{}],"scale":[3e38,3e38,3e38]}}"#, i + 1))
-        .collect();
+    let nodes: Vec<String> =
+        (0..10).map(|i| format!(r#"{{"children":[{}],"scale":[3e38,3e38,3e38]}}"#, i + 1)).collect();
     let body = format!(r#"{TRI_VIEWS},"nodes":[{},{{"mesh":0}}]"#, nodes.join(","));
     let e = err(&gltf(&tri_bin(), &body));
-    assert!(
-        e.contains("glTF node 8: world transform is not finite"),
-        "{e}"
-    );
+    assert!(e.contains("glTF node 8: world transform is not finite"), "{e}");
 }
 
 #[test]
 fn index_out_of_range() {
     let mut bin = tri_bin();
     bin[40..42].copy_from_slice(&907u16.to_le_bytes());
-    let e = err(&gltf(
-        &bin,
-        &format!("{TRI_VIEWS},\"nodes\":[{{\"mesh\":0}}]"),
-    ));
-    assert!(
-        e.contains("mesh 0 primitive 0: index 2 refers to vertex 907 but there are 3 vertices"),
-        "{e}"
-    );
+    let e = err(&gltf(&bin, &format!("{TRI_VIEWS},\"nodes\":[{{\"mesh\":0}}]")));
+    assert!(e.contains("mesh 0 primitive 0: index 2 refers to vertex 907 but there are 3 vertices"), "{e}");
 }
 
 #[test]
 fn ranges_checked() {
     // accessor reads past its bufferView
     let body = TRI_VIEWS.replace(r#""count":3,"type":"VEC3""#, r#""count":4,"type":"VEC3""#);
-    let e = err(&gltf(
-        &tri_bin(),
-        &format!("{body},\"nodes\":[{{\"mesh\":0}}]"),
-    ));
-    assert!(
-        e.contains("accessor 0 of mesh 0 primitive 0: 4 elements of 12 bytes"),
-        "{e}"
-    );
+    let e = err(&gltf(&tri_bin(), &format!("{body},\"nodes\":[{{\"mesh\":0}}]")));
+    assert!(e.contains("accessor 0 of mesh 0 primitive 0: 4 elements of 12 bytes"), "{e}");
     // bufferView past its buffer
-    let body = TRI_VIEWS.replace(
-        r#""byteOffset":36,"byteLength":6"#,
-        r#""byteOffset":40,"byteLength":6"#,
-    );
-    let e = err(&gltf(
-        &tri_bin(),
-        &format!("{body},\"nodes\":[{{\"mesh\":0}}]"),
-    ));
-    assert!(
-        e.contains("bufferView 1 (offset 40, length 6) does not fit in buffer 0 (44 bytes)"),
-        "{e}"
-    );
+    let body = TRI_VIEWS.replace(r#""byteOffset":36,"byteLength":6"#, r#""byteOffset":40,"byteLength":6"#);
+    let e = err(&gltf(&tri_bin(), &format!("{body},\"nodes\":[{{\"mesh\":0}}]")));
+    assert!(e.contains("bufferView 1 (offset 40, length 6) does not fit in buffer 0 (44 bytes)"), "{e}");
     // buffer shorter than its byteLength
     let doc = String::from_utf8(tri_doc(r#""nodes":[{"mesh":0}]"#)).unwrap();
-    let e = err(doc
-        .replace("\"byteLength\":44", "\"byteLength\":4000000000")
-        .as_bytes());
-    assert!(
-        e.contains("glTF buffer 0 declares 4000000000 bytes but its data URI has 44 bytes"),
-        "{e}"
-    );
+    let e = err(doc.replace("\"byteLength\":44", "\"byteLength\":4000000000").as_bytes());
+    assert!(e.contains("glTF buffer 0 declares 4000000000 bytes but its data URI has 44 bytes"), "{e}");
     // huge count without a bufferView (sparse, so the zero base is implied)
     let body = r#""bufferViews":[{"buffer":0,"byteLength":36},{"buffer":0,"byteOffset":36,"byteLength":6}],
       "accessors":[{"componentType":5126,"count":4000000000,"type":"VEC3","min":[0,0,0],"max":[0,0,0],
         "sparse":{"count":1,"indices":{"bufferView":1,"componentType":5123},"values":{"bufferView":0}}}],
       "meshes":[{"primitives":[{"attributes":{"POSITION":0}}]}],"nodes":[{"mesh":0}]"#;
     let e = err(&gltf(&tri_bin(), body));
-    assert!(
-        e.contains("declares 4000000000 elements without a bufferView"),
-        "{e}"
-    );
+    assert!(e.contains("declares 4000000000 elements without a bufferView"), "{e}");
 }
 
 #[test]
@@ -330,25 +271,14 @@ fn glb_hostile_sizes() {
     let mut bytes = glb(json.as_bytes(), Some(&tri_bin()));
     bytes[8..12].copy_from_slice(&u32::MAX.to_le_bytes());
     let e = load_bytes(p, &bytes, Format::Glb).unwrap_err().to_string();
-    assert!(
-        e.contains("truncated GLB: header declares 4294967295 bytes"),
-        "{e}"
-    );
+    assert!(e.contains("truncated GLB: header declares 4294967295 bytes"), "{e}");
     let mut bytes = glb(json.as_bytes(), Some(&tri_bin()));
     let bin_len_at = 20 + json.len().div_ceil(4) * 4;
     bytes[bin_len_at..bin_len_at + 4].copy_from_slice(&u32::MAX.to_le_bytes());
     let e = load_bytes(p, &bytes, Format::Glb).unwrap_err().to_string();
-    assert!(
-        e.contains("chunk 1 ('BIN') declares 4294967295 bytes"),
-        "{e}"
-    );
-    let e = load_bytes(p, &glb(json.as_bytes(), None), Format::Glb)
-        .unwrap_err()
-        .to_string();
-    assert!(
-        e.contains("buffer 0 refers to the GLB binary chunk but there is none"),
-        "{e}"
-    );
+    assert!(e.contains("chunk 1 ('BIN') declares 4294967295 bytes"), "{e}");
+    let e = load_bytes(p, &glb(json.as_bytes(), None), Format::Glb).unwrap_err().to_string();
+    assert!(e.contains("buffer 0 refers to the GLB binary chunk but there is none"), "{e}");
 }
 
 #[test]
@@ -368,80 +298,64 @@ fn external_buffers() {
     assert_eq!(l.mesh.triangles.len(), 1);
     std::fs::write(&f, doc("foo.bin")).unwrap();
     let e = load_path(&f).unwrap_err().to_string();
-    assert!(
-        e.contains("glTF external buffer 'foo.bin' cannot be read: No such file or directory"),
-        "{e}"
-    );
+    assert!(e.contains("glTF external buffer 'foo.bin' cannot be read: No such file or directory"), "{e}");
     assert!(e.starts_with(&f.display().to_string()), "{e}");
     std::fs::write(dir.path().join("short.bin"), [0u8; 10]).unwrap();
     std::fs::write(&f, doc("short.bin")).unwrap();
     let e = load_path(&f).unwrap_err().to_string();
-    assert!(
-        e.contains("'short.bin' has 10 bytes but buffer 0 declares 44"),
-        "{e}"
-    );
+    assert!(e.contains("'short.bin' has 10 bytes but buffer 0 declares 44"), "{e}");
     std::fs::write(&f, doc("https://example.com/x.bin")).unwrap();
     let e = load_path(&f).unwrap_err().to_string();
-    assert!(
-        e.contains("is not supported (only data: URIs and relative file paths)"),
-        "{e}"
-    );
+    assert!(e.contains("is not supported (only data: URIs and relative file paths)"), "{e}");
 }
 
 #[test]
 fn node_graph_errors() {
-    let e = err(&tri_doc(
-        r#""nodes":[{"mesh":0,"children":[1]},{"children":[0]}],"scenes":[{"nodes":[0]}]"#,
-    ));
+    let e = err(&tri_doc(r#""nodes":[{"mesh":0,"children":[1]},{"children":[0]}],"scenes":[{"nodes":[0]}]"#));
     assert!(e.contains("glTF node graph has a cycle at node 0"), "{e}");
     let e = err(&tri_doc(r#""nodes":[{"mesh":0,"children":[0]}]"#));
     assert!(e.contains("glTF node graph has a cycle at node 0"), "{e}");
-    let e = err(&tri_doc(
-        r#""nodes":[{"children":[2]},{"children":[2]},{"mesh":0}]"#,
-    ));
-    assert!(
-        e.contains("glTF node 2 has two parents (nodes 0 and 1)"),
-        "{e}"
-    );
-    let e = err(&tri_doc(
-        r#""nodes":[{"children":[1]},{"mesh":0}],"scenes":[{"nodes":[0,1]}]"#,
-    ));
-    assert!(
-        e.contains("glTF node 1 is a scene root but also a child of node 0"),
-        "{e}"
-    );
+    let e = err(&tri_doc(r#""nodes":[{"children":[2]},{"children":[2]},{"mesh":0}]"#));
+    assert!(e.contains("glTF node 2 has two parents (nodes 0 and 1)"), "{e}");
+    let e = err(&tri_doc(r#""nodes":[{"children":[1]},{"mesh":0}],"scenes":[{"nodes":[0,1]}]"#));
+    assert!(e.contains("glTF node 1 is a scene root but also a child of node 0"), "{e}");
     let e = err(&tri_doc(r#""nodes":[{"mesh":0,"rotation":[0,0,0,0]}]"#));
-    assert!(
-        e.contains("glTF node 0 has a zero rotation quaternion"),
-        "{e}"
-    );
+    assert!(e.contains("glTF node 0 has a zero rotation quaternion"), "{e}");
     let e = err(&tri_doc(r#""nodes":[{"mesh":0,"translation":[1e39,0,0]}]"#));
-    assert!(
-        e.contains("glTF node 0 has a non-finite translation"),
-        "{e}"
-    );
+    assert!(e.contains("glTF node 0 has a non-finite translation"), "{e}");
     let e = err(&tri_doc(r#""nodes":[{"mesh":0,"children":[5]}]"#));
     assert!(e.contains("invalid glTF: nodes[0].children[0]"), "{e}");
 }
 
 fn chain(depth: usize) -> Vec<u8> {
-    let mut nodes: Vec<String> = (0..depth - 1)
-        .map(|i| format!(r#"{{"children":[{}]}}"#, i + 1))
-        .collect();
+    let mut nodes: Vec<String> = (0..depth - 1).map(|i| format!(r#"{{"children":[{}]}}"#, i + 1)).collect();
     nodes.push(r#"{"mesh":0}"#.into());
-    tri_doc(&format!(
-        r#""nodes":[{}],"scenes":[{{"nodes":[0]}}]"#,
-        nodes.join(",")
-    ))
+    tri_doc(&format!(r#""nodes":[{}],"scenes":[{{"nodes":[0]}}]"#, nodes.join(",")))
+}
+
+#[test]
+fn instancing_bomb_refused() {
+    // 70 000 vertices (a strip) instanced by 4000 nodes: 2.8e8 vertices > 2^28
+    let n = 70_000;
+    let bin = vec![0u8; 12 * n];
+    let nodes = vec![r#"{"mesh":0}"#; 4000].join(",");
+    let body = format!(
+        r#""bufferViews":[{{"buffer":0,"byteLength":{}}}],
+        "accessors":[{{"bufferView":0,"componentType":5126,"count":{n},"type":"VEC3","min":[0,0,0],"max":[0,0,0]}}],
+        "meshes":[{{"primitives":[{{"attributes":{{"POSITION":0}},"mode":5}}]}}],"nodes":[{nodes}]"#,
+        12 * n
+    );
+    let e = err(&gltf(&bin, &body));
+    assert!(
+        e.contains("glTF scene has 280000000 vertices after instancing, more than the 268435456 supported"),
+        "{e}"
+    );
 }
 
 #[test]
 fn deep_hierarchies() {
     let e = err(&chain(5000));
-    assert!(
-        e.contains("glTF node hierarchy deeper than 1024 levels (at node 1024)"),
-        "{e}"
-    );
+    assert!(e.contains("glTF node hierarchy deeper than 1024 levels (at node 1024)"), "{e}");
     let l = ok(&chain(MAX_DEPTH));
     assert_eq!(l.mesh.triangles.len(), 1);
     assert!(l.mesh.objects[0].name.ends_with("/node1022/node1023"));
@@ -459,24 +373,16 @@ fn extensions() {
     let e = err(with(r#""extensionsRequired":["EXT_meshopt_compression"]"#).as_bytes());
     assert!(e.contains("'EXT_meshopt_compression'"), "{e}");
     let l = ok(with(r#""extensionsUsed":["EXT_mesh_gpu_instancing"]"#).as_bytes());
-    assert!(
-        l.warnings[0].contains("EXT_mesh_gpu_instancing is not supported"),
-        "{:?}",
-        l.warnings
-    );
-    let l = ok(with(
-        r#""extensionsUsed":["KHR_materials_unlit"],"extensionsRequired":["KHR_materials_unlit"]"#,
-    )
-    .as_bytes());
+    assert!(l.warnings[0].contains("EXT_mesh_gpu_instancing is not supported"), "{:?}", l.warnings);
+    let l =
+        ok(with(r#""extensionsUsed":["KHR_materials_unlit"],"extensionsRequired":["KHR_materials_unlit"]"#)
+            .as_bytes());
     assert_eq!(l.mesh.triangles.len(), 1);
 }
 
 #[test]
 fn quantized_positions_rejected() {
-    let bin: Vec<u8> = [0u16, 0, 0, 1, 0, 0, 0, 1, 0, 0, 1, 2]
-        .iter()
-        .flat_map(|i| i.to_le_bytes())
-        .collect();
+    let bin: Vec<u8> = [0u16, 0, 0, 1, 0, 0, 0, 1, 0, 0, 1, 2].iter().flat_map(|i| i.to_le_bytes()).collect();
     let body = r#""bufferViews":[{"buffer":0,"byteLength":18},{"buffer":0,"byteOffset":18,"byteLength":6}],
       "accessors":[{"bufferView":0,"componentType":5123,"count":3,"type":"VEC3","min":[0,0,0],"max":[1,1,0]},
         {"bufferView":1,"componentType":5123,"count":3,"type":"SCALAR"}],
@@ -496,9 +402,7 @@ fn garbage_documents() {
     assert!(e.contains("no triangles"), "{e}");
     let e = err(&tri_doc(r#""nodes":[{"mesh":0}],"scenes":[{"nodes":[]}]"#));
     assert!(e.contains("no triangles"), "{e}");
-    let e = load_bytes(Path::new("t.glb"), b"glTF\x02\0\0\0\x0c\0\0\0", Format::Glb)
-        .unwrap_err()
-        .to_string();
+    let e = load_bytes(Path::new("t.glb"), b"glTF\x02\0\0\0\x0c\0\0\0", Format::Glb).unwrap_err().to_string();
     assert!(e.contains("GLB has no JSON chunk"), "{e}");
 }
 
@@ -539,11 +443,9 @@ fn shared_simple_meshes() {
 
 #[test]
 fn shared_assemblies() {
-    for (name, tris, objects) in [
-        ("2CylinderEngine.glb", 121496, 67),
-        ("pins.glb", 3408, 7),
-        ("simple_pole.glb", 580, 11),
-    ] {
+    for (name, tris, objects) in
+        [("2CylinderEngine.glb", 121496, 67), ("pins.glb", 3408, 7), ("simple_pole.glb", 580, 11)]
+    {
         let Some(p) = shared(name) else { return };
         let (l, _) = load_path(&p).unwrap();
         assert_eq!(l.mesh.triangles.len(), tris, "{name}");
@@ -552,10 +454,7 @@ fn shared_assemblies() {
         if name == "pins.glb" {
             let (lo, hi) = bounds(&l);
             let ext = hi - lo;
-            assert!(
-                (ext.x - 254.0).abs() < 0.5 && (ext.y - 254.0).abs() < 0.5,
-                "{ext}"
-            );
+            assert!((ext.x - 254.0).abs() < 0.5 && (ext.y - 254.0).abs() < 0.5, "{ext}");
             assert!(l.mesh.objects[0].name.starts_with("world/sides"));
         }
     }

@@ -88,12 +88,7 @@ pub fn load_bytes(path: &Path, bytes: &[u8], format: Format) -> Result<Loaded> {
 pub fn detect_format(path: &Path, bytes: &[u8]) -> Result<Format> {
     let ext = match path.extension() {
         Some(e) => e.to_string_lossy().to_ascii_lowercase(),
-        None => {
-            return Err(Error::input(
-                path,
-                "no file extension (expected .obj, .stl, .gltf or .glb)",
-            ))
-        }
+        None => return Err(Error::input(path, "no file extension (expected .obj, .stl, .gltf or .glb)")),
     };
     let format = match ext.as_str() {
         "obj" => Format::Obj,
@@ -175,10 +170,7 @@ fn validate(path: &Path, loaded: &Loaded) -> Result<()> {
     }
     for (i, p) in mesh.positions.iter().enumerate() {
         if let Some(bad) = non_finite([p.x, p.y, p.z]) {
-            return Err(Error::input(
-                path,
-                format!("vertex {i} has a non-finite coordinate ({bad})"),
-            ));
+            return Err(Error::input(path, format!("vertex {i} has a non-finite coordinate ({bad})")));
         }
     }
     for (t, &o) in mesh.tri_object.iter().enumerate() {
@@ -194,10 +186,7 @@ fn validate(path: &Path, loaded: &Loaded) -> Result<()> {
         }
     }
     if let Some(i) = mesh.objects.iter().position(|o| o.name.is_empty()) {
-        return Err(Error::input(
-            path,
-            format!("internal loader error: object {i} has no name"),
-        ));
+        return Err(Error::input(path, format!("internal loader error: object {i} has no name")));
     }
     Ok(())
 }
@@ -235,15 +224,14 @@ fn describe_start(bytes: &[u8]) -> String {
     }
 }
 
-/// Shortens `s` to at most `max` characters for a message, adding `…` when cut.
+/// Shortens `s` to at most `max` characters for a message, adding `…` when cut; control
+/// characters (NUL, tabs, …) are shown as `?` so the message stays one printable line.
 pub(crate) fn clip(s: &str, max: usize) -> String {
-    if s.chars().count() <= max {
-        s.to_string()
-    } else {
-        let mut out: String = s.chars().take(max).collect();
+    let mut out: String = s.chars().take(max).map(|c| if c.is_control() { '?' } else { c }).collect();
+    if s.chars().nth(max).is_some() {
         out.push('…');
-        out
     }
+    out
 }
 
 /// Drops objects without triangles and renumbers `tri_object`, keeping first-appearance order.
@@ -310,63 +298,40 @@ mod tests {
 
     #[test]
     fn detect_by_extension_case_insensitive() {
-        assert_eq!(
-            detect_format(&p("a.OBJ"), b"v 0 0 0\n").unwrap(),
-            Format::Obj
-        );
+        assert_eq!(detect_format(&p("a.OBJ"), b"v 0 0 0\n").unwrap(), Format::Obj);
         assert_eq!(detect_format(&p("a.Gltf"), b" {}").unwrap(), Format::Gltf);
-        assert_eq!(
-            detect_format(&p("a.GLB"), b"glTF....").unwrap(),
-            Format::Glb
-        );
+        assert_eq!(detect_format(&p("a.GLB"), b"glTF....").unwrap(), Format::Glb);
         let stl = b"solid x\nfacet normal 0 0 1\nendfacet\nendsolid x\n";
         assert_eq!(detect_format(&p("a.StL"), stl).unwrap(), Format::Stl);
     }
 
     #[test]
     fn detect_errors() {
-        let e = detect_format(&p("mesh.ply"), b"ply")
-            .unwrap_err()
-            .to_string();
-        assert!(
-            e.contains("unknown extension '.ply' (expected .obj, .stl, .gltf or .glb)"),
-            "{e}"
-        );
+        let e = detect_format(&p("mesh.ply"), b"ply").unwrap_err().to_string();
+        assert!(e.contains("unknown extension '.ply' (expected .obj, .stl, .gltf or .glb)"), "{e}");
         assert!(e.starts_with("mesh.ply: "), "{e}");
         let e = detect_format(&p("mesh"), b"x").unwrap_err().to_string();
         assert!(e.contains("no file extension"), "{e}");
         let e = detect_format(&p("a.obj"), b"").unwrap_err().to_string();
         assert!(e.contains("file is empty"), "{e}");
-        let e = detect_format(&p("a.glb"), b"PK\x03\x04zip")
-            .unwrap_err()
-            .to_string();
+        let e = detect_format(&p("a.glb"), b"PK\x03\x04zip").unwrap_err().to_string();
         assert!(e.contains("not a glTF file"), "{e}");
-        let e = detect_format(&p("a.obj"), b"v 1 2\0 3")
-            .unwrap_err()
-            .to_string();
+        let e = detect_format(&p("a.obj"), b"v 1 2\0 3").unwrap_err().to_string();
         assert!(e.contains("NUL byte at byte 5"), "{e}");
     }
 
     #[test]
     fn load_path_missing_file_names_path() {
-        let e = load_path(Path::new("/nonexistent/dir/x.stl"))
-            .unwrap_err()
-            .to_string();
-        assert!(
-            e.starts_with("/nonexistent/dir/x.stl: cannot read file:"),
-            "{e}"
-        );
+        let e = load_path(Path::new("/nonexistent/dir/x.stl")).unwrap_err().to_string();
+        assert!(e.starts_with("/nonexistent/dir/x.stl: cannot read file:"), "{e}");
         assert!(e.contains("No such file"), "{e}");
     }
 
     #[test]
     fn empty_file_for_every_format() {
-        for (name, f) in [
-            ("e.obj", Format::Obj),
-            ("e.stl", Format::Stl),
-            ("e.gltf", Format::Gltf),
-            ("e.glb", Format::Glb),
-        ] {
+        for (name, f) in
+            [("e.obj", Format::Obj), ("e.stl", Format::Stl), ("e.gltf", Format::Gltf), ("e.glb", Format::Glb)]
+        {
             let e = load_bytes(&p(name), b"", f).unwrap_err().to_string();
             assert!(e.contains("file is empty"), "{e}");
         }
@@ -396,10 +361,7 @@ mod tests {
     fn validate_catches_bad_meshes() {
         use crate::mesh::{Mesh, Object};
         use glam::DVec3;
-        let obj = || Object {
-            name: "a".into(),
-            ..Default::default()
-        };
+        let obj = || Object { name: "a".into(), ..Default::default() };
         let mut m = Loaded {
             mesh: Mesh {
                 positions: vec![DVec3::ZERO; 3],
@@ -410,17 +372,11 @@ mod tests {
             warnings: vec![],
         };
         let e = validate(&p("x"), &m).unwrap_err().to_string();
-        assert!(
-            e.contains("triangle 0 refers to vertex 5 but there are 3 vertices"),
-            "{e}"
-        );
+        assert!(e.contains("triangle 0 refers to vertex 5 but there are 3 vertices"), "{e}");
         m.mesh.triangles[0] = [0, 1, 2];
         m.mesh.positions[1].y = f64::NEG_INFINITY;
         let e = validate(&p("x"), &m).unwrap_err().to_string();
-        assert!(
-            e.contains("vertex 1 has a non-finite coordinate (-inf)"),
-            "{e}"
-        );
+        assert!(e.contains("vertex 1 has a non-finite coordinate (-inf)"), "{e}");
         m.mesh.positions[1].y = 0.0;
         assert!(validate(&p("x"), &m).is_ok());
         m.mesh.tri_object[0] = 1;
@@ -488,10 +444,7 @@ mod tests {
     #[test]
     fn drop_empty_objects_renumbers() {
         use crate::mesh::{Mesh, Object};
-        let o = |n: &str| Object {
-            name: n.into(),
-            ..Default::default()
-        };
+        let o = |n: &str| Object { name: n.into(), ..Default::default() };
         let mut m = Mesh {
             positions: vec![],
             triangles: vec![[0, 0, 0]; 3],

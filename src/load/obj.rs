@@ -91,10 +91,7 @@ impl<'p> Parser<'p> {
     fn new(path: &'p Path) -> Self {
         Parser {
             path,
-            mesh: Mesh {
-                objects: vec![Object::default()],
-                ..Default::default()
-            },
+            mesh: Mesh { objects: vec![Object::default()], ..Default::default() },
             current: 0,
             warnings: Vec::new(),
             unrecognised: 0,
@@ -109,32 +106,21 @@ impl<'p> Parser<'p> {
     }
 
     fn run(mut self, bytes: &[u8]) -> Result<Loaded> {
-        let mut lines = Lines {
-            bytes,
-            pos: 0,
-            line: 0,
-        };
+        let mut lines = Lines { bytes, pos: 0, line: 0 };
         while let Some((line_no, start, text)) = lines.next_logical() {
             self.statement(line_no, start, &text)?;
         }
         let n = self.mesh.positions.len() as i64;
         if let Some(&(line, idx)) = self.forward_refs.iter().find(|(_, i)| *i > n) {
-            return Err(self.err(
-                line,
-                format!("face refers to vertex {idx} but there are {n} vertices"),
-            ));
+            return Err(self.err(line, format!("face refers to vertex {idx} but there are {n} vertices")));
         }
         if self.unrecognised > MAX_LINE_WARNINGS {
-            self.warnings.push(format!(
-                "{} more unrecognised lines skipped",
-                self.unrecognised - MAX_LINE_WARNINGS
-            ));
+            self.warnings
+                .push(format!("{} more unrecognised lines skipped", self.unrecognised - MAX_LINE_WARNINGS));
         }
         if self.skipped_elements > 0 {
-            self.warnings.push(format!(
-                "skipped {} point/line elements ('p'/'l' statements)",
-                self.skipped_elements
-            ));
+            self.warnings
+                .push(format!("skipped {} point/line elements ('p'/'l' statements)", self.skipped_elements));
         }
         drop_empty_objects(&mut self.mesh);
         for (i, o) in self.mesh.objects.iter_mut().enumerate() {
@@ -142,10 +128,7 @@ impl<'p> Parser<'p> {
                 o.name = format!("object{i}");
             }
         }
-        Ok(Loaded {
-            mesh: self.mesh,
-            warnings: self.warnings,
-        })
+        Ok(Loaded { mesh: self.mesh, warnings: self.warnings })
     }
 
     /// Handles one logical line; `start` is its byte offset in the file.
@@ -159,10 +142,7 @@ impl<'p> Parser<'p> {
             b"f" | b"fo" => self.face(line, start, &mut tokens),
             b"o" | b"g" => {
                 let name = String::from_utf8_lossy(tokens.rest()).trim().to_string();
-                self.mesh.objects.push(Object {
-                    name,
-                    ..Default::default()
-                });
+                self.mesh.objects.push(Object { name, ..Default::default() });
                 self.current = (self.mesh.objects.len() - 1) as u32;
                 Ok(())
             }
@@ -175,10 +155,8 @@ impl<'p> Parser<'p> {
                 self.unrecognised += 1;
                 if self.unrecognised <= MAX_LINE_WARNINGS {
                     let shown = String::from_utf8_lossy(trim(text));
-                    self.warnings.push(format!(
-                        "line {line}: skipped unrecognised line '{}'",
-                        clip(&shown, 60)
-                    ));
+                    self.warnings
+                        .push(format!("line {line}: skipped unrecognised line '{}'", clip(&shown, 60)));
                 }
                 Ok(())
             }
@@ -193,18 +171,12 @@ impl<'p> Parser<'p> {
             };
             let s = self.utf8(line, start + off, tok)?;
             *slot = s.parse::<f64>().map_err(|_| {
-                self.err(
-                    line,
-                    format!("cannot parse '{}' as a vertex coordinate", clip(s, 40)),
-                )
+                self.err(line, format!("cannot parse '{}' as a vertex coordinate", clip(s, 40)))
             })?;
         }
         let index = self.mesh.positions.len();
         if let Some(bad) = non_finite(c) {
-            return Err(self.err(
-                line,
-                format!("vertex {} has a non-finite coordinate ({bad})", index + 1),
-            ));
+            return Err(self.err(line, format!("vertex {} has a non-finite coordinate ({bad})", index + 1)));
         }
         if index > u32::MAX as usize {
             return Err(self.err(line, "more than 4294967296 vertices"));
@@ -221,10 +193,7 @@ impl<'p> Parser<'p> {
             let v = tok.split(|&b| b == b'/').next().unwrap_or(tok);
             let s = self.utf8(line, start + off, v)?;
             let idx: i64 = s.parse().map_err(|_| {
-                self.err(
-                    line,
-                    format!("cannot parse '{}' as a face vertex index", clip(s, 40)),
-                )
+                self.err(line, format!("cannot parse '{}' as a face vertex index", clip(s, 40)))
             })?;
             let zero_based = match idx {
                 0 => return Err(self.err(line, "face refers to vertex 0 (OBJ indices start at 1)")),
@@ -249,18 +218,12 @@ impl<'p> Parser<'p> {
                 }
             };
             let Ok(z) = u32::try_from(zero_based) else {
-                return Err(self.err(
-                    line,
-                    format!("face refers to vertex {idx}, beyond any file"),
-                ));
+                return Err(self.err(line, format!("face refers to vertex {idx}, beyond any file")));
             };
             face.push(z);
         }
         if face.len() < 3 {
-            return Err(self.err(
-                line,
-                format!("face has {} vertices (needs at least 3)", face.len()),
-            ));
+            return Err(self.err(line, format!("face has {} vertices (needs at least 3)", face.len())));
         }
         for i in 1..face.len() - 1 {
             self.mesh.triangles.push([face[0], face[i], face[i + 1]]);
@@ -271,12 +234,8 @@ impl<'p> Parser<'p> {
     }
 
     fn utf8<'a>(&self, line: usize, offset: usize, tok: &'a [u8]) -> Result<&'a str> {
-        std::str::from_utf8(tok).map_err(|e| {
-            self.err(
-                line,
-                format!("not UTF-8 at byte {}", offset + e.valid_up_to()),
-            )
-        })
+        std::str::from_utf8(tok)
+            .map_err(|e| self.err(line, format!("not UTF-8 at byte {}", offset + e.valid_up_to())))
     }
 }
 
@@ -331,19 +290,13 @@ fn continues(text: &[u8]) -> bool {
 }
 
 fn trim_end(t: &[u8]) -> &[u8] {
-    let end = t
-        .iter()
-        .rposition(|b| !b.is_ascii_whitespace())
-        .map_or(0, |i| i + 1);
+    let end = t.iter().rposition(|b| !b.is_ascii_whitespace()).map_or(0, |i| i + 1);
     &t[..end]
 }
 
 fn trim(t: &[u8]) -> &[u8] {
     let t = trim_end(t);
-    let start = t
-        .iter()
-        .position(|b| !b.is_ascii_whitespace())
-        .unwrap_or(t.len());
+    let start = t.iter().position(|b| !b.is_ascii_whitespace()).unwrap_or(t.len());
     &t[start..]
 }
 
@@ -401,9 +354,7 @@ mod tests {
     }
 
     fn err(src: &[u8]) -> String {
-        let e = load_bytes(&path(), src, Format::Obj)
-            .unwrap_err()
-            .to_string();
+        let e = load_bytes(&path(), src, Format::Obj).unwrap_err().to_string();
         assert!(e.starts_with("test.obj: "), "{e}");
         assert!(!e.contains('\n'), "{e}");
         e
@@ -456,9 +407,7 @@ mod tests {
         many.extend_from_slice(b"v 0 0 0\nf 1 1 1\nl 1 1\n");
         let l = ok(&many);
         assert_eq!(l.warnings.len(), MAX_LINE_WARNINGS + 2, "{:?}", l.warnings);
-        assert!(l
-            .warnings
-            .contains(&"15 more unrecognised lines skipped".to_string()));
+        assert!(l.warnings.contains(&"15 more unrecognised lines skipped".to_string()));
         assert!(l.warnings.last().unwrap().contains("1 point/line"));
         // a degenerate (repeated index) triangle is kept
         assert_eq!(l.mesh.triangles, vec![[0, 0, 0]]);
@@ -467,34 +416,19 @@ mod tests {
     #[test]
     fn index_errors() {
         let e = err(b"v 0 0 0\nv 1 0 0\nv 0 1 0\nf 0 1 2\n");
-        assert!(
-            e.contains("line 4: face refers to vertex 0 (OBJ indices start at 1)"),
-            "{e}"
-        );
+        assert!(e.contains("line 4: face refers to vertex 0 (OBJ indices start at 1)"), "{e}");
         let e = err(b"v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 4\n");
-        assert!(
-            e.contains("line 4: face refers to vertex 4 but there are 3 vertices"),
-            "{e}"
-        );
+        assert!(e.contains("line 4: face refers to vertex 4 but there are 3 vertices"), "{e}");
         let e = err(b"v 0 0 0\nv 1 0 0\nf 1 2 -3\nv 0 1 0\n");
-        assert!(
-            e.contains("line 3: face refers to vertex -3 but only 2 vertices"),
-            "{e}"
-        );
+        assert!(e.contains("line 3: face refers to vertex -3 but only 2 vertices"), "{e}");
         let e = err(b"v 0 0 0\nv 1 0 0\nf 1 2\n");
         assert!(e.contains("line 3: face has 2 vertices"), "{e}");
         let e = err(b"v 0 0 0\nf 1 x 1\n");
-        assert!(
-            e.contains("line 2: cannot parse 'x' as a face vertex index"),
-            "{e}"
-        );
+        assert!(e.contains("line 2: cannot parse 'x' as a face vertex index"), "{e}");
         let e = err(b"v 0 0 0\nf 1 1 99999999999999999999\n");
         assert!(e.contains("line 2: cannot parse"), "{e}");
         let e = err(b"v 0 0 0\nf 1 1 9999999999999\n");
-        assert!(
-            e.contains("line 2: face refers to vertex 9999999999999"),
-            "{e}"
-        );
+        assert!(e.contains("line 2: face refers to vertex 9999999999999"), "{e}");
     }
 
     #[test]
@@ -506,27 +440,15 @@ mod tests {
     #[test]
     fn vertex_errors() {
         let e = err(b"v 0 0 0\nv 1 nan 0\nv 0 1 0\nf 1 2 3\n");
-        assert!(
-            e.contains("line 2: vertex 2 has a non-finite coordinate (NaN)"),
-            "{e}"
-        );
+        assert!(e.contains("line 2: vertex 2 has a non-finite coordinate (NaN)"), "{e}");
         let e = err(b"v 0 0 -inf\n");
-        assert!(
-            e.contains("line 1: vertex 1 has a non-finite coordinate (-inf)"),
-            "{e}"
-        );
+        assert!(e.contains("line 1: vertex 1 has a non-finite coordinate (-inf)"), "{e}");
         let e = err(b"v 0 0 1e999\n");
         assert!(e.contains("non-finite coordinate (inf)"), "{e}");
         let e = err(b"v 0 0\n");
-        assert!(
-            e.contains("line 1: vertex has 2 coordinates (needs 3)"),
-            "{e}"
-        );
+        assert!(e.contains("line 1: vertex has 2 coordinates (needs 3)"), "{e}");
         let e = err(b"v 0 0 1,5\n");
-        assert!(
-            e.contains("line 1: cannot parse '1,5' as a vertex coordinate"),
-            "{e}"
-        );
+        assert!(e.contains("line 1: cannot parse '1,5' as a vertex coordinate"), "{e}");
     }
 
     #[test]
@@ -559,25 +481,23 @@ mod tests {
         assert_eq!(f, Format::Obj);
         assert_eq!(l.mesh.triangles.len(), 8);
         assert_eq!(l.mesh.tri_object.len(), 8);
-        assert!(l.mesh.objects.len() >= 2, "{:?}", l.mesh.objects);
-        assert!(l.mesh.objects.iter().all(|o| !o.name.is_empty()));
+        assert_eq!(l.mesh.positions.len(), 5);
+        let names: Vec<_> = l.mesh.objects.iter().map(|o| o.name.as_str()).collect();
+        assert_eq!(names, ["object0", "bottom"]);
+        assert_eq!(l.mesh.tri_object, [0, 0, 0, 0, 1, 1, 1, 1]);
+        // `f 5//2 2//2 1//2` (the first face after `o bottom`), 0-based
+        assert_eq!(l.mesh.triangles[4], [4, 1, 0]);
         assert!(l.warnings.is_empty(), "{:?}", l.warnings);
     }
 
     #[test]
     fn shared_fcl() {
-        for (name, tris, header) in [
-            ("fcl_env.obj", 2180, "6540 2180"),
-            ("fcl_rob.obj", 216, "648 216"),
-        ] {
+        for (name, tris, header) in [("fcl_env.obj", 2180, "6540 2180"), ("fcl_rob.obj", 216, "648 216")] {
             let Some(p) = shared(name) else { return };
             let (l, _) = load_path(&p).unwrap();
             assert_eq!(l.mesh.triangles.len(), tris);
             assert_eq!(l.mesh.positions.len(), 3 * tris);
-            assert_eq!(
-                l.warnings,
-                vec![format!("line 1: skipped unrecognised line '{header}'")]
-            );
+            assert_eq!(l.warnings, vec![format!("line 1: skipped unrecognised line '{header}'")]);
         }
     }
 
@@ -588,14 +508,11 @@ mod tests {
         };
         let (l, _) = load_path(&p).unwrap();
         assert_eq!(l.mesh.triangles.len(), 69451);
-        let (lo, hi) = l.mesh.positions.iter().fold(
-            (DVec3::splat(f64::MAX), DVec3::splat(f64::MIN)),
-            |(lo, hi), p| (lo.min(*p), hi.max(*p)),
-        );
+        let (lo, hi) =
+            l.mesh.positions.iter().fold((DVec3::splat(f64::MAX), DVec3::splat(f64::MIN)), |(lo, hi), p| {
+                (lo.min(*p), hi.max(*p))
+            });
         let ext = hi - lo;
-        assert!(
-            ext.max_element() > 0.14 && ext.max_element() < 0.17,
-            "{ext}"
-        );
+        assert!(ext.max_element() > 0.14 && ext.max_element() < 0.17, "{ext}");
     }
 }

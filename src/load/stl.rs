@@ -36,23 +36,23 @@ fn is_binary(bytes: &[u8]) -> bool {
     matches!(binary_expected_len(bytes), Some((_, need)) if need == bytes.len() as u64)
 }
 
-/// Starts with `solid` after optional whitespace (and BOM) and contains `facet` or `endsolid`.
+/// Starts with `solid` after optional whitespace (and BOM) and has `facet` in its first 4 KiB
+/// or `endsolid` in its last 1 KiB.
 fn looks_ascii(bytes: &[u8]) -> bool {
     let mut b = bytes.strip_prefix(&[0xEF, 0xBB, 0xBF]).unwrap_or(bytes);
-    let start = b
-        .iter()
-        .position(|c| !c.is_ascii_whitespace())
-        .unwrap_or(b.len());
+    let start = b.iter().position(|c| !c.is_ascii_whitespace()).unwrap_or(b.len());
     b = &b[start..];
     if b.len() < 5 || !b[..5].eq_ignore_ascii_case(b"solid") {
         return false;
     }
-    contains_ignore_case(b, b"facet") || contains_ignore_case(b, b"endsolid")
+    // Bounded scans: a facet near the start, or `endsolid` near the end (an empty solid).
+    let head = &b[..b.len().min(4096)];
+    let tail = &b[b.len().saturating_sub(1024)..];
+    contains_ignore_case(head, b"facet") || contains_ignore_case(tail, b"endsolid")
 }
 
 fn contains_ignore_case(hay: &[u8], needle: &[u8]) -> bool {
-    hay.windows(needle.len())
-        .any(|w| w.eq_ignore_ascii_case(needle))
+    hay.windows(needle.len()).any(|w| w.eq_ignore_ascii_case(needle))
 }
 
 /// Errors unless `bytes` is an exactly-sized binary STL or looks like ASCII STL.
@@ -97,10 +97,7 @@ pub(crate) fn load(path: &Path, bytes: &[u8]) -> Result<Loaded> {
 fn load_binary(path: &Path, bytes: &[u8]) -> Result<Loaded> {
     let n = binary_expected_len(bytes).map_or(0, |(n, _)| n as usize);
     if n > u32::MAX as usize / 3 {
-        return Err(Error::input(
-            path,
-            format!("binary STL has {n} triangles, more than supported"),
-        ));
+        return Err(Error::input(path, format!("binary STL has {n} triangles, more than supported")));
     }
     // Size was checked against the file: `bytes` holds all n facets.
     let mut positions = Vec::with_capacity(3 * n);
@@ -129,10 +126,7 @@ fn load_binary(path: &Path, bytes: &[u8]) -> Result<Loaded> {
             positions,
             tri_object: vec![0; triangles.len()],
             triangles,
-            objects: vec![Object {
-                name,
-                ..Default::default()
-            }],
+            objects: vec![Object { name, ..Default::default() }],
         },
         warnings: Vec::new(),
     })
@@ -185,27 +179,15 @@ fn load_ascii(path: &Path, bytes: &[u8]) -> Result<Loaded> {
         let is = |k: &[u8]| kw.eq_ignore_ascii_case(k);
         if is(b"solid") {
             if state == State::InFacet {
-                return Err(err(
-                    line_no,
-                    "'solid' inside a facet (missing endfacet)".into(),
-                ));
+                return Err(err(line_no, "'solid' inside a facet (missing endfacet)".into()));
             }
             if state == State::InSolid {
                 warnings.push(format!("line {line_no}: new solid before 'endsolid'"));
             }
-            let rest = raw
-                .get(kw.as_ptr() as usize - raw.as_ptr() as usize + 5..)
-                .unwrap_or(&[]);
+            let rest = raw.get(kw.as_ptr() as usize - raw.as_ptr() as usize + 5..).unwrap_or(&[]);
             let name = String::from_utf8_lossy(rest).trim().to_string();
-            let name = if name.is_empty() {
-                format!("solid{solids}")
-            } else {
-                name
-            };
-            mesh.objects.push(Object {
-                name,
-                ..Default::default()
-            });
+            let name = if name.is_empty() { format!("solid{solids}") } else { name };
+            mesh.objects.push(Object { name, ..Default::default() });
             solids += 1;
             state = State::InSolid;
         } else if is(b"facet") {
@@ -213,10 +195,7 @@ fn load_ascii(path: &Path, bytes: &[u8]) -> Result<Loaded> {
                 State::InSolid => {}
                 State::Outside => return Err(err(line_no, "'facet' outside a solid".into())),
                 State::InFacet => {
-                    return Err(err(
-                        line_no,
-                        "'facet' inside a facet (missing endfacet)".into(),
-                    ))
+                    return Err(err(line_no, "'facet' inside a facet (missing endfacet)".into()))
                 }
             }
             verts.clear();
@@ -234,29 +213,17 @@ fn load_ascii(path: &Path, bytes: &[u8]) -> Result<Loaded> {
             let mut c = [0.0f64; 3];
             for (k, slot) in c.iter_mut().enumerate() {
                 let Some((off, tok)) = tokens.next() else {
-                    return Err(err(
-                        line_no,
-                        format!("vertex has {k} coordinates (needs 3)"),
-                    ));
+                    return Err(err(line_no, format!("vertex has {k} coordinates (needs 3)")));
                 };
                 let s = std::str::from_utf8(tok).map_err(|e| {
-                    err(
-                        line_no,
-                        format!("not UTF-8 at byte {}", line_start + off + e.valid_up_to()),
-                    )
+                    err(line_no, format!("not UTF-8 at byte {}", line_start + off + e.valid_up_to()))
                 })?;
                 *slot = s.parse().map_err(|_| {
-                    err(
-                        line_no,
-                        format!("cannot parse '{}' as a vertex coordinate", clip(s, 40)),
-                    )
+                    err(line_no, format!("cannot parse '{}' as a vertex coordinate", clip(s, 40)))
                 })?;
             }
             if let Some(bad) = non_finite(c) {
-                return Err(err(
-                    line_no,
-                    format!("vertex has a non-finite coordinate ({bad})"),
-                ));
+                return Err(err(line_no, format!("vertex has a non-finite coordinate ({bad})")));
             }
             verts.push(DVec3::from_array(c));
         } else if is(b"endfacet") {
@@ -264,10 +231,7 @@ fn load_ascii(path: &Path, bytes: &[u8]) -> Result<Loaded> {
                 return Err(err(line_no, "'endfacet' outside a facet".into()));
             }
             if verts.len() < 3 {
-                let msg = format!(
-                    "facet starting at line {facet_line} has {} vertices",
-                    verts.len()
-                );
+                let msg = format!("facet starting at line {facet_line} has {} vertices", verts.len());
                 return Err(err(line_no, format!("{msg} (needs 3)")));
             }
             let base = mesh.positions.len();
@@ -286,18 +250,12 @@ fn load_ascii(path: &Path, bytes: &[u8]) -> Result<Loaded> {
                 State::InSolid => state = State::Outside,
                 State::Outside => return Err(err(line_no, "'endsolid' without 'solid'".into())),
                 State::InFacet => {
-                    return Err(err(
-                        line_no,
-                        "'endsolid' inside a facet (missing endfacet)".into(),
-                    ))
+                    return Err(err(line_no, "'endsolid' inside a facet (missing endfacet)".into()))
                 }
             }
         } else {
             let shown = String::from_utf8_lossy(kw);
-            return Err(err(
-                line_no,
-                format!("unexpected '{}' in ASCII STL", clip(&shown, 40)),
-            ));
+            return Err(err(line_no, format!("unexpected '{}' in ASCII STL", clip(&shown, 40))));
         }
     }
     match state {
@@ -378,21 +336,21 @@ mod tests {
         let mut b = binary(b"solid x", &[TRI; 13]);
         b[80..84].copy_from_slice(&u32::MAX.to_le_bytes());
         let e = err(&b);
-        assert!(e.contains("header declares 4294967295 triangles (needs 214748364834 bytes) but the file has 734 bytes"), "{e}");
+        assert!(
+            e.contains(
+                "header declares 4294967295 triangles (needs 214748364834 bytes) but the file has 734 bytes"
+            ),
+            "{e}"
+        );
         let mut b = binary(b"", &[TRI]);
         b.push(0);
         let e = err(&b);
-        assert!(
-            e.contains("binary STL size mismatch") && e.contains("(1 extra)"),
-            "{e}"
-        );
+        assert!(e.contains("binary STL size mismatch") && e.contains("(1 extra)"), "{e}");
         let e = err(b"abc");
         assert!(e.contains("too short for binary STL"), "{e}");
         let e = err(&binary(b"", &[]));
         assert!(e.contains("no triangles"), "{e}");
-        let e = load_bytes(&path(), b"", Format::Stl)
-            .unwrap_err()
-            .to_string();
+        let e = load_bytes(&path(), b"", Format::Stl).unwrap_err().to_string();
         assert!(e.contains("file is empty"), "{e}");
     }
 
@@ -401,10 +359,7 @@ mod tests {
         let mut t = [TRI, TRI];
         t[1][2][1] = f32::NAN;
         let e = err(&binary(b"", &t));
-        assert!(
-            e.contains("triangle 1 vertex 2 has a non-finite coordinate (NaN)"),
-            "{e}"
-        );
+        assert!(e.contains("triangle 1 vertex 2 has a non-finite coordinate (NaN)"), "{e}");
         t[1][2][1] = f32::NEG_INFINITY;
         let e = err(&binary(b"", &t));
         assert!(e.contains("non-finite coordinate (-inf)"), "{e}");
@@ -440,47 +395,24 @@ mod tests {
     #[test]
     fn ascii_errors_name_line() {
         let e = err(ASCII.replace("vertex 1 0 0", "vertex 1 x 0").as_bytes());
-        assert!(
-            e.contains("line 5: cannot parse 'x' as a vertex coordinate"),
-            "{e}"
-        );
+        assert!(e.contains("line 5: cannot parse 'x' as a vertex coordinate"), "{e}");
         let e = err(ASCII.replace("vertex 1 0 0", "vertex 1 NaN 0").as_bytes());
-        assert!(
-            e.contains("line 5: vertex has a non-finite coordinate (NaN)"),
-            "{e}"
-        );
+        assert!(e.contains("line 5: vertex has a non-finite coordinate (NaN)"), "{e}");
         let e = err(ASCII.replace("vertex 1 0 0", "vertex 1 0").as_bytes());
-        assert!(
-            e.contains("line 5: vertex has 2 coordinates (needs 3)"),
-            "{e}"
-        );
+        assert!(e.contains("line 5: vertex has 2 coordinates (needs 3)"), "{e}");
         let e = err(ASCII.replace("   vertex 0 1 0\n", "").as_bytes());
-        assert!(
-            e.contains("line 7: facet starting at line 2 has 2 vertices"),
-            "{e}"
-        );
+        assert!(e.contains("line 7: facet starting at line 2 has 2 vertices"), "{e}");
         let e = err(ASCII.replace("endloop", "wobble").as_bytes());
-        assert!(
-            e.contains("line 7: unexpected 'wobble' in ASCII STL"),
-            "{e}"
-        );
+        assert!(e.contains("line 7: unexpected 'wobble' in ASCII STL"), "{e}");
         let e = err(ASCII.replace(" endfacet\nendsolid one\n", "").as_bytes());
-        assert!(
-            e.contains("end of file inside the facet starting at line 2"),
-            "{e}"
-        );
-        let e = err(ASCII
-            .replace("vertex 1 0 0", "vertex 1 \u{e9} 0")
-            .as_bytes());
+        assert!(e.contains("end of file inside the facet starting at line 2"), "{e}");
+        let e = err(ASCII.replace("vertex 1 0 0", "vertex 1 \u{e9} 0").as_bytes());
         assert!(e.contains("line 5: cannot parse"), "{e}");
         let mut bad = ASCII.as_bytes().to_vec();
         let at = ASCII.find("vertex 1 0 0").unwrap() + 7;
         bad[at] = 0xff;
         let e = err(&bad);
-        assert!(
-            e.contains(&format!("line 5: not UTF-8 at byte {at}")),
-            "{e}"
-        );
+        assert!(e.contains(&format!("line 5: not UTF-8 at byte {at}")), "{e}");
         let e = err(b"solid empty\nendsolid empty\n");
         assert!(e.contains("no triangles"), "{e}");
     }
@@ -516,22 +448,9 @@ mod tests {
             assert_eq!(l.mesh.tri_object.iter().filter(|&&o| o == 1).count(), 20);
         }
         if let Some(l) = shared_case("counter.unitsmm.STL", 83750, &["solid0"]) {
-            let zmin = l
-                .mesh
-                .positions
-                .iter()
-                .map(|p| p.z)
-                .fold(f64::MAX, f64::min);
-            let zmax = l
-                .mesh
-                .positions
-                .iter()
-                .map(|p| p.z)
-                .fold(f64::MIN, f64::max);
-            assert!(
-                (255.0..257.0).contains(&zmin) && (281.0..282.5).contains(&zmax),
-                "{zmin} {zmax}"
-            );
+            let zmin = l.mesh.positions.iter().map(|p| p.z).fold(f64::MAX, f64::min);
+            let zmax = l.mesh.positions.iter().map(|p| p.z).fold(f64::MIN, f64::max);
+            assert!((255.0..257.0).contains(&zmin) && (281.0..282.5).contains(&zmax), "{zmin} {zmax}");
         }
     }
 }

@@ -14,14 +14,7 @@ fn tri(a: [f64; 3], b: [f64; 3], c: [f64; 3]) -> [DVec3; 3] {
 /// Classify both ways round and in every vertex rotation/reflection: the answer must not move.
 fn check(a: &[DVec3; 3], b: &[DVec3; 3]) -> Option<(bool, Contact)> {
     let base = classify(a, b).map(|h| (h.crossing, h.contact));
-    let perms = [
-        [0, 1, 2],
-        [1, 2, 0],
-        [2, 0, 1],
-        [0, 2, 1],
-        [2, 1, 0],
-        [1, 0, 2],
-    ];
+    let perms = [[0, 1, 2], [1, 2, 0], [2, 0, 1], [0, 2, 1], [2, 1, 0], [1, 0, 2]];
     for pa in perms {
         for pb in perms {
             let a2 = pa.map(|i| a[i]);
@@ -104,20 +97,11 @@ fn coplanar_cases() {
     let dup = unit();
     assert_eq!(check(&unit(), &dup), Some((false, Contact::CoplanarArea)));
     let overlap = tri([0.2, 0.2, 0.0], [2.0, 0.2, 0.0], [0.2, 2.0, 0.0]);
-    assert_eq!(
-        check(&unit(), &overlap),
-        Some((false, Contact::CoplanarArea))
-    );
+    assert_eq!(check(&unit(), &overlap), Some((false, Contact::CoplanarArea)));
     let adjacent = tri([1.0, 0.0, 0.0], [1.0, 1.0, 0.0], [0.0, 1.0, 0.0]);
-    assert_eq!(
-        check(&unit(), &adjacent),
-        Some((false, Contact::CoplanarBoundary))
-    );
+    assert_eq!(check(&unit(), &adjacent), Some((false, Contact::CoplanarBoundary)));
     let corner = tri([1.0, 0.0, 0.0], [2.0, 0.0, 0.0], [2.0, 1.0, 0.0]);
-    assert_eq!(
-        check(&unit(), &corner),
-        Some((false, Contact::CoplanarBoundary))
-    );
+    assert_eq!(check(&unit(), &corner), Some((false, Contact::CoplanarBoundary)));
     let apart = tri([1.0, 0.5, 0.0], [2.0, 0.5, 0.0], [2.0, 1.0, 0.0]);
     assert_eq!(check(&unit(), &apart), None);
     // T-junction: a vertex of b on the open edge of a, b outside.
