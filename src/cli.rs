@@ -58,6 +58,10 @@ pub struct Args {
     /// List at most N pairs (the summary counts stay complete).
     #[arg(long, value_name = "N", default_value_t = 1000)]
     pub max_pairs: usize,
+    /// Also run parry3d-f64 on the same input and add a `cross_check` block listing every
+    /// disagreement (slow on large overlapping meshes: parry's distance is not a dual walk).
+    #[arg(long, value_enum, value_name = "TOOL")]
+    pub cross_check: Option<CrossCheckArg>,
     /// Deterministic report: no timings, no thread count (byte-identical across runs).
     #[arg(long)]
     pub no_timings: bool,
@@ -77,6 +81,13 @@ pub enum FailOnArg {
     Clearance,
     /// Never fail on findings.
     Never,
+}
+
+/// `--cross-check` values.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
+pub enum CrossCheckArg {
+    /// parry3d-f64 0.31 (GJK triangle tests, f64).
+    Parry,
 }
 
 /// `--bvh` values.
@@ -107,6 +118,8 @@ pub struct Config {
     pub max_pairs: usize,
     /// Deterministic report.
     pub deterministic: bool,
+    /// Run parry3d-f64 too.
+    pub cross_check: bool,
 }
 
 fn numbers(flag: &str, s: &str) -> Result<Vec<f64>> {
@@ -198,6 +211,7 @@ impl Args {
             threads: self.threads,
             max_pairs: self.max_pairs,
             deterministic: self.no_timings,
+            cross_check: self.cross_check.is_some(),
         })
     }
 }
@@ -229,6 +243,13 @@ fn run_in_pool(cfg: &Config, threads: usize) -> Result<Outcome> {
     let load_ms = t0.elapsed().as_secs_f64() * 1e3;
     let result = query::check(&a.mesh, &b.mesh, &cfg.settings);
     let failed = cfg.fail_on.fails(result.verdict);
+    let cross_check = if cfg.cross_check {
+        let p = crate::cross_check::parry_f64(&a.mesh, &b.mesh, true)
+            .map_err(|e| Error::Usage(format!("--cross-check parry: {e}")))?;
+        Some(report::cross_check_report(&result, &p, cfg.max_pairs, cfg.deterministic))
+    } else {
+        None
+    };
     let ctx = report::Context {
         inputs: [&a, &b],
         transforms: [cfg.inputs[0].transform, cfg.inputs[1].transform],
@@ -243,6 +264,7 @@ fn run_in_pool(cfg: &Config, threads: usize) -> Result<Outcome> {
         },
         failed,
         times: (!cfg.deterministic).then(|| (load_ms, t0.elapsed().as_secs_f64() * 1e3)),
+        cross_check,
     };
     let rep = report::build(&ctx, &result);
     let json = report::to_json(&rep);

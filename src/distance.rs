@@ -219,8 +219,8 @@ fn face_candidate(t: &[DVec3; 3], m: &[DVec3; 3], p: DVec3) -> Option<DVec3> {
 /// elsewhere and uses 0 then), with witness points on each triangle: the minimum over the 6
 /// vertex–triangle and 9 edge–edge candidates. Degenerate triangles (segments, points) work.
 ///
-/// Candidates, in tie-breaking order (the first minimum wins), with `a` and `b` in canonical
-/// order (see below):
+/// Candidates, in tie-breaking order (the first minimum wins), `a` and `b` being read as `b` and
+/// `a` when `b` precedes `a` in the canonical order below:
 /// 1. the 9 edge pairs, `a`'s edges outer and `b`'s inner, edge `i` being `[t[i], t[(i+1)%3]]`
 ///    ([`closest_points_segments`]);
 /// 2. `b[0]`, `b[1]`, `b[2]` against the face of `a`, then `a[0]`, `a[1]`, `a[2]` against the face
@@ -385,6 +385,20 @@ mod tests {
         // Skew: x-axis against the line (0.5, t, 3), t in [-1, 1].
         let (x, y) = closest_points_segments(v(-1., 0., 0.), v(1., 0., 0.), v(0.5, -1., 3.), v(0.5, 1., 3.));
         assert!(x == v(0.5, 0., 0.) && y == v(0.5, 0., 3.));
+    }
+
+    #[test]
+    fn rounding_level_sliver() {
+        // Collinear in the reals, area at rounding level in f64 (found by proptest): trusting
+        // the noisy edge/face classification returned a point at distance 2.02236 here.
+        let (a, b) = (
+            v(-0.20043760249966502, -0.5308879409712681, 0.040917768540565135),
+            v(0.6749250841175143, 0.36989199074258267, 0.),
+        );
+        let c = a + (b - a) * -0.9255784842009412;
+        let p = v(-0.7744038838422532, 0.4903938308694553, 0.) * 2.0;
+        let q = closest_point_on_triangle(p, a, b, c);
+        assert!(q.distance(p) <= 2.0208225638766786 + 1e-12, "{q}");
     }
 
     #[test]

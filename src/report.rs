@@ -27,6 +27,9 @@
 //!              "distance", "segment": [[x,y,z],[x,y,z]] | null}],
 //!   "pairs_truncated": bool,
 //!   "bvh": {"a": {"nodes", "leaves", "depth", "sah_cost", "bytes"}, "b": {...}},
+//!   "cross_check": null | {"tool", "intersects", "verdict_agrees", "intersecting_pairs",
+//!                  "distance", "distance_difference", "only_meshclash": [[a,b]], "only_parry": [[a,b]],
+//!                  "only_meshclash_count", "only_parry_count", "parry_ms": [pairs, distance] | null},
 //!   "warnings": ["..."],
 //!   "timings_ms": {"load", "build", "query", "total"} | null
 //! }
@@ -71,10 +74,66 @@ pub struct Report {
     pub pairs_truncated: bool,
     /// Tree sizes.
     pub bvh: Trees,
+    /// What parry3d-f64 says on the same input (`--cross-check parry`), else null.
+    pub cross_check: Option<CrossCheckReport>,
     /// Loader warnings, prefixed with the file.
     pub warnings: Vec<String>,
     /// Phase times (null in deterministic mode).
     pub timings_ms: Option<TimingsReport>,
+}
+
+/// The `cross_check` block: parry3d-f64's answer and every disagreement with ours.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct CrossCheckReport {
+    /// "parry3d-f64 0.31".
+    pub tool: String,
+    /// parry's verdict on "do they intersect (touch or cross)".
+    pub intersects: bool,
+    /// Does it agree with ours (crossing or exact touching pairs exist)?
+    pub verdict_agrees: bool,
+    /// Pairs parry calls intersecting.
+    pub intersecting_pairs: usize,
+    /// parry's minimum distance.
+    pub distance: f64,
+    /// Our minimum distance minus parry's.
+    pub distance_difference: f64,
+    /// Pairs only we report as meeting (at most `max_pairs` listed).
+    pub only_meshclash: Vec<[u32; 2]>,
+    /// Pairs only parry reports (at most `max_pairs` listed).
+    pub only_parry: Vec<[u32; 2]>,
+    /// Total counts of the two lists above (never truncated).
+    pub only_meshclash_count: usize,
+    /// See `only_meshclash_count`.
+    pub only_parry_count: usize,
+    /// parry's pair search and distance times, ms (null in deterministic mode).
+    pub parry_ms: Option<[f64; 2]>,
+}
+
+/// Compare our result with parry's.
+pub fn cross_check_report(
+    r: &ClashResult,
+    p: &crate::cross_check::ParryResult,
+    max: usize,
+    deterministic: bool,
+) -> CrossCheckReport {
+    let ours: Vec<(u32, u32)> = r.pairs.iter().filter(|f| f.contact.is_some()).map(|f| (f.a, f.b)).collect();
+    let (only_ours, only_parry) = crate::cross_check::diff_pairs(&ours, &p.intersecting_pairs);
+    let ours_min = r.closest.map_or(f64::NAN, |c| c.distance);
+    let list = |v: &[(u32, u32)]| v.iter().take(max).map(|&(a, b)| [a, b]).collect();
+    CrossCheckReport {
+        tool: "parry3d-f64 0.31".into(),
+        intersects: !p.intersecting_pairs.is_empty(),
+        verdict_agrees: p.intersecting_pairs.is_empty() == ours.is_empty(),
+        intersecting_pairs: p.intersecting_pairs.len(),
+        distance: p.distance,
+        distance_difference: ours_min - p.distance,
+        only_meshclash: list(&only_ours),
+        only_parry: list(&only_parry),
+        only_meshclash_count: only_ours.len(),
+        only_parry_count: only_parry.len(),
+        parry_ms: (!deterministic).then_some([p.pairs_ms, p.distance_ms]),
+    }
 }
 
 /// Tool name and version.
@@ -274,6 +333,8 @@ pub struct Context<'a> {
     pub failed: bool,
     /// Load and total times, or None in deterministic mode.
     pub times: Option<(f64, f64)>,
+    /// The cross-check block, if one was run.
+    pub cross_check: Option<CrossCheckReport>,
 }
 
 fn v3(p: DVec3) -> [f64; 3] {
@@ -351,6 +412,7 @@ pub fn build(ctx: &Context, r: &ClashResult) -> Report {
         pairs: r.pairs.iter().take(max).map(|p| pair_report(p, oa, ob)).collect(),
         pairs_truncated: r.pairs.len() > max,
         bvh: Trees { a: tree_report(&r.trees[0]), b: tree_report(&r.trees[1]) },
+        cross_check: ctx.cross_check.clone(),
         warnings,
         timings_ms: ctx.times.map(|(load, total)| TimingsReport {
             load,

@@ -2,7 +2,7 @@
 
 use assert_cmd::Command;
 use meshclash::report::Report;
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 
 fn root() -> PathBuf {
     PathBuf::from(env!("CARGO_MANIFEST_DIR"))
@@ -37,6 +37,7 @@ fn parse(stdout: &[u8]) -> Report {
         "pairs",
         "pairs_truncated",
         "bvh",
+        "cross_check",
         "warnings",
         "timings_ms",
     ];
@@ -217,7 +218,22 @@ fn byte_identical_across_thread_counts_on_the_bunny() {
     assert_eq!(run("4"), one);
 }
 
-#[allow(dead_code)]
-fn exists(p: &Path) -> bool {
-    p.exists()
+#[test]
+fn cross_check_with_parry_lists_disagreements() {
+    let out = bin()
+        .args([&shipped("fcl_env.obj"), &shipped("fcl_rob.obj"), "-q", "--cross-check", "parry"])
+        .output()
+        .unwrap();
+    let r = parse(&out.stdout);
+    let cc = r.cross_check.expect("cross_check block");
+    assert!(cc.intersects && cc.verdict_agrees);
+    assert_eq!(cc.distance, 0.0);
+    // Every pair parry reports and we do not must be one we can show is apart; and vice versa.
+    assert_eq!(cc.only_meshclash_count, cc.only_meshclash.len());
+    assert_eq!(
+        cc.intersecting_pairs as i64 - cc.only_parry_count as i64 + cc.only_meshclash_count as i64,
+        (r.summary.crossing_pairs + r.summary.touching_pairs) as i64
+    );
+    let none = bin().args([&shipped("fcl_env.obj"), &shipped("fcl_rob.obj"), "-q"]).output().unwrap();
+    assert!(parse(&none.stdout).cross_check.is_none());
 }
