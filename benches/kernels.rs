@@ -1,0 +1,62 @@
+//! Criterion benchmarks of the kernels and phases: exact triangle–triangle classification,
+//! closed-form distance, BVH build per strategy, and the whole check on real meshes.
+//! `cargo bench --bench kernels` (needs ../shared/meshes beside the repo for the mesh cases).
+
+use criterion::{black_box, criterion_group, criterion_main, Criterion};
+use glam::{DMat4, DVec3};
+use meshclash::bvh::{BuildOptions, Bvh, Strategy};
+use meshclash::distance::triangle_distance;
+use meshclash::query::{check, load_input, InputSpec, Settings};
+use meshclash::tri_tri::classify;
+
+/// Deterministic pseudo-random triangle pairs near each other (a mix of crossing and apart).
+fn pairs(n: usize) -> Vec<([DVec3; 3], [DVec3; 3])> {
+    let mut s = 0x9e3779b97f4a7c15u64;
+    let mut r = || {
+        s ^= s << 13;
+        s ^= s >> 7;
+        s ^= s << 17;
+        (s >> 11) as f64 / (1u64 << 53) as f64 - 0.5
+    };
+    (0..n)
+        .map(|_| {
+            let mut t = || [0; 3].map(|_| DVec3::new(r(), r(), r()));
+            (t(), t())
+        })
+        .collect()
+}
+
+fn kernels(c: &mut Criterion) {
+    let ps = pairs(4096);
+    c.bench_function("tri_tri::classify x4096", |b| {
+        b.iter(|| ps.iter().filter(|(x, y)| classify(black_box(x), black_box(y)).is_some()).count())
+    });
+    c.bench_function("distance::triangle_distance x4096", |b| {
+        b.iter(|| ps.iter().map(|(x, y)| triangle_distance(black_box(x), black_box(y)).distance).sum::<f64>())
+    });
+}
+
+fn shared(name: &str) -> Option<meshclash::mesh::Mesh> {
+    let path = std::path::PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../shared/meshes").join(name);
+    load_input(&InputSpec { path, transform: DMat4::IDENTITY }).ok().map(|i| i.mesh)
+}
+
+fn phases(c: &mut Criterion) {
+    let Some(bunny) = shared("stanford-bunny.obj") else { return };
+    let mut g = c.benchmark_group("bunny 69k");
+    g.sample_size(10);
+    for s in [Strategy::Sah, Strategy::Median, Strategy::Equal] {
+        let opts = BuildOptions { strategy: s, leaf_size: 4 };
+        g.bench_function(format!("build {}", s.name()), |b| b.iter(|| Bvh::build(black_box(&bunny), opts)));
+    }
+    let mut moved = bunny.clone();
+    let m = DMat4::from_cols_array(&[
+        0.8, 0.6, 0.0, 0.0, -0.6, 0.8, 0.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.01, 0.005, 0.002, 1.0,
+    ]);
+    meshclash::query::place(&mut moved, &m, std::path::Path::new("bunny")).unwrap();
+    g.bench_function("check vs rotated copy", |b| b.iter(|| check(&bunny, &moved, &Settings::default())));
+    g.finish();
+}
+
+criterion_group!(benches, kernels, phases);
+criterion_main!(benches);
