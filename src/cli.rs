@@ -37,12 +37,14 @@ pub struct Args {
     /// Affine transform of B, as --transform-a.
     #[arg(long, value_name = "M", allow_hyphen_values = true)]
     pub transform_b: Option<String>,
-    /// Pairs that do not touch but are within this distance count as touching (model units).
-    #[arg(long, value_name = "E", default_value_t = 0.0, allow_negative_numbers = true)]
-    pub touch_tolerance: f64,
-    /// Also report every pair closer than D that does not touch (model units).
-    #[arg(long, value_name = "D", default_value_t = 0.0, allow_negative_numbers = true)]
-    pub clearance: f64,
+    /// Pairs that do not touch but are within this distance count as touching: model units, or
+    /// relative to the model size with a `rel` suffix (`1e-6rel` = 1e-6 × the diagonal of the
+    /// box around both inputs).
+    #[arg(long, value_name = "E", default_value = "0", allow_hyphen_values = true)]
+    pub touch_tolerance: String,
+    /// Also report every pair closer than D that does not touch (model units, or `rel` suffix).
+    #[arg(long, value_name = "D", default_value = "0", allow_hyphen_values = true)]
+    pub clearance: String,
     /// Exit 1 when the verdict is at or above this.
     #[arg(long, value_enum, default_value_t = FailOnArg::Clash)]
     pub fail_on: FailOnArg,
@@ -108,7 +110,11 @@ pub struct Config {
     pub inputs: [InputSpec; 2],
     /// Where the report goes (None = stdout).
     pub output: Option<PathBuf>,
-    /// Search settings.
+    /// Touch tolerance as given.
+    pub touch: Tol,
+    /// Clearance as given.
+    pub clearance: Tol,
+    /// Search settings (tolerances are resolved to absolute values once the inputs are loaded).
     pub settings: Settings,
     /// Failure threshold.
     pub fail_on: FailOn,
@@ -167,11 +173,45 @@ fn placement(name: char, transform: &Option<String>, translate: &Option<String>)
     Ok(m)
 }
 
-fn tolerance(flag: &str, v: f64) -> Result<f64> {
-    if v.is_finite() && v >= 0.0 {
-        Ok(v)
-    } else {
-        Err(Error::Usage(format!("--{flag} must be a finite number >= 0, got {v}")))
+/// A tolerance as given: absolute (model units) or relative to the model size.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Tol {
+    /// Model units.
+    Abs(f64),
+    /// Times the diagonal of the box around both inputs.
+    Rel(f64),
+}
+
+impl Tol {
+    /// The absolute value for a model of size `size`.
+    pub fn resolve(self, size: f64) -> f64 {
+        match self {
+            Tol::Abs(v) => v,
+            Tol::Rel(r) => r * size,
+        }
+    }
+
+    /// As written on the command line (canonical form).
+    pub fn spec(self) -> String {
+        match self {
+            Tol::Abs(v) => format!("{v}"),
+            Tol::Rel(r) => format!("{r}rel"),
+        }
+    }
+}
+
+/// Parse `1.5` or `1e-6rel`: finite, >= 0.
+pub fn parse_tolerance(flag: &str, s: &str) -> Result<Tol> {
+    let t = s.trim();
+    let (num, rel) = match t.strip_suffix("rel") {
+        Some(n) => (n, true),
+        None => (t, false),
+    };
+    match num.trim().parse::<f64>() {
+        Ok(v) if v.is_finite() && v >= 0.0 => Ok(if rel { Tol::Rel(v) } else { Tol::Abs(v) }),
+        _ => Err(Error::Usage(format!(
+            "--{flag} must be a finite number >= 0, optionally with a 'rel' suffix (e.g. 0.01 or 1e-6rel), got '{s}'"
+        ))),
     }
 }
 
@@ -181,18 +221,18 @@ impl Args {
         if !(1..=64).contains(&self.leaf_size) {
             return Err(Error::Usage(format!("--leaf-size must be 1..=64, got {}", self.leaf_size)));
         }
-        let tolerances = Tolerances {
-            touch: tolerance("touch-tolerance", self.touch_tolerance)?,
-            clearance: tolerance("clearance", self.clearance)?,
-        };
+        let touch = parse_tolerance("touch-tolerance", &self.touch_tolerance)?;
+        let clearance = parse_tolerance("clearance", &self.clearance)?;
         Ok(Config {
             inputs: [
                 InputSpec { path: self.a, transform: placement('a', &self.transform_a, &self.translate_a)? },
                 InputSpec { path: self.b, transform: placement('b', &self.transform_b, &self.translate_b)? },
             ],
             output: self.output,
+            touch,
+            clearance,
             settings: Settings {
-                tolerances,
+                tolerances: Tolerances::default(),
                 bvh: BuildOptions {
                     strategy: match self.bvh {
                         BvhArg::Sah => Strategy::Sah,
@@ -241,7 +281,17 @@ fn run_in_pool(cfg: &Config, threads: usize) -> Result<Outcome> {
     let (a, b) = rayon::join(|| query::load_input(&cfg.inputs[0]), || query::load_input(&cfg.inputs[1]));
     let (a, b) = (a?, b?);
     let load_ms = t0.elapsed().as_secs_f64() * 1e3;
-    let result = query::check(&a.mesh, &b.mesh, &cfg.settings);
+    let size = crate::geom::Aabb::of_points(&a.mesh.positions)
+        .union(crate::geom::Aabb::of_points(&b.mesh.positions))
+        .extent()
+        .length();
+    let mut settings = cfg.settings;
+    settings.tolerances =
+        Tolerances { touch: cfg.touch.resolve(size), clearance: cfg.clearance.resolve(size) };
+    if !settings.tolerances.touch.is_finite() || !settings.tolerances.clearance.is_finite() {
+        return Err(Error::Usage("relative tolerance overflows for this model size".into()));
+    }
+    let result = query::check(&a.mesh, &b.mesh, &settings);
     let failed = cfg.fail_on.fails(result.verdict);
     let cross_check = if cfg.cross_check {
         let p = crate::cross_check::parry_f64(&a.mesh, &b.mesh, true)
@@ -254,8 +304,12 @@ fn run_in_pool(cfg: &Config, threads: usize) -> Result<Outcome> {
         inputs: [&a, &b],
         transforms: [cfg.inputs[0].transform, cfg.inputs[1].transform],
         settings: SettingsReport {
-            touch_tolerance: cfg.settings.tolerances.touch,
-            clearance: cfg.settings.tolerances.clearance,
+            touch_tolerance: settings.tolerances.touch,
+            clearance: settings.tolerances.clearance,
+            touch_tolerance_given: cfg.touch.spec(),
+            clearance_given: cfg.clearance.spec(),
+            model_size: size,
+            units: "model".into(),
             fail_on: cfg.fail_on.name().into(),
             bvh: cfg.settings.bvh.strategy.name().into(),
             leaf_size: cfg.settings.bvh.leaf_size,

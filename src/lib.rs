@@ -15,6 +15,7 @@
 
 pub mod bvh;
 pub mod cli;
+pub mod containment;
 pub mod cross_check;
 pub mod distance;
 pub mod error;

@@ -5,6 +5,7 @@
 //! bands, clearance and the closest pair) are f64 closed forms ([`crate::distance`]).
 
 use crate::bvh::{self, BuildOptions, Bvh};
+use crate::containment::{self, Containment};
 use crate::distance::triangle_distance;
 use crate::error::{Error, Result};
 use crate::geom::predicates::{self, Tolerances};
@@ -129,7 +130,7 @@ pub enum Verdict {
     Clearance,
     /// Some pair touches (exactly, or within the touch tolerance), none crosses.
     Touching,
-    /// Some pair crosses.
+    /// Some pair crosses, or one part lies inside the other.
     Clash,
 }
 
@@ -217,6 +218,10 @@ pub struct ClashResult {
     pub closest: Option<Closest>,
     /// The overall answer.
     pub verdict: Verdict,
+    /// Whether one part hides inside the other (decided only when no triangles meet).
+    pub containment: Containment,
+    /// Whether each input is closed (see [`crate::containment::topology`]).
+    pub closed: [bool; 2],
     /// The two trees.
     pub trees: [TreeStats; 2],
     /// Phase times.
@@ -266,7 +271,13 @@ pub fn check(a: &Mesh, b: &Mesh, settings: &Settings) -> ClashResult {
         Some(p) => Some(contact_witness(a, b, p)),
         None => closest_pair(a, &ta, b, &tb),
     };
-    let verdict = if counts.crossing > 0 {
+    let (topo_a, topo_b) = rayon::join(|| containment::topology(a), || containment::topology(b));
+    let containment = if counts.crossing + counts.touching - counts.within_tolerance > 0 {
+        Containment::None // surfaces meet: a part cannot be strictly inside the other
+    } else {
+        containment::decide(a, &ta, &topo_a, b, &tb, &topo_b)
+    };
+    let verdict = if counts.crossing > 0 || containment.is_clash() {
         Verdict::Clash
     } else if counts.touching > 0 {
         Verdict::Touching
@@ -280,6 +291,8 @@ pub fn check(a: &Mesh, b: &Mesh, settings: &Settings) -> ClashResult {
         counts,
         closest,
         verdict,
+        containment,
+        closed: [topo_a.closed, topo_b.closed],
         trees: [ta.stats(), tb.stats()],
         timings: Timings { build_ms, query_ms: ms(t1) },
     }

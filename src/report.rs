@@ -10,17 +10,20 @@
 //!   "schema": "meshclash.report/1",
 //!   "tool": {"name": "meshclash", "version": "0.1.0"},
 //!   "inputs": {
-//!     "a": {"path", "format": "obj|stl|gltf|glb", "vertices", "triangles", "degenerate_triangles",
+//!     "a": {"path", "format": "obj|stl|gltf|glb", "vertices", "triangles", "degenerate_triangles", "closed",
 //!           "objects": [{"name", "triangles"}], "bounds": {"min": [x,y,z], "max": [x,y,z]},
 //!           "transform": [16 numbers, row-major] | null},
 //!     "b": { ...same... }
 //!   },
-//!   "settings": {"touch_tolerance", "clearance", "fail_on", "bvh", "leaf_size", "max_pairs",
+//!   "settings": {"touch_tolerance", "clearance", "touch_tolerance_given", "clearance_given",
+//!                "model_size", "units": "model", "fail_on", "bvh", "leaf_size", "max_pairs",
 //!                "threads": n | null},
-//!   "verdict": "clash" | "touching" | "clearance" | "clear",
+//!   "verdict": "clash" | "touching" | "clearance" | "clear",  // containment is a clash
 //!   "failed": bool,                  // verdict at or above fail_on (exit code 1)
 //!   "summary": {"crossing_pairs", "touching_pairs", "within_tolerance_pairs", "clearance_pairs",
-//!               "min_distance": number | null},
+//!               "min_distance": number | null,
+//!               "contained": "a_in_b|b_in_a|a_partly_in_b|b_partly_in_a|undecided" | null,
+//!               "contained_reason": string | null},
 //!   "closest": {"distance", "a": {"triangle", "object", "point": [x,y,z]}, "b": {...}} | null,
 //!   "pairs": [{"a", "b", "a_object", "b_object", "kind": "crossing|touching|clearance",
 //!              "contact": "point|segment|coplanar_area|coplanar_boundary|within_tolerance" | null,
@@ -170,6 +173,9 @@ pub struct InputReport {
     pub triangles: usize,
     /// Zero-area triangles.
     pub degenerate_triangles: usize,
+    /// Every edge of its non-degenerate triangles is shared by exactly two of them (after
+    /// merging exactly coincident vertices): it bounds a volume and can contain the other part.
+    pub closed: bool,
     /// Objects in file order.
     pub objects: Vec<ObjectReport>,
     /// World bounds (after the transform).
@@ -202,10 +208,18 @@ pub struct Bounds {
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct SettingsReport {
-    /// Absolute touch tolerance (model units).
+    /// Absolute touch tolerance used (model units).
     pub touch_tolerance: f64,
-    /// Absolute clearance (model units).
+    /// Absolute clearance used (model units).
     pub clearance: f64,
+    /// The touch tolerance as given: a number (absolute) or `<r>rel` (relative to model_size).
+    pub touch_tolerance_given: String,
+    /// The clearance as given.
+    pub clearance_given: String,
+    /// Diagonal of the box around both inputs (the base of relative tolerances).
+    pub model_size: f64,
+    /// Units of every length in the report: "model" (the files' own units).
+    pub units: String,
     /// `clash`, `touching`, `clearance` or `never`.
     pub fail_on: String,
     /// `sah`, `median` or `equal`.
@@ -232,6 +246,10 @@ pub struct Summary {
     pub clearance_pairs: u64,
     /// The minimum distance between the two surfaces.
     pub min_distance: Option<f64>,
+    /// `a_in_b`, `b_in_a`, `a_partly_in_b`, `b_partly_in_a` (all a clash), `undecided`, or null.
+    pub contained: Option<String>,
+    /// Why containment is `undecided`, else null.
+    pub contained_reason: Option<String>,
 }
 
 /// The closest pair.
@@ -341,7 +359,7 @@ fn v3(p: DVec3) -> [f64; 3] {
     p.to_array()
 }
 
-fn input_report(input: &Input, m: &DMat4, info: &crate::query::MeshInfo) -> InputReport {
+fn input_report(input: &Input, m: &DMat4, info: &crate::query::MeshInfo, closed: bool) -> InputReport {
     let Aabb { min, max } = info.bounds;
     InputReport {
         path: input.path.display().to_string(),
@@ -349,6 +367,7 @@ fn input_report(input: &Input, m: &DMat4, info: &crate::query::MeshInfo) -> Inpu
         vertices: info.vertices,
         triangles: info.triangles,
         degenerate_triangles: info.degenerate_triangles,
+        closed,
         objects: info.objects.iter().map(|(n, t)| ObjectReport { name: n.clone(), triangles: *t }).collect(),
         bounds: Bounds { min: v3(min), max: v3(max) },
         transform: (*m != DMat4::IDENTITY).then(|| m.transpose().to_cols_array().to_vec()),
@@ -391,8 +410,8 @@ pub fn build(ctx: &Context, r: &ClashResult) -> Report {
         schema: SCHEMA.to_string(),
         tool: Tool { name: "meshclash".into(), version: env!("CARGO_PKG_VERSION").into() },
         inputs: Inputs {
-            a: input_report(ia, &ctx.transforms[0], &infa),
-            b: input_report(ib, &ctx.transforms[1], &infb),
+            a: input_report(ia, &ctx.transforms[0], &infa, r.closed[0]),
+            b: input_report(ib, &ctx.transforms[1], &infb, r.closed[1]),
         },
         settings: ctx.settings.clone(),
         verdict: r.verdict.name().to_string(),
@@ -403,6 +422,11 @@ pub fn build(ctx: &Context, r: &ClashResult) -> Report {
             within_tolerance_pairs: r.counts.within_tolerance,
             clearance_pairs: r.counts.clearance,
             min_distance: r.closest.map(|c| c.distance),
+            contained: r.containment.name().map(str::to_string),
+            contained_reason: match &r.containment {
+                crate::containment::Containment::Undecided(why) => Some(why.clone()),
+                _ => None,
+            },
         },
         closest: r.closest.map(|c| ClosestReport {
             distance: c.distance,

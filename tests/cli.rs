@@ -237,3 +237,78 @@ fn cross_check_with_parry_lists_disagreements() {
     let none = bin().args([&shipped("fcl_env.obj"), &shipped("fcl_rob.obj"), "-q"]).output().unwrap();
     assert!(parse(&none.stdout).cross_check.is_none());
 }
+
+/// An axis-aligned box as an OBJ file (12 triangles, closed).
+fn cube_obj(dir: &std::path::Path, name: &str, min: [f64; 3], max: [f64; 3]) -> String {
+    let mut s = String::new();
+    for i in 0..8 {
+        let c = |k: usize| if i >> k & 1 == 0 { min[k] } else { max[k] };
+        s += &format!("v {} {} {}\n", c(0), c(1), c(2));
+    }
+    for q in [[1, 3, 4, 2], [5, 6, 8, 7], [1, 2, 6, 5], [3, 7, 8, 4], [1, 5, 7, 3], [2, 4, 8, 6]] {
+        s += &format!("f {} {} {} {}\n", q[0], q[1], q[2], q[3]);
+    }
+    let path = dir.join(name);
+    std::fs::write(&path, s).unwrap();
+    path.display().to_string()
+}
+
+#[test]
+fn a_part_hidden_inside_another_is_a_clash() {
+    let dir = tempfile::tempdir().unwrap();
+    let outer = cube_obj(dir.path(), "outer.obj", [0.0; 3], [10.0; 3]);
+    let inner = cube_obj(dir.path(), "inner.obj", [4.0; 3], [5.0; 3]);
+    let out = bin().args([&inner, &outer]).output().unwrap();
+    assert_eq!(out.status.code(), Some(1));
+    let r = parse(&out.stdout);
+    assert_eq!(r.verdict, "clash");
+    assert_eq!(r.summary.contained.as_deref(), Some("a_in_b"));
+    assert!(r.inputs.a.closed && r.inputs.b.closed);
+    assert!(r.pairs.is_empty());
+    assert_eq!(r.summary.min_distance, Some(4.0));
+    let out = bin().args([&outer, &inner]).output().unwrap();
+    assert_eq!(parse(&out.stdout).summary.contained.as_deref(), Some("b_in_a"));
+    // Touching the container from inside: a face-to-face contact, no containment claim.
+    let touching = cube_obj(dir.path(), "touch.obj", [0.0, 4.0, 4.0], [1.0, 5.0, 5.0]);
+    let r = parse(&bin().args([&touching, &outer]).output().unwrap().stdout);
+    assert_eq!(r.verdict, "touching");
+    assert_eq!(r.summary.contained, None);
+    // Outside: clear.
+    let apart = cube_obj(dir.path(), "apart.obj", [20.0; 3], [21.0; 3]);
+    let r = parse(&bin().args([&apart, &outer]).output().unwrap().stdout);
+    assert_eq!((r.verdict.as_str(), r.summary.contained.as_deref()), ("clear", None));
+}
+
+#[test]
+fn open_container_makes_containment_undecided() {
+    let dir = tempfile::tempdir().unwrap();
+    let inner = cube_obj(dir.path(), "inner.obj", [4.0; 3], [5.0; 3]);
+    let outer = cube_obj(dir.path(), "outer.obj", [0.0; 3], [10.0; 3]);
+    let text = std::fs::read_to_string(&outer).unwrap();
+    let open: String = text.lines().filter(|l| *l != "f 5 6 8 7").map(|l| format!("{l}\n")).collect();
+    std::fs::write(&outer, open).unwrap();
+    let r = parse(&bin().args([&inner, &outer]).output().unwrap().stdout);
+    assert!(!r.inputs.b.closed);
+    assert_eq!(r.summary.contained.as_deref(), Some("undecided"));
+    assert!(r.summary.contained_reason.unwrap().contains("not closed"));
+    assert_eq!(r.verdict, "clear");
+}
+
+#[test]
+fn relative_tolerances_resolve_against_model_size() {
+    let dir = tempfile::tempdir().unwrap();
+    let a = cube_obj(dir.path(), "a.obj", [0.0; 3], [1.0; 3]);
+    let b = cube_obj(dir.path(), "b.obj", [1.25, 0.0, 0.0], [2.0, 1.0, 1.0]);
+    let out = bin().args([&a, &b, "--clearance", "0.1rel"]).output().unwrap();
+    let r = parse(&out.stdout);
+    let size = (4.0f64 + 1.0 + 1.0).sqrt(); // box (0,0,0)-(2,1,1)
+    assert!((r.settings.model_size - size).abs() < 1e-12);
+    assert_eq!(r.settings.clearance_given, "0.1rel");
+    assert!((r.settings.clearance - 0.1 * size).abs() < 1e-12);
+    // The gap is 0.25: 0.1 × 2.449 = 0.245 does not reach it, 0.2 × 2.449 = 0.49 does.
+    assert_eq!(r.verdict, "clear");
+    let r = parse(&bin().args([&a, &b, "--clearance", "0.2rel"]).output().unwrap().stdout);
+    assert_eq!(r.verdict, "clearance");
+    let r = parse(&bin().args([&a, &b, "--clearance", "0.3"]).output().unwrap().stdout);
+    assert_eq!((r.verdict.as_str(), r.settings.clearance_given.as_str()), ("clearance", "0.3"));
+}
