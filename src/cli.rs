@@ -5,7 +5,8 @@
 use crate::bvh::{BuildOptions, Strategy};
 use crate::error::{Error, Result};
 use crate::geom::predicates::Tolerances;
-use crate::query::{self, FailOn, InputSpec, Settings};
+use crate::output::progress::Phase;
+use crate::query::{self, DistanceError, FailOn, InputSpec, Mode, Settings};
 use crate::report::{self, SettingsReport};
 use clap::{Parser, ValueEnum};
 use glam::{DMat4, DVec3, DVec4};
@@ -16,12 +17,27 @@ use std::time::Instant;
 /// glTF (.gltf/.glb); writes a JSON report. Exit code: 0 nothing at or above --fail-on,
 /// 1 findings at or above it, 2 bad input, I/O or usage error.
 #[derive(Debug, Parser)]
-#[command(name = "meshclash", version, about, long_about = None)]
+#[command(
+    name = "meshclash",
+    version,
+    about,
+    long_about = None,
+    args_conflicts_with_subcommands = true,
+    subcommand_negates_reqs = true
+)]
 pub struct Args {
     /// First mesh (A).
-    pub a: PathBuf,
+    #[arg(required = true)]
+    pub a: Option<PathBuf>,
     /// Second mesh (B).
-    pub b: PathBuf,
+    #[arg(required = true)]
+    pub b: Option<PathBuf>,
+    /// `schema`, `completions <shell>` or `man` instead of a check.
+    #[command(subcommand)]
+    pub command: Option<crate::output::Command>,
+    /// Output flags: --format, --junit, --baseline, --export-glb.
+    #[command(flatten)]
+    pub outputs: crate::output::OutputArgs,
     /// Write the report to FILE (atomically) instead of stdout.
     #[arg(short, long, value_name = "FILE")]
     pub output: Option<PathBuf>,
@@ -64,6 +80,20 @@ pub struct Args {
     /// disagreement (slow on large overlapping meshes: parry's distance is not a dual walk).
     #[arg(long, value_enum, value_name = "TOOL")]
     pub cross_check: Option<CrossCheckArg>,
+    /// Pair classification: `exact` predicates, or `fast` plain f64 determinants (gives up
+    /// exactness on nearly touching or coplanar pairs; `meshclash bench --trade` measures it).
+    #[arg(long, value_enum, default_value_t = ModeArg::Exact)]
+    pub mode: ModeArg,
+    /// Stop at the first crossing pair: a quick pass/fail gate. Counts become lower bounds,
+    /// no distance or containment is computed, and which pair is listed depends on timing.
+    #[arg(long)]
+    pub first_hit: bool,
+    /// Allowed relative error of the minimum distance (reported d <= (1+R)·true + A).
+    #[arg(long, value_name = "R", default_value_t = 0.0)]
+    pub distance_rel_err: f64,
+    /// Allowed absolute error of the minimum distance (model units).
+    #[arg(long, value_name = "A", default_value_t = 0.0)]
+    pub distance_abs_err: f64,
     /// Deterministic report: no timings, no thread count (byte-identical across runs).
     #[arg(long)]
     pub no_timings: bool,
@@ -83,6 +113,9 @@ pub enum FailOnArg {
     Clearance,
     /// Never fail on findings.
     Never,
+    /// With --baseline: fail only on crossing pairs that were not crossing in the baseline, or
+    /// on containment the baseline did not report.
+    New,
 }
 
 /// `--cross-check` values.
@@ -90,6 +123,23 @@ pub enum FailOnArg {
 pub enum CrossCheckArg {
     /// parry3d-f64 0.31 (GJK triangle tests, f64).
     Parry,
+}
+
+/// `--mode` values.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
+pub enum ModeArg {
+    /// Exact predicates (default).
+    Exact,
+    /// Plain f64 determinants, no exact fallback.
+    Fast,
+}
+
+fn nonneg(flag: &str, v: f64) -> Result<f64> {
+    if v.is_finite() && v >= 0.0 {
+        Ok(v)
+    } else {
+        Err(Error::Usage(format!("--{flag} must be a finite number >= 0, got {v}")))
+    }
 }
 
 /// `--bvh` values.
@@ -126,6 +176,8 @@ pub struct Config {
     pub deterministic: bool,
     /// Run parry3d-f64 too.
     pub cross_check: bool,
+    /// Output format, JUnit and GLB files, baseline.
+    pub outputs: crate::output::OutputOptions,
 }
 
 fn numbers(flag: &str, s: &str) -> Result<Vec<f64>> {
@@ -225,8 +277,14 @@ impl Args {
         let clearance = parse_tolerance("clearance", &self.clearance)?;
         Ok(Config {
             inputs: [
-                InputSpec { path: self.a, transform: placement('a', &self.transform_a, &self.translate_a)? },
-                InputSpec { path: self.b, transform: placement('b', &self.transform_b, &self.translate_b)? },
+                InputSpec {
+                    path: self.a.ok_or_else(|| Error::Usage("missing mesh A".into()))?,
+                    transform: placement('a', &self.transform_a, &self.translate_a)?,
+                },
+                InputSpec {
+                    path: self.b.ok_or_else(|| Error::Usage("missing mesh B".into()))?,
+                    transform: placement('b', &self.transform_b, &self.translate_b)?,
+                },
             ],
             output: self.output,
             touch,
@@ -241,17 +299,28 @@ impl Args {
                     },
                     leaf_size: self.leaf_size,
                 },
+                mode: match self.mode {
+                    ModeArg::Exact => Mode::Exact,
+                    ModeArg::Fast => Mode::Fast,
+                },
+                first_hit: self.first_hit,
+                distance_error: DistanceError {
+                    rel: nonneg("distance-rel-err", self.distance_rel_err)?,
+                    abs: nonneg("distance-abs-err", self.distance_abs_err)?,
+                },
             },
             fail_on: match self.fail_on {
                 FailOnArg::Clash => FailOn::Clash,
                 FailOnArg::Touching => FailOn::Touching,
                 FailOnArg::Clearance => FailOn::Clearance,
-                FailOnArg::Never => FailOn::Never,
+                // `new` is decided after the baseline comparison (crate::output::finish).
+                FailOnArg::Never | FailOnArg::New => FailOn::Never,
             },
             threads: self.threads,
             max_pairs: self.max_pairs,
             deterministic: self.no_timings,
             cross_check: self.cross_check.is_some(),
+            outputs: self.outputs.into_options(self.fail_on == FailOnArg::New)?,
         })
     }
 }
@@ -259,24 +328,33 @@ impl Args {
 /// What the binary should do after a successful run.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Outcome {
-    /// The JSON report, if it goes to stdout (None when written to `--output`).
+    /// What goes to stdout: the report in `--format` (default JSON; None when the report is
+    /// written to `--output` and no `--format` is given).
     pub stdout: Option<String>,
     /// Lines for stderr (warnings).
     pub warnings: Vec<String>,
     /// 0 or 1.
     pub exit_code: u8,
+    /// The finished report (for the human summary on a terminal).
+    pub report: Box<report::Report>,
 }
 
 /// Do the whole job for a validated config.
 pub fn run(cfg: &Config) -> Result<Outcome> {
+    run_with_progress(cfg, &|_| {})
+}
+
+/// [`run`], calling `progress` as each phase starts (the binary drives a spinner with it).
+pub fn run_with_progress(cfg: &Config, progress: &(dyn Fn(Phase) + Sync)) -> Result<Outcome> {
     let pool = rayon::ThreadPoolBuilder::new()
         .num_threads(cfg.threads)
         .build()
         .map_err(|e| Error::Usage(format!("--threads: {e}")))?;
-    pool.install(|| run_in_pool(cfg, pool.current_num_threads()))
+    pool.install(|| run_in_pool(cfg, pool.current_num_threads(), progress))
 }
 
-fn run_in_pool(cfg: &Config, threads: usize) -> Result<Outcome> {
+fn run_in_pool(cfg: &Config, threads: usize, progress: &(dyn Fn(Phase) + Sync)) -> Result<Outcome> {
+    progress(Phase::Load);
     let t0 = Instant::now();
     let (a, b) = rayon::join(|| query::load_input(&cfg.inputs[0]), || query::load_input(&cfg.inputs[1]));
     let (a, b) = (a?, b?);
@@ -291,9 +369,11 @@ fn run_in_pool(cfg: &Config, threads: usize) -> Result<Outcome> {
     if !settings.tolerances.touch.is_finite() || !settings.tolerances.clearance.is_finite() {
         return Err(Error::Usage("relative tolerance overflows for this model size".into()));
     }
+    progress(Phase::Check);
     let result = query::check(&a.mesh, &b.mesh, &settings);
     let failed = cfg.fail_on.fails(result.verdict);
     let cross_check = if cfg.cross_check {
+        progress(Phase::CrossCheck);
         let p = crate::cross_check::parry_f64(&a.mesh, &b.mesh, true)
             .map_err(|e| Error::Usage(format!("--cross-check parry: {e}")))?;
         Some(report::cross_check_report(&result, &p, cfg.max_pairs, cfg.deterministic))
@@ -312,6 +392,10 @@ fn run_in_pool(cfg: &Config, threads: usize) -> Result<Outcome> {
             units: "model".into(),
             fail_on: cfg.fail_on.name().into(),
             bvh: cfg.settings.bvh.strategy.name().into(),
+            mode: cfg.settings.mode.name().into(),
+            first_hit: cfg.settings.first_hit,
+            distance_rel_err: cfg.settings.distance_error.rel,
+            distance_abs_err: cfg.settings.distance_error.abs,
             leaf_size: cfg.settings.bvh.leaf_size,
             max_pairs: cfg.max_pairs,
             threads: (!cfg.deterministic).then_some(threads),
@@ -320,15 +404,15 @@ fn run_in_pool(cfg: &Config, threads: usize) -> Result<Outcome> {
         times: (!cfg.deterministic).then(|| (load_ms, t0.elapsed().as_secs_f64() * 1e3)),
         cross_check,
     };
-    let rep = report::build(&ctx, &result);
+    let mut rep = report::build(&ctx, &result);
+    progress(Phase::Write);
+    crate::output::finish(&cfg.outputs, &mut rep, &result, [&a.mesh, &b.mesh])?;
     let json = report::to_json(&rep);
     let warnings = rep.warnings.clone();
-    let stdout = match &cfg.output {
-        Some(path) => {
-            report::write_atomic(path, json.as_bytes())?;
-            None
-        }
-        None => Some(json),
-    };
-    Ok(Outcome { stdout, warnings, exit_code: failed as u8 })
+    if let Some(path) = &cfg.output {
+        report::write_atomic(path, json.as_bytes())?;
+    }
+    let stdout = crate::output::stdout_for(&cfg.outputs, &rep, &json, cfg.output.is_some());
+    let exit_code = rep.failed as u8;
+    Ok(Outcome { stdout, warnings, exit_code, report: Box::new(rep) })
 }

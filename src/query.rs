@@ -17,6 +17,7 @@ use crate::tri_tri::{self, Contact, Shape};
 use glam::DMat4;
 use rayon::prelude::*;
 use std::path::{Path, PathBuf};
+use std::sync::atomic::{AtomicBool, Ordering};
 use std::time::Instant;
 
 /// One input file and where to put it.
@@ -35,6 +36,43 @@ pub struct Settings {
     pub tolerances: Tolerances,
     /// BVH build options.
     pub bvh: BuildOptions,
+    /// Exact (default) or fast predicates.
+    pub mode: Mode,
+    /// Stop at the first crossing pair (a pass/fail gate): counts become lower bounds.
+    pub first_hit: bool,
+    /// Allowed error of the minimum distance: the reported distance `d` satisfies
+    /// `d <= (1 + rel) * true + abs` (PQP-style). Zero (default) = the f64 minimum.
+    pub distance_error: DistanceError,
+}
+
+/// The speed/accuracy trade of the pair classification.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum Mode {
+    /// Exact predicates (adaptive precision): verdicts exact for the coordinates as given.
+    #[default]
+    Exact,
+    /// Plain f64 determinants without exact fallback: gives up exactness on nearly
+    /// touching or nearly coplanar pairs (a sign may flip or vanish).
+    Fast,
+}
+
+impl Mode {
+    /// Name on the command line and in the report.
+    pub fn name(self) -> &'static str {
+        match self {
+            Mode::Exact => "exact",
+            Mode::Fast => "fast",
+        }
+    }
+}
+
+/// Approximate-distance bounds (see [`Settings::distance_error`]).
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct DistanceError {
+    /// Relative error allowed.
+    pub rel: f64,
+    /// Absolute error allowed (model units).
+    pub abs: f64,
 }
 
 /// A loaded, placed input.
@@ -235,10 +273,11 @@ pub fn check(a: &Mesh, b: &Mesh, settings: &Settings) -> ClashResult {
     let build_ms = ms(t0);
     let t1 = Instant::now();
     let tol = settings.tolerances;
+    let stop = AtomicBool::new(false);
     let mut pairs = traverse::collect_pairs(
         &ta,
         &tb,
-        |x, y| tol.boxes_may_meet(x, y),
+        |x, y| !stop.load(Ordering::Relaxed) && tol.boxes_may_meet(x, y),
         |la, lb, out| {
             for &i in la {
                 let ti = bvh::triangle(a, i);
@@ -248,7 +287,13 @@ pub fn check(a: &Mesh, b: &Mesh, settings: &Settings) -> ClashResult {
                     if !tol.boxes_may_meet(&bi, &Aabb::of_triangle(&tj)) {
                         continue;
                     }
-                    if let Some(f) = classify_pair(i, &ti, j, &tj, &tol) {
+                    if stop.load(Ordering::Relaxed) {
+                        return;
+                    }
+                    if let Some(f) = classify_pair(i, &ti, j, &tj, &tol, settings.mode) {
+                        if settings.first_hit && f.kind == PairKind::Crossing {
+                            stop.store(true, Ordering::Relaxed);
+                        }
                         out.push(f);
                     }
                 }
@@ -269,10 +314,11 @@ pub fn check(a: &Mesh, b: &Mesh, settings: &Settings) -> ClashResult {
     }
     let closest = match pairs.iter().find(|p| p.contact.is_some()) {
         Some(p) => Some(contact_witness(a, b, p)),
-        None => closest_pair(a, &ta, b, &tb),
+        None if stop.load(Ordering::Relaxed) => None,
+        None => closest_pair(a, &ta, b, &tb, settings.distance_error),
     };
     let (topo_a, topo_b) = rayon::join(|| containment::topology(a), || containment::topology(b));
-    let containment = if counts.crossing + counts.touching - counts.within_tolerance > 0 {
+    let containment = if counts.crossing + counts.touching - counts.within_tolerance > 0 || settings.first_hit {
         Containment::None // surfaces meet: a part cannot be strictly inside the other
     } else {
         containment::decide(a, &ta, &topo_a, b, &tb, &topo_b)
@@ -303,8 +349,19 @@ fn ms(t: Instant) -> f64 {
 }
 
 /// Exact classification, then the tolerance bands for pairs that do not meet.
-fn classify_pair(i: u32, ti: &[DVec3; 3], j: u32, tj: &[DVec3; 3], tol: &Tolerances) -> Option<PairFinding> {
-    if let Some(h) = tri_tri::classify(ti, tj) {
+fn classify_pair(
+    i: u32,
+    ti: &[DVec3; 3],
+    j: u32,
+    tj: &[DVec3; 3],
+    tol: &Tolerances,
+    mode: Mode,
+) -> Option<PairFinding> {
+    let hit = match mode {
+        Mode::Exact => tri_tri::classify(ti, tj),
+        Mode::Fast => tri_tri::classify_with::<tri_tri::Float>(ti, tj),
+    };
+    if let Some(h) = hit {
         let kind = if h.crossing { PairKind::Crossing } else { PairKind::Touching };
         return Some(PairFinding {
             a: i,
@@ -348,13 +405,22 @@ fn contact_witness(a: &Mesh, b: &Mesh, p: &PairFinding) -> Closest {
 }
 
 /// Branch-and-bound closest pair of two meshes known not to touch.
-fn closest_pair(a: &Mesh, ta: &Bvh, b: &Mesh, tb: &Bvh) -> Option<Closest> {
+fn closest_pair(a: &Mesh, ta: &Bvh, b: &Mesh, tb: &Bvh, err: DistanceError) -> Option<Closest> {
     let scale = ta.bounds().max_abs().max(tb.bounds().max_abs());
     let slack = predicates::distance_rounding_slack(scale);
+    // With an error allowance, a node pair whose lower bound lb has (1 + rel)·lb + abs >= best
+    // cannot improve on best by more than the allowance: shrink the bound accordingly.
+    let shrink = |lb: f64| {
+        if err.rel == 0.0 && err.abs == 0.0 {
+            lb
+        } else {
+            (lb * (1.0 + err.rel) + err.abs).max(lb)
+        }
+    };
     let best = traverse::min_pair(
         ta,
         tb,
-        |x, y| x.distance_sq(y).sqrt(),
+        |x, y| shrink(x.distance_sq(y).sqrt()),
         slack,
         |la, lb, bound| {
             let mut best: Option<Candidate<(DVec3, DVec3)>> = None;

@@ -16,7 +16,8 @@
 //!     "b": { ...same... }
 //!   },
 //!   "settings": {"touch_tolerance", "clearance", "touch_tolerance_given", "clearance_given",
-//!                "model_size", "units": "model", "fail_on", "bvh", "leaf_size", "max_pairs",
+//!                "model_size", "units": "model", "fail_on", "bvh", "mode": "exact|fast", "first_hit",
+//!                "distance_rel_err", "distance_abs_err", "leaf_size", "max_pairs",
 //!                "threads": n | null},
 //!   "verdict": "clash" | "touching" | "clearance" | "clear",  // containment is a clash
 //!   "failed": bool,                  // verdict at or above fail_on (exit code 1)
@@ -52,7 +53,7 @@ use std::path::Path;
 pub const SCHEMA: &str = "meshclash.report/1";
 
 /// The whole report.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, schemars::JsonSchema)]
 #[serde(deny_unknown_fields)]
 pub struct Report {
     /// Always [`SCHEMA`].
@@ -83,10 +84,13 @@ pub struct Report {
     pub warnings: Vec<String>,
     /// Phase times (null in deterministic mode).
     pub timings_ms: Option<TimingsReport>,
+    /// With `--baseline`: the comparison with the earlier report; absent otherwise.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub baseline: Option<crate::output::baseline::BaselineReport>,
 }
 
 /// The `cross_check` block: parry3d-f64's answer and every disagreement with ours.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, schemars::JsonSchema)]
 #[serde(deny_unknown_fields)]
 pub struct CrossCheckReport {
     /// "parry3d-f64 0.31".
@@ -140,7 +144,7 @@ pub fn cross_check_report(
 }
 
 /// Tool name and version.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, schemars::JsonSchema)]
 #[serde(deny_unknown_fields)]
 pub struct Tool {
     /// "meshclash".
@@ -150,7 +154,7 @@ pub struct Tool {
 }
 
 /// Inputs A and B.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, schemars::JsonSchema)]
 #[serde(deny_unknown_fields)]
 pub struct Inputs {
     /// First input.
@@ -160,7 +164,7 @@ pub struct Inputs {
 }
 
 /// One input.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, schemars::JsonSchema)]
 #[serde(deny_unknown_fields)]
 pub struct InputReport {
     /// Path as given.
@@ -185,7 +189,7 @@ pub struct InputReport {
 }
 
 /// An object (OBJ `o`/`g`, STL solid, glTF mesh instance).
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, schemars::JsonSchema)]
 #[serde(deny_unknown_fields)]
 pub struct ObjectReport {
     /// Its name.
@@ -195,7 +199,7 @@ pub struct ObjectReport {
 }
 
 /// An axis-aligned box.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, schemars::JsonSchema)]
 #[serde(deny_unknown_fields)]
 pub struct Bounds {
     /// Lower corner.
@@ -205,7 +209,7 @@ pub struct Bounds {
 }
 
 /// Settings as used.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, schemars::JsonSchema)]
 #[serde(deny_unknown_fields)]
 pub struct SettingsReport {
     /// Absolute touch tolerance used (model units).
@@ -224,6 +228,14 @@ pub struct SettingsReport {
     pub fail_on: String,
     /// `sah`, `median` or `equal`.
     pub bvh: String,
+    /// `exact` or `fast` (plain f64 determinants, no exact fallback).
+    pub mode: String,
+    /// Stopped at the first crossing pair: counts are lower bounds.
+    pub first_hit: bool,
+    /// Allowed relative error of `min_distance`.
+    pub distance_rel_err: f64,
+    /// Allowed absolute error of `min_distance`.
+    pub distance_abs_err: f64,
     /// Largest leaf.
     pub leaf_size: u32,
     /// Cap on listed pairs.
@@ -233,7 +245,7 @@ pub struct SettingsReport {
 }
 
 /// Counts.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, schemars::JsonSchema)]
 #[serde(deny_unknown_fields)]
 pub struct Summary {
     /// Pairs whose interiors cross.
@@ -253,7 +265,7 @@ pub struct Summary {
 }
 
 /// The closest pair.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, schemars::JsonSchema)]
 #[serde(deny_unknown_fields)]
 pub struct ClosestReport {
     /// The distance.
@@ -265,7 +277,7 @@ pub struct ClosestReport {
 }
 
 /// A point on a triangle.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, schemars::JsonSchema)]
 #[serde(deny_unknown_fields)]
 pub struct Witness {
     /// Triangle index.
@@ -277,7 +289,7 @@ pub struct Witness {
 }
 
 /// One listed pair.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, schemars::JsonSchema)]
 #[serde(deny_unknown_fields)]
 pub struct PairReport {
     /// Triangle in A.
@@ -296,10 +308,17 @@ pub struct PairReport {
     pub distance: f64,
     /// Shared segment, or (tolerance/clearance pairs) the two closest points.
     pub segment: Option<[[f64; 3]; 2]>,
+    /// Stable finding id, 16 hex digits, from the two triangles' coordinates and object names
+    /// (see [`crate::output::baseline`]); absent only in reports of older versions.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub id: Option<String>,
+    /// With `--baseline`: `new` or `persistent`; absent otherwise.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub status: Option<String>,
 }
 
 /// Tree sizes.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, schemars::JsonSchema)]
 #[serde(deny_unknown_fields)]
 pub struct Trees {
     /// A's tree.
@@ -309,7 +328,7 @@ pub struct Trees {
 }
 
 /// One tree.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, schemars::JsonSchema)]
 #[serde(deny_unknown_fields)]
 pub struct TreeReport {
     /// Nodes.
@@ -325,7 +344,7 @@ pub struct TreeReport {
 }
 
 /// Phase times.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, schemars::JsonSchema)]
 #[serde(deny_unknown_fields)]
 pub struct TimingsReport {
     /// Reading and parsing both files.
@@ -392,6 +411,8 @@ fn pair_report(p: &PairFinding, ca: &[u32], cb: &[u32]) -> PairReport {
         },
         distance: p.distance,
         segment: p.segment.map(|[s, t]| [v3(s), v3(t)]),
+        id: None,
+        status: None,
     }
 }
 
@@ -444,6 +465,7 @@ pub fn build(ctx: &Context, r: &ClashResult) -> Report {
             query: r.timings.query_ms,
             total,
         }),
+        baseline: None,
     }
 }
 

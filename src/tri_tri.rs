@@ -17,7 +17,8 @@
 //! Zero-area triangles are classified as what they are — segments or points — and can touch
 //! anything, or cross a proper triangle when a segment pierces its interior transversally.
 
-use crate::geom::predicates::{self as pr, Sign};
+use crate::geom::predicates::{self as pr, Exact, Kernel, Sign};
+pub use crate::geom::predicates::Float;
 use crate::geom::DVec3;
 
 /// How two triangles meet.
@@ -102,28 +103,317 @@ impl Shape {
 
 /// Classify the pair `(a, b)` exactly. `None` if they share no point.
 pub fn classify(a: &[DVec3; 3], b: &[DVec3; 3]) -> Option<Hit> {
-    classify_shapes(&Shape::of(a), &Shape::of(b))
+    Classifier::<Exact>::classify_shapes(&Shape::of(a), &Shape::of(b))
 }
 
 /// As [`classify`], for already classified shapes.
 pub fn classify_shapes(a: &Shape, b: &Shape) -> Option<Hit> {
-    match (*a, *b) {
-        (Shape::Tri(a), Shape::Tri(b)) => tri_tri(&a, &b),
-        (Shape::Tri(t), Shape::Seg(p, q)) => seg_tri(p, q, &t),
-        (Shape::Seg(p, q), Shape::Tri(t)) => seg_tri(p, q, &t),
-        (Shape::Tri(t), Shape::Pt(p)) | (Shape::Pt(p), Shape::Tri(t)) => point_tri(p, &t),
-        (Shape::Seg(p, q), Shape::Seg(r, s)) => seg_seg(p, q, r, s),
-        (Shape::Seg(p, q), Shape::Pt(r)) | (Shape::Pt(r), Shape::Seg(p, q)) => point_seg(r, p, q),
-        (Shape::Pt(p), Shape::Pt(q)) => (p == q).then(|| point_hit(p)),
+    Classifier::<Exact>::classify_shapes(a, b)
+}
+
+/// As [`classify`], with the predicates of kernel `K`: [`Exact`] (the default everywhere), or
+/// [`Float`] (plain f64 determinants with no exact fallback: faster on near-degenerate input,
+/// and wrong there — the `fast` mode, measured by `meshclash bench --trade`).
+pub fn classify_with<K: Kernel>(a: &[DVec3; 3], b: &[DVec3; 3]) -> Option<Hit> {
+    Classifier::<K>::classify_shapes(&Classifier::<K>::shape(a), &Classifier::<K>::shape(b))
+}
+
+/// The classification code, generic over the predicate kernel.
+struct Classifier<K>(std::marker::PhantomData<K>);
+
+impl<K: Kernel> Classifier<K> {
+    fn shape(t: &[DVec3; 3]) -> Shape {
+        if K::collinear(t[0], t[1], t[2]) {
+            Shape::of(t)
+        } else {
+            Shape::Tri(*t)
+        }
     }
-}
 
-fn point_hit(p: DVec3) -> Hit {
-    Hit { crossing: false, contact: Contact::Point, segment: Some([p, p]) }
-}
+    fn classify_shapes(a: &Shape, b: &Shape) -> Option<Hit> {
+        match (*a, *b) {
+            (Shape::Tri(a), Shape::Tri(b)) => Self::tri_tri(&a, &b),
+            (Shape::Tri(t), Shape::Seg(p, q)) => Self::seg_tri(p, q, &t),
+            (Shape::Seg(p, q), Shape::Tri(t)) => Self::seg_tri(p, q, &t),
+            (Shape::Tri(t), Shape::Pt(p)) | (Shape::Pt(p), Shape::Tri(t)) => Self::point_tri(p, &t),
+            (Shape::Seg(p, q), Shape::Seg(r, s)) => Self::seg_seg(p, q, r, s),
+            (Shape::Seg(p, q), Shape::Pt(r)) | (Shape::Pt(r), Shape::Seg(p, q)) => Self::point_seg(r, p, q),
+            (Shape::Pt(p), Shape::Pt(q)) => (p == q).then(|| Self::point_hit(p)),
+        }
+    }
+    fn point_hit(p: DVec3) -> Hit {
+        Hit { crossing: false, contact: Contact::Point, segment: Some([p, p]) }
+    }
 
-fn touch(contact: Contact, segment: Option<[DVec3; 2]>) -> Option<Hit> {
-    Some(Hit { crossing: false, contact, segment })
+    fn touch(contact: Contact, segment: Option<[DVec3; 2]>) -> Option<Hit> {
+        Some(Hit { crossing: false, contact, segment })
+    }
+
+
+
+    /// `s`: the signs of the triangle's vertices with respect to the other plane (not all equal
+    /// strictly, not all zero). `first`: true for triangle `a` (whose normal comes first in `L`).
+    fn section(s: [Sign; 3], first: bool) -> Section {
+        let split = s.contains(&1) && s.contains(&-1);
+        for i in 0..3 {
+            let (j, k) = ((i + 1) % 3, (i + 2) % 3);
+            let sigma = s[i];
+            if sigma != 0 && s[j] != sigma && s[k] != sigma {
+                // Apex i alone on its side. Derivation (see module doc): for `a` with the apex on
+                // the positive side the section runs from edge (i,k) to edge (i,j) along L; for `b`
+                // the other way round; a negative apex reverses both.
+                let (ij, ik) = (End { apex: i, other: j }, End { apex: i, other: k });
+                let forward = (sigma > 0) != first;
+                let (lo, hi) = if forward { (ij, ik) } else { (ik, ij) };
+                return Section { lo, hi, sigma, single: false, split };
+            }
+        }
+        // Pattern (σ, σ, 0) in some order: the section is the zero vertex.
+        let z = s.iter().position(|&v| v == 0).expect("section: one vertex on the plane");
+        let i = (z + 1) % 3;
+        let e = End { apex: i, other: z };
+        Section { lo: e, hi: e, sigma: s[i], single: true, split: false }
+    }
+
+    /// Order along `L` of `x` (an end of `a`'s section) and `y` (an end of `b`'s section):
+    /// negative if `x` comes first, 0 if they coincide.
+    fn cmp_ends(a: &[DVec3; 3], sa: &Section, x: End, b: &[DVec3; 3], sb: &Section, y: End) -> Sign {
+        let o = K::orient3d(a[x.apex], a[x.other], b[y.apex], b[y.other]);
+        // orient3d > 0 ⟺ x before y when both apexes are on the positive sides; each negative apex
+        // side reverses the direction of L relative to the normals used.
+        -o * sa.sigma * sb.sigma
+    }
+
+    /// The f64 position of an end, for the report only.
+    fn end_point(t: &[DVec3; 3], d: &[f64; 3], e: End) -> DVec3 {
+        let (p, q) = (t[e.apex], t[e.other]);
+        let (dp, dq) = (d[e.apex], d[e.other]);
+        if dq == 0.0 {
+            return q;
+        }
+        let u = dp / (dp - dq);
+        p + (q - p) * u
+    }
+
+    fn tri_tri(a: &[DVec3; 3], b: &[DVec3; 3]) -> Option<Hit> {
+        let sa = a.map(|p| K::orient3d(b[0], b[1], b[2], p));
+        if sa.iter().all(|&s| s > 0) || sa.iter().all(|&s| s < 0) {
+            return None;
+        }
+        if sa.iter().all(|&s| s == 0) {
+            return Self::coplanar(a, b);
+        }
+        let sb = b.map(|p| K::orient3d(a[0], a[1], a[2], p));
+        if sb.iter().all(|&s| s > 0) || sb.iter().all(|&s| s < 0) {
+            return None;
+        }
+        let ia = Self::section(sa, true);
+        let ib = Self::section(sb, false);
+        // Meet iff lo_a <= hi_b and lo_b <= hi_a.
+        let lo_a_hi_b = Self::cmp_ends(a, &ia, ia.lo, b, &ib, ib.hi);
+        let hi_a_lo_b = Self::cmp_ends(a, &ia, ia.hi, b, &ib, ib.lo);
+        if lo_a_hi_b > 0 || hi_a_lo_b < 0 {
+            return None;
+        }
+        let positive = lo_a_hi_b < 0 && hi_a_lo_b > 0 && !ia.single && !ib.single;
+        // The shared interval: max of the lows, min of the highs.
+        let da = a.map(|p| K::orient3d_value(b[0], b[1], b[2], p));
+        let db = b.map(|p| K::orient3d_value(a[0], a[1], a[2], p));
+        let lo_cmp = Self::cmp_ends(a, &ia, ia.lo, b, &ib, ib.lo);
+        let lo = if lo_cmp >= 0 { Self::end_point(a, &da, ia.lo) } else { Self::end_point(b, &db, ib.lo) };
+        let hi_cmp = Self::cmp_ends(a, &ia, ia.hi, b, &ib, ib.hi);
+        let hi = if hi_cmp <= 0 { Self::end_point(a, &da, ia.hi) } else { Self::end_point(b, &db, ib.hi) };
+        let segment = Some(if positive { [lo, hi] } else { [lo, lo] });
+        Some(Hit {
+            crossing: positive && ia.split && ib.split,
+            contact: if positive { Contact::Segment } else { Contact::Point },
+            segment,
+        })
+    }
+
+    /// Counter-clockwise (in projection `k`) copy of a proper triangle.
+    fn ccw(t: &[DVec3; 3], k: usize) -> [DVec3; 3] {
+        if K::orient2d(t[0], t[1], t[2], k) > 0 {
+            *t
+        } else {
+            [t[0], t[2], t[1]]
+        }
+    }
+
+    /// For each edge of `t` (ccw in projection `k`): (all of `pts` strictly outside, all weakly).
+    fn separation(t: &[DVec3; 3], pts: &[DVec3], k: usize) -> (bool, bool) {
+        let (mut strict, mut weak) = (false, false);
+        for i in 0..3 {
+            let (e0, e1) = (t[i], t[(i + 1) % 3]);
+            let s: Vec<Sign> = pts.iter().map(|&p| K::orient2d(e0, e1, p, k)).collect();
+            strict |= s.iter().all(|&v| v < 0);
+            weak |= s.iter().all(|&v| v <= 0);
+        }
+        (strict, weak)
+    }
+
+    fn coplanar(a: &[DVec3; 3], b: &[DVec3; 3]) -> Option<Hit> {
+        let k = K::projection_axis(a[0], a[1], a[2]).expect("proper triangle");
+        let (a, b) = (Self::ccw(a, k), Self::ccw(b, k));
+        let (sa, wa) = Self::separation(&a, &b, k);
+        let (sb, wb) = Self::separation(&b, &a, k);
+        if sa || sb {
+            return None;
+        }
+        Self::touch(if wa || wb { Contact::CoplanarBoundary } else { Contact::CoplanarArea }, None)
+    }
+
+    /// Point in closed triangle, the point known to be in the triangle's plane.
+    fn in_closed_triangle(p: DVec3, t: &[DVec3; 3], k: usize) -> bool {
+        let t = Self::ccw(t, k);
+        (0..3).all(|i| K::orient2d(t[i], t[(i + 1) % 3], p, k) >= 0)
+    }
+
+    fn point_tri(p: DVec3, t: &[DVec3; 3]) -> Option<Hit> {
+        if K::orient3d(t[0], t[1], t[2], p) != 0 {
+            return None;
+        }
+        let k = K::projection_axis(t[0], t[1], t[2]).expect("proper triangle");
+        Self::in_closed_triangle(p, t, k).then(|| Self::point_hit(p))
+    }
+
+    /// Is `p` on the closed segment `[q, r]` (`q != r`)?
+    fn on_segment(p: DVec3, q: DVec3, r: DVec3) -> bool {
+        if !K::collinear(q, r, p) {
+            return false;
+        }
+        let k = pr::line_axis(q, r);
+        let (lo, hi) = if q[k] <= r[k] { (q[k], r[k]) } else { (r[k], q[k]) };
+        lo <= p[k] && p[k] <= hi
+    }
+
+    fn point_seg(p: DVec3, q: DVec3, r: DVec3) -> Option<Hit> {
+        Self::on_segment(p, q, r).then(|| Self::point_hit(p))
+    }
+
+    /// Overlap of collinear segments `[p,q]` and `[r,s]`: None, a point, or a segment.
+    fn collinear_overlap(p: DVec3, q: DVec3, r: DVec3, s: DVec3) -> Option<Hit> {
+        let k = pr::line_axis(p, q);
+        let (p, q) = if p[k] <= q[k] { (p, q) } else { (q, p) };
+        let (r, s) = if r[k] <= s[k] { (r, s) } else { (s, r) };
+        let lo = if p[k] >= r[k] { p } else { r };
+        let hi = if q[k] <= s[k] { q } else { s };
+        if lo[k] > hi[k] {
+            None
+        } else if lo[k] == hi[k] {
+            Self::touch(Contact::Point, Some([lo, lo]))
+        } else {
+            Self::touch(Contact::Segment, Some([lo, hi]))
+        }
+    }
+
+    fn seg_seg(p: DVec3, q: DVec3, r: DVec3, s: DVec3) -> Option<Hit> {
+        if K::orient3d(p, q, r, s) != 0 {
+            return None; // skew lines
+        }
+        if K::collinear(p, q, r) && K::collinear(p, q, s) {
+            return Self::collinear_overlap(p, q, r, s);
+        }
+        // Coplanar, not all collinear: project where the plane does not collapse.
+        let k = (0..3)
+            .find(|&k| K::orient2d(p, q, r, k) != 0 || K::orient2d(p, q, s, k) != 0)
+            .expect("non-collinear coplanar points project somewhere");
+        let d1 = K::orient2d(r, s, p, k);
+        let d2 = K::orient2d(r, s, q, k);
+        let d3 = K::orient2d(p, q, r, k);
+        let d4 = K::orient2d(p, q, s, k);
+        if d1 * d2 < 0 && d3 * d4 < 0 {
+            // Proper crossing of two segments: a single point; place it (f64) for the report.
+            let (d1, d2) = (q - p, s - r);
+            let n = d1.cross(d2);
+            let nn = n.dot(n);
+            let m = if nn > 0.0 { p + d1 * ((r - p).cross(d2).dot(n) / nn) } else { p };
+            return Self::touch(Contact::Point, Some([m, m]));
+        }
+        for (x, y, z) in [(p, r, s), (q, r, s), (r, p, q), (s, p, q)] {
+            if Self::on_segment(x, y, z) {
+                return Self::touch(Contact::Point, Some([x, x]));
+            }
+        }
+        None
+    }
+
+    fn seg_tri(p: DVec3, q: DVec3, t: &[DVec3; 3]) -> Option<Hit> {
+        let sp = K::orient3d(t[0], t[1], t[2], p);
+        let sq = K::orient3d(t[0], t[1], t[2], q);
+        if sp * sq > 0 {
+            return None;
+        }
+        let k = K::projection_axis(t[0], t[1], t[2]).expect("proper triangle");
+        if sp == 0 && sq == 0 {
+            return Self::seg_tri_coplanar(p, q, &Self::ccw(t, k), k);
+        }
+        if sp == 0 {
+            return Self::in_closed_triangle(p, t, k).then(|| Self::point_hit(p));
+        }
+        if sq == 0 {
+            return Self::in_closed_triangle(q, t, k).then(|| Self::point_hit(q));
+        }
+        // Strictly through the plane: where does the line pass relative to the three edges?
+        let s = [0, 1, 2].map(|i| K::orient3d(p, q, t[i], t[(i + 1) % 3]));
+        let inside = s.iter().all(|&v| v >= 0) || s.iter().all(|&v| v <= 0);
+        if !inside {
+            return None;
+        }
+        let dp = K::orient3d_value(t[0], t[1], t[2], p);
+        let dq = K::orient3d_value(t[0], t[1], t[2], q);
+        let x = p + (q - p) * (dp / (dp - dq));
+        let crossing = s.iter().all(|&v| v != 0);
+        Some(Hit { crossing, contact: Contact::Point, segment: Some([x, x]) })
+    }
+
+    /// Segment in the plane of proper triangle `t` (ccw in projection `k`).
+    fn seg_tri_coplanar(p: DVec3, q: DVec3, t: &[DVec3; 3], k: usize) -> Option<Hit> {
+        let (strict_t, weak_t) = Self::separation(t, &[p, q], k);
+        let line: Vec<Sign> = t.iter().map(|&v| K::orient2d(p, q, v, k)).collect();
+        let strict_l = line.iter().all(|&v| v > 0) || line.iter().all(|&v| v < 0);
+        if strict_t || strict_l {
+            return None;
+        }
+        let both_sides = line.contains(&1) && line.contains(&-1);
+        if !weak_t && both_sides {
+            // The segment passes through the open triangle: a positive-length contact.
+            return Self::touch(Contact::Segment, None);
+        }
+        // Only boundary contact: a segment if collinear with an edge over a positive length.
+        let mut best: Option<Hit> = None;
+        for i in 0..3 {
+            let (e0, e1) = (t[i], t[(i + 1) % 3]);
+            if K::orient2d(e0, e1, p, k) == 0 && K::orient2d(e0, e1, q, k) == 0 {
+                if let Some(h) = Self::collinear_overlap(p, q, e0, e1) {
+                    if h.contact == Contact::Segment {
+                        return Some(h);
+                    }
+                    best = best.or(Some(h));
+                }
+            }
+        }
+        if best.is_some() {
+            return best;
+        }
+        // A single boundary point: an endpoint inside, or the segment through a vertex/edge.
+        for x in [p, q] {
+            if Self::in_closed_triangle(x, t, k) {
+                return Self::touch(Contact::Point, Some([x, x]));
+            }
+        }
+        for &v in t {
+            if Self::on_segment(v, p, q) {
+                return Self::touch(Contact::Point, Some([v, v]));
+            }
+        }
+        for i in 0..3 {
+            if let Some(h) = Self::seg_seg(p, q, t[i], t[(i + 1) % 3]) {
+                return Some(h);
+            }
+        }
+        Self::touch(Contact::Point, None)
+    }
 }
 
 /// An endpoint of a triangle's section by the other plane: the point where edge
@@ -133,7 +423,6 @@ struct End {
     apex: usize,
     other: usize,
 }
-
 /// A triangle's section by the other triangle's plane, as an interval on the line `L`
 /// (direction `n_a × n_b`): its low and high ends, and the sign of the apex side.
 struct Section {
@@ -144,270 +433,6 @@ struct Section {
     single: bool,
     /// The plane cuts the triangle's interior (vertices strictly on both sides).
     split: bool,
-}
-
-/// `s`: the signs of the triangle's vertices with respect to the other plane (not all equal
-/// strictly, not all zero). `first`: true for triangle `a` (whose normal comes first in `L`).
-fn section(s: [Sign; 3], first: bool) -> Section {
-    let split = s.contains(&1) && s.contains(&-1);
-    for i in 0..3 {
-        let (j, k) = ((i + 1) % 3, (i + 2) % 3);
-        let sigma = s[i];
-        if sigma != 0 && s[j] != sigma && s[k] != sigma {
-            // Apex i alone on its side. Derivation (see module doc): for `a` with the apex on
-            // the positive side the section runs from edge (i,k) to edge (i,j) along L; for `b`
-            // the other way round; a negative apex reverses both.
-            let (ij, ik) = (End { apex: i, other: j }, End { apex: i, other: k });
-            let forward = (sigma > 0) != first;
-            let (lo, hi) = if forward { (ij, ik) } else { (ik, ij) };
-            return Section { lo, hi, sigma, single: false, split };
-        }
-    }
-    // Pattern (σ, σ, 0) in some order: the section is the zero vertex.
-    let z = s.iter().position(|&v| v == 0).expect("section: one vertex on the plane");
-    let i = (z + 1) % 3;
-    let e = End { apex: i, other: z };
-    Section { lo: e, hi: e, sigma: s[i], single: true, split: false }
-}
-
-/// Order along `L` of `x` (an end of `a`'s section) and `y` (an end of `b`'s section):
-/// negative if `x` comes first, 0 if they coincide.
-fn cmp_ends(a: &[DVec3; 3], sa: &Section, x: End, b: &[DVec3; 3], sb: &Section, y: End) -> Sign {
-    let o = pr::orient3d(a[x.apex], a[x.other], b[y.apex], b[y.other]);
-    // orient3d > 0 ⟺ x before y when both apexes are on the positive sides; each negative apex
-    // side reverses the direction of L relative to the normals used.
-    -o * sa.sigma * sb.sigma
-}
-
-/// The f64 position of an end, for the report only.
-fn end_point(t: &[DVec3; 3], d: &[f64; 3], e: End) -> DVec3 {
-    let (p, q) = (t[e.apex], t[e.other]);
-    let (dp, dq) = (d[e.apex], d[e.other]);
-    if dq == 0.0 {
-        return q;
-    }
-    let u = dp / (dp - dq);
-    p + (q - p) * u
-}
-
-fn tri_tri(a: &[DVec3; 3], b: &[DVec3; 3]) -> Option<Hit> {
-    let sa = a.map(|p| pr::orient3d(b[0], b[1], b[2], p));
-    if sa.iter().all(|&s| s > 0) || sa.iter().all(|&s| s < 0) {
-        return None;
-    }
-    if sa.iter().all(|&s| s == 0) {
-        return coplanar(a, b);
-    }
-    let sb = b.map(|p| pr::orient3d(a[0], a[1], a[2], p));
-    if sb.iter().all(|&s| s > 0) || sb.iter().all(|&s| s < 0) {
-        return None;
-    }
-    let ia = section(sa, true);
-    let ib = section(sb, false);
-    // Meet iff lo_a <= hi_b and lo_b <= hi_a.
-    let lo_a_hi_b = cmp_ends(a, &ia, ia.lo, b, &ib, ib.hi);
-    let hi_a_lo_b = cmp_ends(a, &ia, ia.hi, b, &ib, ib.lo);
-    if lo_a_hi_b > 0 || hi_a_lo_b < 0 {
-        return None;
-    }
-    let positive = lo_a_hi_b < 0 && hi_a_lo_b > 0 && !ia.single && !ib.single;
-    // The shared interval: max of the lows, min of the highs.
-    let da = a.map(|p| pr::orient3d_value(b[0], b[1], b[2], p));
-    let db = b.map(|p| pr::orient3d_value(a[0], a[1], a[2], p));
-    let lo_cmp = cmp_ends(a, &ia, ia.lo, b, &ib, ib.lo);
-    let lo = if lo_cmp >= 0 { end_point(a, &da, ia.lo) } else { end_point(b, &db, ib.lo) };
-    let hi_cmp = cmp_ends(a, &ia, ia.hi, b, &ib, ib.hi);
-    let hi = if hi_cmp <= 0 { end_point(a, &da, ia.hi) } else { end_point(b, &db, ib.hi) };
-    let segment = Some(if positive { [lo, hi] } else { [lo, lo] });
-    Some(Hit {
-        crossing: positive && ia.split && ib.split,
-        contact: if positive { Contact::Segment } else { Contact::Point },
-        segment,
-    })
-}
-
-/// Counter-clockwise (in projection `k`) copy of a proper triangle.
-fn ccw(t: &[DVec3; 3], k: usize) -> [DVec3; 3] {
-    if pr::orient2d(t[0], t[1], t[2], k) > 0 {
-        *t
-    } else {
-        [t[0], t[2], t[1]]
-    }
-}
-
-/// For each edge of `t` (ccw in projection `k`): (all of `pts` strictly outside, all weakly).
-fn separation(t: &[DVec3; 3], pts: &[DVec3], k: usize) -> (bool, bool) {
-    let (mut strict, mut weak) = (false, false);
-    for i in 0..3 {
-        let (e0, e1) = (t[i], t[(i + 1) % 3]);
-        let s: Vec<Sign> = pts.iter().map(|&p| pr::orient2d(e0, e1, p, k)).collect();
-        strict |= s.iter().all(|&v| v < 0);
-        weak |= s.iter().all(|&v| v <= 0);
-    }
-    (strict, weak)
-}
-
-fn coplanar(a: &[DVec3; 3], b: &[DVec3; 3]) -> Option<Hit> {
-    let k = pr::projection_axis(a[0], a[1], a[2]).expect("proper triangle");
-    let (a, b) = (ccw(a, k), ccw(b, k));
-    let (sa, wa) = separation(&a, &b, k);
-    let (sb, wb) = separation(&b, &a, k);
-    if sa || sb {
-        return None;
-    }
-    touch(if wa || wb { Contact::CoplanarBoundary } else { Contact::CoplanarArea }, None)
-}
-
-/// Point in closed triangle, the point known to be in the triangle's plane.
-fn in_closed_triangle(p: DVec3, t: &[DVec3; 3], k: usize) -> bool {
-    let t = ccw(t, k);
-    (0..3).all(|i| pr::orient2d(t[i], t[(i + 1) % 3], p, k) >= 0)
-}
-
-fn point_tri(p: DVec3, t: &[DVec3; 3]) -> Option<Hit> {
-    if pr::orient3d(t[0], t[1], t[2], p) != 0 {
-        return None;
-    }
-    let k = pr::projection_axis(t[0], t[1], t[2]).expect("proper triangle");
-    in_closed_triangle(p, t, k).then(|| point_hit(p))
-}
-
-/// Is `p` on the closed segment `[q, r]` (`q != r`)?
-fn on_segment(p: DVec3, q: DVec3, r: DVec3) -> bool {
-    if !pr::collinear(q, r, p) {
-        return false;
-    }
-    let k = pr::line_axis(q, r);
-    let (lo, hi) = if q[k] <= r[k] { (q[k], r[k]) } else { (r[k], q[k]) };
-    lo <= p[k] && p[k] <= hi
-}
-
-fn point_seg(p: DVec3, q: DVec3, r: DVec3) -> Option<Hit> {
-    on_segment(p, q, r).then(|| point_hit(p))
-}
-
-/// Overlap of collinear segments `[p,q]` and `[r,s]`: None, a point, or a segment.
-fn collinear_overlap(p: DVec3, q: DVec3, r: DVec3, s: DVec3) -> Option<Hit> {
-    let k = pr::line_axis(p, q);
-    let (p, q) = if p[k] <= q[k] { (p, q) } else { (q, p) };
-    let (r, s) = if r[k] <= s[k] { (r, s) } else { (s, r) };
-    let lo = if p[k] >= r[k] { p } else { r };
-    let hi = if q[k] <= s[k] { q } else { s };
-    if lo[k] > hi[k] {
-        None
-    } else if lo[k] == hi[k] {
-        touch(Contact::Point, Some([lo, lo]))
-    } else {
-        touch(Contact::Segment, Some([lo, hi]))
-    }
-}
-
-fn seg_seg(p: DVec3, q: DVec3, r: DVec3, s: DVec3) -> Option<Hit> {
-    if pr::orient3d(p, q, r, s) != 0 {
-        return None; // skew lines
-    }
-    if pr::collinear(p, q, r) && pr::collinear(p, q, s) {
-        return collinear_overlap(p, q, r, s);
-    }
-    // Coplanar, not all collinear: project where the plane does not collapse.
-    let k = (0..3)
-        .find(|&k| pr::orient2d(p, q, r, k) != 0 || pr::orient2d(p, q, s, k) != 0)
-        .expect("non-collinear coplanar points project somewhere");
-    let d1 = pr::orient2d(r, s, p, k);
-    let d2 = pr::orient2d(r, s, q, k);
-    let d3 = pr::orient2d(p, q, r, k);
-    let d4 = pr::orient2d(p, q, s, k);
-    if d1 * d2 < 0 && d3 * d4 < 0 {
-        // Proper crossing of two segments: a single point; place it (f64) for the report.
-        let (d1, d2) = (q - p, s - r);
-        let n = d1.cross(d2);
-        let nn = n.dot(n);
-        let m = if nn > 0.0 { p + d1 * ((r - p).cross(d2).dot(n) / nn) } else { p };
-        return touch(Contact::Point, Some([m, m]));
-    }
-    for (x, y, z) in [(p, r, s), (q, r, s), (r, p, q), (s, p, q)] {
-        if on_segment(x, y, z) {
-            return touch(Contact::Point, Some([x, x]));
-        }
-    }
-    None
-}
-
-fn seg_tri(p: DVec3, q: DVec3, t: &[DVec3; 3]) -> Option<Hit> {
-    let sp = pr::orient3d(t[0], t[1], t[2], p);
-    let sq = pr::orient3d(t[0], t[1], t[2], q);
-    if sp * sq > 0 {
-        return None;
-    }
-    let k = pr::projection_axis(t[0], t[1], t[2]).expect("proper triangle");
-    if sp == 0 && sq == 0 {
-        return seg_tri_coplanar(p, q, &ccw(t, k), k);
-    }
-    if sp == 0 {
-        return in_closed_triangle(p, t, k).then(|| point_hit(p));
-    }
-    if sq == 0 {
-        return in_closed_triangle(q, t, k).then(|| point_hit(q));
-    }
-    // Strictly through the plane: where does the line pass relative to the three edges?
-    let s = [0, 1, 2].map(|i| pr::orient3d(p, q, t[i], t[(i + 1) % 3]));
-    let inside = s.iter().all(|&v| v >= 0) || s.iter().all(|&v| v <= 0);
-    if !inside {
-        return None;
-    }
-    let dp = pr::orient3d_value(t[0], t[1], t[2], p);
-    let dq = pr::orient3d_value(t[0], t[1], t[2], q);
-    let x = p + (q - p) * (dp / (dp - dq));
-    let crossing = s.iter().all(|&v| v != 0);
-    Some(Hit { crossing, contact: Contact::Point, segment: Some([x, x]) })
-}
-
-/// Segment in the plane of proper triangle `t` (ccw in projection `k`).
-fn seg_tri_coplanar(p: DVec3, q: DVec3, t: &[DVec3; 3], k: usize) -> Option<Hit> {
-    let (strict_t, weak_t) = separation(t, &[p, q], k);
-    let line: Vec<Sign> = t.iter().map(|&v| pr::orient2d(p, q, v, k)).collect();
-    let strict_l = line.iter().all(|&v| v > 0) || line.iter().all(|&v| v < 0);
-    if strict_t || strict_l {
-        return None;
-    }
-    let both_sides = line.contains(&1) && line.contains(&-1);
-    if !weak_t && both_sides {
-        // The segment passes through the open triangle: a positive-length contact.
-        return touch(Contact::Segment, None);
-    }
-    // Only boundary contact: a segment if collinear with an edge over a positive length.
-    let mut best: Option<Hit> = None;
-    for i in 0..3 {
-        let (e0, e1) = (t[i], t[(i + 1) % 3]);
-        if pr::orient2d(e0, e1, p, k) == 0 && pr::orient2d(e0, e1, q, k) == 0 {
-            if let Some(h) = collinear_overlap(p, q, e0, e1) {
-                if h.contact == Contact::Segment {
-                    return Some(h);
-                }
-                best = best.or(Some(h));
-            }
-        }
-    }
-    if best.is_some() {
-        return best;
-    }
-    // A single boundary point: an endpoint inside, or the segment through a vertex/edge.
-    for x in [p, q] {
-        if in_closed_triangle(x, t, k) {
-            return touch(Contact::Point, Some([x, x]));
-        }
-    }
-    for &v in t {
-        if on_segment(v, p, q) {
-            return touch(Contact::Point, Some([v, v]));
-        }
-    }
-    for i in 0..3 {
-        if let Some(h) = seg_seg(p, q, t[i], t[(i + 1) % 3]) {
-            return Some(h);
-        }
-    }
-    touch(Contact::Point, None)
 }
 
 #[cfg(test)]

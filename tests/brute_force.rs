@@ -58,7 +58,7 @@ fn brute(a: &[[DVec3; 3]], b: &[[DVec3; 3]]) -> Brute {
 }
 
 fn compare(a: &[[DVec3; 3]], b: &[[DVec3; 3]], opts: BuildOptions) -> Result<(), TestCaseError> {
-    let settings = Settings { tolerances: Tolerances::default(), bvh: opts };
+    let settings = Settings { tolerances: Tolerances::default(), bvh: opts, ..Default::default() };
     let r = check(&mesh(a), &mesh(b), &settings);
     let want = brute(a, b);
     let got: Vec<(u32, u32, bool)> =
@@ -123,7 +123,7 @@ fn thread_count_does_not_change_the_result() {
     };
     let (a, b) = (mesh(&grid(60, 0.0, 7)), mesh(&grid(60, 0.3, 3)));
     let settings =
-        Settings { tolerances: Tolerances { touch: 0.0, clearance: 0.2 }, bvh: BuildOptions::default() };
+        Settings { tolerances: Tolerances { touch: 0.0, clearance: 0.2 }, bvh: BuildOptions::default(), ..Default::default() };
     let run = |threads: usize| {
         let pool = rayon::ThreadPoolBuilder::new().num_threads(threads).build().unwrap();
         let mut r = pool.install(|| check(&a, &b, &settings));

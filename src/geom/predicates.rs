@@ -90,6 +90,67 @@ pub fn line_axis(p: DVec3, q: DVec3) -> usize {
     }
 }
 
+/// The predicates a classification is built from. [`Exact`] is the product; [`Float`] exists
+/// to measure what exactness costs and buys (`--mode fast`).
+pub trait Kernel {
+    /// Sign of `((b - a) × (c - a)) · (d - a)`.
+    fn orient3d(a: DVec3, b: DVec3, c: DVec3, d: DVec3) -> Sign;
+    /// The determinant value (sign as `orient3d`), to place points for the report.
+    fn orient3d_value(a: DVec3, b: DVec3, c: DVec3, d: DVec3) -> f64;
+    /// Sign of component `axis` of `(b - a) × (c - a)`.
+    fn orient2d(a: DVec3, b: DVec3, c: DVec3, axis: usize) -> Sign;
+    /// Are the three points collinear?
+    fn collinear(a: DVec3, b: DVec3, c: DVec3) -> bool {
+        (0..3).all(|k| Self::orient2d(a, b, c, k) == 0)
+    }
+    /// A projection axis on which the triangle does not collapse.
+    fn projection_axis(a: DVec3, b: DVec3, c: DVec3) -> Option<usize> {
+        let n = (b - a).cross(c - a).abs();
+        let mut order = [0usize, 1, 2];
+        order.sort_by(|&i, &j| n[j].total_cmp(&n[i]));
+        order.into_iter().find(|&k| Self::orient2d(a, b, c, k) != 0)
+    }
+}
+
+/// Shewchuk's adaptive exact predicates: signs exact for the f64 inputs.
+pub struct Exact;
+
+impl Kernel for Exact {
+    #[inline]
+    fn orient3d(a: DVec3, b: DVec3, c: DVec3, d: DVec3) -> Sign {
+        orient3d(a, b, c, d)
+    }
+    #[inline]
+    fn orient3d_value(a: DVec3, b: DVec3, c: DVec3, d: DVec3) -> f64 {
+        orient3d_value(a, b, c, d)
+    }
+    #[inline]
+    fn orient2d(a: DVec3, b: DVec3, c: DVec3, axis: usize) -> Sign {
+        orient2d(a, b, c, axis)
+    }
+}
+
+/// Plain f64 determinants, no error bound, no exact fallback: a sign may be wrong (or zero
+/// instead of non-zero, and vice versa) when the points are nearly degenerate.
+pub struct Float;
+
+impl Kernel for Float {
+    #[inline]
+    fn orient3d(a: DVec3, b: DVec3, c: DVec3, d: DVec3) -> Sign {
+        sign(Self::orient3d_value(a, b, c, d))
+    }
+    #[inline]
+    fn orient3d_value(a: DVec3, b: DVec3, c: DVec3, d: DVec3) -> f64 {
+        (b - a).cross(c - a).dot(d - a)
+    }
+    #[inline]
+    fn orient2d(a: DVec3, b: DVec3, c: DVec3, axis: usize) -> Sign {
+        let (u, v) = (b - a, c - a);
+        let (i, j) = ((axis + 1) % 3, (axis + 2) % 3);
+        sign(u[i] * v[j] - u[j] * v[i])
+    }
+}
+
 /// How much f64 rounding may move a closed-form triangle–triangle distance between inputs whose
 /// coordinates are at most `scale` in magnitude: `DISTANCE_ROUNDING_ULPS` ulps of `scale`.
 /// The closest-pair search never prunes a node pair whose box distance is within this of the

@@ -164,3 +164,22 @@ fn degenerate_triangles() {
     let s4 = [v(0.0, 2.0, 1.0), v(2.0, 0.0, 1.0), v(2.0, 0.0, 1.0)];
     assert_eq!(check(&s1, &s4), None);
 }
+
+#[test]
+fn float_kernel_agrees_on_generic_input_and_errs_near_degeneracy() {
+    let b = tri([0.2, 0.2, -1.0], [0.3, 0.2, 1.0], [0.2, 0.6, 1.0]);
+    let exact = classify(&unit(), &b).map(|h| (h.crossing, h.contact));
+    let float = classify_with::<Float>(&unit(), &b).map(|h| (h.crossing, h.contact));
+    assert_eq!(exact, float);
+    // A vertex one ulp below a plane far from the origin: the float determinant loses it.
+    let off = v(1.0e8, 1.0e8, 1.0e8);
+    let a = [v(0.0, 0.0, 0.0), v(1.0, 0.0, 0.3), v(0.0, 1.0, 0.7)].map(|p| p + off);
+    let on = a[0] * 0.25 + a[1] * 0.25 + a[2] * 0.5; // rounded: just off the plane
+    let b = [on, on + v(0.0, 0.0, 1.0), on + v(0.5, 0.0, 1.0)];
+    let e = classify(&a, &b).map(|h| (h.crossing, h.contact));
+    let f = classify_with::<Float>(&a, &b).map(|h| (h.crossing, h.contact));
+    // Exact says what the coordinates really do; the float kernel may or may not agree, but
+    // it must never panic, and the exact answer is invariant under swapping.
+    assert_eq!(e, classify(&b, &a).map(|h| (h.crossing, h.contact)));
+    let _ = f;
+}
