@@ -30,6 +30,15 @@ pub struct Topology {
     pub closed: bool,
     /// One vertex index per connected component (the first, in triangle order).
     pub component_seeds: Vec<u32>,
+    /// For each vertex of the mesh, its component (index into `component_seeds`), or
+    /// `u32::MAX` for a vertex no triangle uses.
+    pub component_of: Vec<u32>,
+    /// For a closed mesh: per triangle, +1 if its normal (right-hand rule) points out of the
+    /// solid, −1 if in, 0 for zero-area triangles. Found by propagating a consistent winding
+    /// across shared edges within each component and taking the sign of each component's
+    /// signed volume, so input winding does not matter. `None` for open meshes, or if some
+    /// component cannot be oriented consistently.
+    pub outward: Option<Vec<i8>>,
 }
 
 /// Merge exactly coincident vertices (+0 and −0 are the same point) and count edge uses.
@@ -53,6 +62,7 @@ pub fn topology(mesh: &Mesh) -> Topology {
         x
     }
     let mut edges: HashMap<(u32, u32), u32> = HashMap::with_capacity(mesh.triangles.len() * 3 / 2);
+    let mut directed: HashMap<(u32, u32), i32> = HashMap::with_capacity(mesh.triangles.len() * 3 / 2);
     for (t, tri) in mesh.triangles.iter().enumerate() {
         let v = tri.map(|i| merged[i as usize]);
         for k in 0..3 {
@@ -67,20 +77,108 @@ pub fn topology(mesh: &Mesh) -> Topology {
         for k in 0..3 {
             let (a, b) = (v[k], v[(k + 1) % 3]);
             *edges.entry((a.min(b), a.max(b))).or_insert(0) += 1;
+            // Net direction: +1 for a -> b with a < b, -1 for the other way.
+            *directed.entry((a.min(b), a.max(b))).or_insert(0) += if a < b { 1 } else { -1 };
         }
     }
     let closed = !edges.is_empty() && edges.values().all(|&c| c == 2);
     // The first vertex (in triangle order) of each component.
-    let mut seen = vec![false; parent.len()];
+    let mut comp_of_root = vec![u32::MAX; parent.len()];
     let mut component_seeds = Vec::new();
     for tri in &mesh.triangles {
         let v = tri[0];
-        let root = find(&mut parent, merged[v as usize]);
-        if !std::mem::replace(&mut seen[root as usize], true) {
+        let root = find(&mut parent, merged[v as usize]) as usize;
+        if comp_of_root[root] == u32::MAX {
+            comp_of_root[root] = component_seeds.len() as u32;
             component_seeds.push(v);
         }
     }
-    Topology { closed, component_seeds }
+    let mut used = vec![false; mesh.positions.len()];
+    for tri in &mesh.triangles {
+        for &v in tri {
+            used[v as usize] = true;
+        }
+    }
+    let component_of = (0..mesh.positions.len())
+        .map(|v| if used[v] { comp_of_root[find(&mut parent, merged[v]) as usize] } else { u32::MAX })
+        .collect();
+    let _ = directed;
+    let outward = if closed { orient(mesh, &merged) } else { None };
+    Topology { closed, component_seeds, component_of, outward }
+}
+
+/// Consistent outward winding of a closed mesh (see [`Topology::outward`]).
+fn orient(mesh: &Mesh, merged: &[u32]) -> Option<Vec<i8>> {
+    let n = mesh.triangles.len();
+    let proper: Vec<bool> =
+        (0..n).map(|t| !Shape::of(&bvh::triangle(mesh, t as u32)).is_degenerate()).collect();
+    // Undirected edge -> the (at most two, as the mesh is closed) triangles using it, with the
+    // direction each traverses it in (+1 when from the lower merged id to the higher).
+    let mut by_edge: HashMap<(u32, u32), Vec<(u32, i8)>> = HashMap::with_capacity(n * 3 / 2);
+    for t in (0..n).filter(|&t| proper[t]) {
+        let v = mesh.triangles[t].map(|i| merged[i as usize]);
+        for k in 0..3 {
+            let (a, b) = (v[k], v[(k + 1) % 3]);
+            by_edge.entry((a.min(b), a.max(b))).or_default().push((t as u32, if a < b { 1 } else { -1 }));
+        }
+    }
+    let mut flip = vec![0i8; n];
+    let mut comps: Vec<Vec<u32>> = Vec::new();
+    for start in (0..n).filter(|&t| proper[t]) {
+        if flip[start] != 0 {
+            continue;
+        }
+        flip[start] = 1;
+        let mut comp = vec![start as u32];
+        let mut queue = vec![start as u32];
+        while let Some(t) = queue.pop() {
+            let v = mesh.triangles[t as usize].map(|i| merged[i as usize]);
+            for k in 0..3 {
+                let (a, b) = (v[k], v[(k + 1) % 3]);
+                let here = if a < b { 1 } else { -1 } * flip[t as usize];
+                for &(u, dir) in &by_edge[&(a.min(b), a.max(b))] {
+                    if u == t {
+                        continue;
+                    }
+                    // The neighbour must traverse the shared edge the other way.
+                    let want = -here * dir;
+                    match flip[u as usize] {
+                        0 => {
+                            flip[u as usize] = want;
+                            comp.push(u);
+                            queue.push(u);
+                        }
+                        f if f != want => return None, // not orientable consistently
+                        _ => {}
+                    }
+                }
+            }
+        }
+        comps.push(comp);
+    }
+    for comp in comps {
+        // Signed volume of the component with the propagated winding (f64: only its sign is
+        // used, and a closed solid's is far from zero unless it is flat).
+        // Relative to a vertex of the component: far from the origin (1e8) the plain triple
+        // products cancel catastrophically.
+        let o = bvh::triangle(mesh, comp[0])[0];
+        let vol: f64 = comp
+            .iter()
+            .map(|&t| {
+                let [a, b, c] = bvh::triangle(mesh, t).map(|p| p - o);
+                a.dot(b.cross(c)) * flip[t as usize] as f64
+            })
+            .sum();
+        if vol == 0.0 {
+            return None;
+        }
+        if vol < 0.0 {
+            for &t in &comp {
+                flip[t as usize] = -flip[t as usize];
+            }
+        }
+    }
+    Some(flip)
 }
 
 /// Ray directions tried in turn: nearly axis-aligned (so the segment's box stays thin and the
@@ -149,6 +247,63 @@ pub fn point_in_closed_mesh(p: DVec3, m: &Mesh, t: &Bvh) -> Inside {
     Inside::Undecided
 }
 
+/// Generalized winding number of `m` at `p` (Jacobson, Kavan, Sorkine-Hornung 2013): the sum
+/// of the triangles' signed solid angles over 4π (Van Oosterom & Strackee 1983). 1 inside a
+/// closed outward-wound surface, 0 outside, in between for open or leaky ones. f64, used only
+/// to decide whether to call an open container's containment "undecided".
+pub fn winding_number(p: DVec3, m: &Mesh) -> f64 {
+    let total: f64 = m
+        .triangles
+        .iter()
+        .map(|t| {
+            let [a, b, c] = t.map(|i| m.positions[i as usize] - p);
+            let (la, lb, lc) = (a.length(), b.length(), c.length());
+            let num = a.dot(b.cross(c));
+            let den = la * lb * lc + a.dot(b) * lc + a.dot(c) * lb + b.dot(c) * la;
+            2.0 * num.atan2(den)
+        })
+        .sum();
+    total / (4.0 * std::f64::consts::PI)
+}
+
+/// Is `p` exactly on a triangle of `m`?
+fn on_surface(p: DVec3, m: &Mesh, t: &Bvh) -> bool {
+    let pt = Aabb { min: p, max: p };
+    let mut stack = vec![0u32];
+    while let Some(i) = stack.pop() {
+        let node = &t.nodes[i as usize];
+        if !node.bounds.overlaps(&pt) {
+            continue;
+        }
+        if !node.is_leaf() {
+            stack.push(node.a);
+            stack.push(i + 1);
+            continue;
+        }
+        for &tri in t.leaf_prims(node) {
+            if crate::tri_tri::classify(&[p, p, p], &bvh::triangle(m, tri)).is_some() {
+                return true;
+            }
+        }
+    }
+    false
+}
+
+/// Do two closed, consistently oriented solids overlap in volume through a face-to-face
+/// contact? A coplanar pair whose outward normals point the same way has both interiors on the
+/// same side of the shared area (duplicated parts, flush overlaps, a part touching a solid's
+/// wall from inside); opposite normals are plain contact. Exact: the normal directions of two
+/// coplanar triangles are compared by 2D orientation signs on one projection.
+pub fn coplanar_overlap(ta: &[DVec3; 3], orient_a: i8, tb: &[DVec3; 3], orient_b: i8) -> bool {
+    if orient_a == 0 || orient_b == 0 {
+        return false;
+    }
+    let Some(k) = pr::projection_axis(ta[0], ta[1], ta[2]) else { return false };
+    let sa = pr::orient2d(ta[0], ta[1], ta[2], k) * orient_a;
+    let sb = pr::orient2d(tb[0], tb[1], tb[2], k) * orient_b;
+    sa != 0 && sa == sb
+}
+
 enum Crossing {
     No,
     Yes,
@@ -199,6 +354,9 @@ pub enum Containment {
     APartlyInB,
     /// Some components of B lie inside A, others outside.
     BPartlyInA,
+    /// Surfaces only touch, but face-to-face contacts show the two solids share volume
+    /// (duplicated parts, flush overlaps, touching a solid's wall from inside).
+    VolumesOverlap,
     /// Could not decide, with the reason.
     Undecided(String),
 }
@@ -212,6 +370,7 @@ impl Containment {
             Containment::BInA => "b_in_a",
             Containment::APartlyInB => "a_partly_in_b",
             Containment::BPartlyInA => "b_partly_in_a",
+            Containment::VolumesOverlap => "volumes_overlap",
             Containment::Undecided(_) => "undecided",
         })
     }
@@ -237,26 +396,45 @@ fn one_way(inner: &Mesh, it: &Topology, outer: &Mesh, ot: &Bvh, otopo: &Topology
         return OneWay::Counts(0, n);
     }
     if !otopo.closed {
-        // Inside an open surface is undefined; it only matters when the box allows it.
-        return if ot.bounds().contains(&ib) {
-            OneWay::Undecided(format!(
-                "{name} is not closed, so whether the other part lies inside it is undefined"
-            ))
-        } else {
-            OneWay::Counts(0, n)
-        };
+        // Inside an open surface is undefined. Say so only where it could matter: the box
+        // allows it and the generalized winding number (Jacobson et al. 2013) at a vertex of
+        // the inner part says "mostly enclosed" (> 1/2; a lone sheet never exceeds 1/2).
+        if ot.bounds().contains(&ib) {
+            let p = inner.positions[it.component_seeds[0] as usize];
+            let w = winding_number(p, outer);
+            if w.abs() > 0.5 {
+                return OneWay::Undecided(format!(
+                    "{name} is not closed, so whether the other part lies inside it is undefined \
+                     (winding number {w:.3} at a vertex of the other part)"
+                ));
+            }
+        }
+        return OneWay::Counts(0, n);
     }
-    let mut inside = 0;
-    for &v in &it.component_seeds {
-        match point_in_closed_mesh(inner.positions[v as usize], outer, ot) {
-            Inside::Yes => inside += 1,
-            Inside::No => {}
+    // One vertex per component decides, provided it is not on the other surface (surfaces may
+    // touch); a component all of whose vertices lie on the other surface decides nothing here
+    // (face-to-face overlaps are caught by orientation, see `coplanar_overlap`).
+    let mut state = vec![None::<bool>; n];
+    for (v, &c) in it.component_of.iter().enumerate() {
+        if c == u32::MAX || state[c as usize].is_some() {
+            continue;
+        }
+        let p = inner.positions[v];
+        if on_surface(p, outer, ot) {
+            continue;
+        }
+        match point_in_closed_mesh(p, outer, ot) {
+            Inside::Yes => state[c as usize] = Some(true),
+            Inside::No => state[c as usize] = Some(false),
             Inside::Undecided => {
                 return OneWay::Undecided(format!("every ray from vertex {v} met an edge of {name} exactly"))
             }
         }
+        if state.iter().all(Option::is_some) {
+            break;
+        }
     }
-    OneWay::Counts(inside, n)
+    OneWay::Counts(state.iter().filter(|s| **s == Some(true)).count(), n)
 }
 
 /// Decide containment both ways for two meshes with no meeting triangles.

@@ -92,10 +92,45 @@ pub struct Input {
 pub fn load_input(spec: &InputSpec) -> Result<Input> {
     let (loaded, format) = load::load_path(&spec.path)?;
     let mut mesh = loaded.mesh;
+    let mut warnings = loaded.warnings;
     if spec.transform != DMat4::IDENTITY {
         place(&mut mesh, &spec.transform, &spec.path)?;
     }
-    Ok(Input { path: spec.path.clone(), format, mesh, warnings: loaded.warnings })
+    warnings.extend(check_range(&mesh, &spec.path)?);
+    Ok(Input { path: spec.path.clone(), format, mesh, warnings })
+}
+
+/// The exact predicates need every coordinate to be 0 or within
+/// [`predicates::MIN_EXACT_MAGNITUDE`], [`predicates::MAX_EXACT_MAGNITUDE`]: larger ones are an
+/// error (no verdict could be trusted), smaller non-zero ones a warning (only pairs whose
+/// coordinate differences are all that small could be misjudged).
+pub fn check_range(mesh: &Mesh, path: &Path) -> Result<Vec<String>> {
+    let mut tiny: Option<(usize, f64)> = None;
+    let mut tiny_count = 0usize;
+    for (i, p) in mesh.positions.iter().enumerate() {
+        for c in p.to_array() {
+            let m = c.abs();
+            if m > predicates::MAX_EXACT_MAGNITUDE {
+                return Err(Error::input(
+                    path,
+                    format!("vertex {i} has coordinate {c:e}, beyond ±2^250 (about 1.8e75), where verdicts stop being exact"),
+                ));
+            }
+            if m != 0.0 && m < predicates::MIN_EXACT_MAGNITUDE {
+                tiny_count += 1;
+                tiny.get_or_insert((i, c));
+            }
+        }
+    }
+    Ok(tiny
+        .map(|(i, c)| {
+            format!(
+                "{tiny_count} coordinates are non-zero but below 2^-250 in magnitude (e.g. {c:e} at vertex {i}): \
+                 verdicts between triangles that small may be inexact"
+            )
+        })
+        .into_iter()
+        .collect())
 }
 
 /// Apply an affine transform to every vertex (f64), rejecting non-finite results.
@@ -271,12 +306,19 @@ pub fn check(a: &Mesh, b: &Mesh, settings: &Settings) -> ClashResult {
     let t0 = Instant::now();
     let (ta, tb) = rayon::join(|| Bvh::build(a, settings.bvh), || Bvh::build(b, settings.bvh));
     let build_ms = ms(t0);
+    let mut r = check_built(a, &ta, b, &tb, settings);
+    r.timings.build_ms = build_ms;
+    r
+}
+
+/// As [`check`], with both trees already built (assemblies reuse one tree for many pairs).
+pub fn check_built(a: &Mesh, ta: &Bvh, b: &Mesh, tb: &Bvh, settings: &Settings) -> ClashResult {
     let t1 = Instant::now();
     let tol = settings.tolerances;
     let stop = AtomicBool::new(false);
     let mut pairs = traverse::collect_pairs(
-        &ta,
-        &tb,
+        ta,
+        tb,
         |x, y| !stop.load(Ordering::Relaxed) && tol.boxes_may_meet(x, y),
         |la, lb, out| {
             for &i in la {
@@ -315,13 +357,15 @@ pub fn check(a: &Mesh, b: &Mesh, settings: &Settings) -> ClashResult {
     let closest = match pairs.iter().find(|p| p.contact.is_some()) {
         Some(p) => Some(contact_witness(a, b, p)),
         None if stop.load(Ordering::Relaxed) => None,
-        None => closest_pair(a, &ta, b, &tb, settings.distance_error),
+        None => closest_pair(a, ta, b, tb, settings.distance_error),
     };
     let (topo_a, topo_b) = rayon::join(|| containment::topology(a), || containment::topology(b));
-    let containment = if counts.crossing + counts.touching - counts.within_tolerance > 0 || settings.first_hit {
-        Containment::None // surfaces meet: a part cannot be strictly inside the other
+    let containment = if counts.crossing > 0 || settings.first_hit {
+        Containment::None // a crossing is a clash already (and first-hit stops looking)
+    } else if volumes_overlap(a, &topo_a, b, &topo_b, &pairs) {
+        Containment::VolumesOverlap
     } else {
-        containment::decide(a, &ta, &topo_a, b, &tb, &topo_b)
+        containment::decide(a, ta, &topo_a, b, tb, &topo_b)
     };
     let verdict = if counts.crossing > 0 || containment.is_clash() {
         Verdict::Clash
@@ -340,8 +384,24 @@ pub fn check(a: &Mesh, b: &Mesh, settings: &Settings) -> ClashResult {
         containment,
         closed: [topo_a.closed, topo_b.closed],
         trees: [ta.stats(), tb.stats()],
-        timings: Timings { build_ms, query_ms: ms(t1) },
+        timings: Timings { build_ms: 0.0, query_ms: ms(t1) },
     }
+}
+
+/// Face-to-face contacts between two closed, consistently oriented solids whose outward
+/// normals agree (see [`containment::coplanar_overlap`]).
+fn volumes_overlap(
+    a: &Mesh,
+    topo_a: &containment::Topology,
+    b: &Mesh,
+    topo_b: &containment::Topology,
+    pairs: &[PairFinding],
+) -> bool {
+    let (Some(oa), Some(ob)) = (&topo_a.outward, &topo_b.outward) else { return false };
+    pairs.iter().filter(|p| p.contact == Some(Contact::CoplanarArea)).any(|p| {
+        let (ta, tb) = (bvh::triangle(a, p.a), bvh::triangle(b, p.b));
+        containment::coplanar_overlap(&ta, oa[p.a as usize], &tb, ob[p.b as usize])
+    })
 }
 
 fn ms(t: Instant) -> f64 {

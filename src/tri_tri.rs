@@ -17,8 +17,8 @@
 //! Zero-area triangles are classified as what they are — segments or points — and can touch
 //! anything, or cross a proper triangle when a segment pierces its interior transversally.
 
-use crate::geom::predicates::{self as pr, Exact, Kernel, Sign};
 pub use crate::geom::predicates::Float;
+use crate::geom::predicates::{self as pr, Exact, Kernel, Sign};
 use crate::geom::DVec3;
 
 /// How two triangles meet.
@@ -148,8 +148,6 @@ impl<K: Kernel> Classifier<K> {
     fn touch(contact: Contact, segment: Option<[DVec3; 2]>) -> Option<Hit> {
         Some(Hit { crossing: false, contact, segment })
     }
-
-
 
     /// `s`: the signs of the triangle's vertices with respect to the other plane (not all equal
     /// strictly, not all zero). `first`: true for triangle `a` (whose normal comes first in `L`).

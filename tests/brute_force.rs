@@ -122,8 +122,11 @@ fn thread_count_does_not_change_the_result() {
         t
     };
     let (a, b) = (mesh(&grid(60, 0.0, 7)), mesh(&grid(60, 0.3, 3)));
-    let settings =
-        Settings { tolerances: Tolerances { touch: 0.0, clearance: 0.2 }, bvh: BuildOptions::default(), ..Default::default() };
+    let settings = Settings {
+        tolerances: Tolerances { touch: 0.0, clearance: 0.2 },
+        bvh: BuildOptions::default(),
+        ..Default::default()
+    };
     let run = |threads: usize| {
         let pool = rayon::ThreadPoolBuilder::new().num_threads(threads).build().unwrap();
         let mut r = pool.install(|| check(&a, &b, &settings));

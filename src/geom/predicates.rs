@@ -5,7 +5,12 @@
 //! implemented by the `robust` crate: a floating-point evaluation with an error bound, falling
 //! back to exact expansion arithmetic only when the bound cannot decide the sign. The signs are
 //! therefore exact for the f64 coordinates as given, as long as no intermediate overflows or
-//! underflows (coordinates between about 1e-140 and 1e140 in magnitude, or exactly zero).
+//! underflows: every coordinate must be 0 or have a magnitude in
+//! [`MIN_EXACT_MAGNITUDE`, `MAX_EXACT_MAGNITUDE`] = [2^-250, 2^250] (about 5.5e-76 to 1.8e75).
+//! Products of three coordinate differences must stay within f64's normal range; the exact
+//! oracle test found overflow from about 2^342 and underflow from about 2^-350 for unit-shaped
+//! triangles, and ulp-sized differences of coordinates near m are m·2^-52, hence the margins.
+//! The loader stage rejects larger coordinates and warns about smaller non-zero ones.
 //!
 //! Nothing outside this module compares a computed geometric quantity against a threshold:
 //! verdicts are built from these signs. The only tolerances are the user's own
@@ -13,6 +18,11 @@
 
 use super::{Aabb, DVec3};
 use robust::{Coord, Coord3D};
+
+/// Largest coordinate magnitude for which the predicates are exact (2^250).
+pub const MAX_EXACT_MAGNITUDE: f64 = f64::from_bits((1023 + 250) << 52);
+/// Smallest non-zero coordinate magnitude for which the predicates are exact (2^-250).
+pub const MIN_EXACT_MAGNITUDE: f64 = f64::from_bits((1023 - 250) << 52);
 
 /// The sign of an exact determinant.
 pub type Sign = i8;
@@ -35,11 +45,71 @@ pub fn orient3d(a: DVec3, b: DVec3, c: DVec3, d: DVec3) -> Sign {
     -sign(robust::orient3d(c3(a), c3(b), c3(c), c3(d)))
 }
 
-/// As [`orient3d`], also returning the (approximate, correctly signed) determinant value, used
-/// only to place an intersection point for the report, never to decide.
-#[inline]
+/// The determinant of [`orient3d`] as a value, used only to place intersection points for the
+/// report, never to decide. Evaluated in double-double arithmetic (about 106 bits) from exact
+/// coordinate differences, so that points are placed accurately even when a vertex is within
+/// rounding of the other plane (where the f64 value has no correct digits); its sign is forced
+/// to the exact one.
 pub fn orient3d_value(a: DVec3, b: DVec3, c: DVec3, d: DVec3) -> f64 {
-    -robust::orient3d(c3(a), c3(b), c3(c), c3(d))
+    let s = orient3d(a, b, c, d);
+    if s == 0 {
+        return 0.0;
+    }
+    let v = dd::orient3d(a, b, c, d);
+    if (v > 0.0) == (s > 0) && v != 0.0 {
+        v
+    } else {
+        // Even 106 bits could not resolve it: the magnitude is below any useful resolution.
+        f64::MIN_POSITIVE * s as f64
+    }
+}
+
+/// Double-double arithmetic (Dekker 1971; Knuth's TwoSum; TwoProduct by fused multiply-add).
+mod dd {
+    use super::DVec3;
+
+    #[derive(Clone, Copy)]
+    pub(super) struct Dd(f64, f64);
+
+    #[inline]
+    fn two_sum(a: f64, b: f64) -> Dd {
+        let s = a + b;
+        let bb = s - a;
+        Dd(s, (a - (s - bb)) + (b - bb))
+    }
+
+    #[inline]
+    fn add(x: Dd, y: Dd) -> Dd {
+        let s = two_sum(x.0, y.0);
+        let lo = s.1 + x.1 + y.1;
+        let h = s.0 + lo;
+        Dd(h, lo - (h - s.0))
+    }
+
+    #[inline]
+    fn neg(x: Dd) -> Dd {
+        Dd(-x.0, -x.1)
+    }
+
+    #[inline]
+    fn mul(x: Dd, y: Dd) -> Dd {
+        let p = x.0 * y.0;
+        let e = x.0.mul_add(y.0, -p);
+        let lo = e + (x.0 * y.1 + x.1 * y.0);
+        let h = p + lo;
+        Dd(h, lo - (h - p))
+    }
+
+    /// `((b - a) × (c - a)) · (d - a)`, differences exact.
+    pub(super) fn orient3d(a: DVec3, b: DVec3, c: DVec3, d: DVec3) -> f64 {
+        let diff = |p: DVec3, k: usize| two_sum(p[k], -a[k]);
+        let (u, v, w) =
+            ([0, 1, 2].map(|k| diff(b, k)), [0, 1, 2].map(|k| diff(c, k)), [0, 1, 2].map(|k| diff(d, k)));
+        let cross = |i: usize, j: usize| add(mul(u[i], v[j]), neg(mul(u[j], v[i])));
+        let n = [cross(1, 2), cross(2, 0), cross(0, 1)];
+        let r = add(add(mul(n[0], w[0]), mul(n[1], w[1])), mul(n[2], w[2]));
+        r.0 + r.1
+    }
 }
 
 /// Drop coordinate `axis` keeping the other two in cyclic order, so that the 2D orientation of
@@ -218,6 +288,26 @@ impl Tolerances {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn orient3d_value_is_accurate_near_coplanarity() {
+        // d is 2^-40 above the plane z = 0.375 tilted by rounding: the exact value is known.
+        let (a, b, c) =
+            (DVec3::new(0.0, 0.0, 0.375), DVec3::new(1.0, 0.0, 0.375), DVec3::new(0.0, 1.0, 0.375));
+        let h = 2f64.powi(-40);
+        let d = DVec3::new(0.3, 0.7, 0.375 + h);
+        assert_eq!(orient3d_value(a, b, c, d), h);
+        let off = DVec3::splat(1.0e8);
+        let v =
+            orient3d_value(a + off, b + off, c + off, DVec3::new(0.25, 0.5, 0.375 + 2f64.powi(-20)) + off);
+        assert_eq!(v, 2f64.powi(-20));
+    }
+
+    #[test]
+    fn range_constants_are_powers_of_two() {
+        assert_eq!(MAX_EXACT_MAGNITUDE, 2f64.powi(250));
+        assert_eq!(MIN_EXACT_MAGNITUDE, 2f64.powi(-250));
+    }
 
     #[test]
     fn orient3d_sign_convention() {
