@@ -34,10 +34,7 @@ pub struct Args {
     pub b: Option<PathBuf>,
     /// `schema`, `completions <shell>` or `man` instead of a check.
     #[command(subcommand)]
-    pub command: Option<crate::output::Command>,
-    /// Output flags: --format, --junit, --baseline, --export-glb.
-    #[command(flatten)]
-    pub outputs: crate::output::OutputArgs,
+    pub command: Option<Command>,
     /// Write the report to FILE (atomically) instead of stdout.
     #[arg(short, long, value_name = "FILE")]
     pub output: Option<PathBuf>,
@@ -94,12 +91,38 @@ pub struct Args {
     /// Allowed absolute error of the minimum distance (model units).
     #[arg(long, value_name = "A", default_value_t = 0.0)]
     pub distance_abs_err: f64,
+    /// Check only parts of A whose name matches GLOB (`*`, `?`; repeatable). Part names are
+    /// glTF node paths (`Engine/Piston_2`), OBJ `o`/`g` names, STL solid names.
+    #[arg(long, value_name = "GLOB")]
+    pub select_a: Vec<String>,
+    /// Check only parts of B matching GLOB (in scene mode: the second set; without it, the
+    /// selected parts are checked all-vs-all).
+    #[arg(long, value_name = "GLOB")]
+    pub select_b: Vec<String>,
+    /// Leave out parts matching GLOB, on both sides (repeatable).
+    #[arg(long, value_name = "GLOB")]
+    pub exclude: Vec<String>,
     /// Deterministic report: no timings, no thread count (byte-identical across runs).
     #[arg(long)]
     pub no_timings: bool,
-    /// Do not print warnings on stderr.
+    /// Output flags: --format, --junit, --baseline, --export-glb.
+    #[command(flatten)]
+    pub outputs: crate::output::OutputArgs,
+    /// Nothing on stderr but errors: no warnings, no summary, no progress.
     #[arg(short, long)]
     pub quiet: bool,
+}
+
+/// Subcommands instead of a check: the generated-text ones of [`crate::output::Command`], and
+/// `bench`.
+#[derive(Debug, clap::Subcommand)]
+pub enum Command {
+    /// `schema`, `completions <shell>`, `man`.
+    #[command(flatten)]
+    Output(crate::output::Command),
+    /// Time meshclash against parry3d (f32 and f64) on generated and given meshes, compare their
+    /// answers, and (--trade) tabulate every speed/accuracy option against the exact default.
+    Bench(crate::bench::BenchArgs),
 }
 
 /// `--fail-on` values.
@@ -176,6 +199,8 @@ pub struct Config {
     pub deterministic: bool,
     /// Run parry3d-f64 too.
     pub cross_check: bool,
+    /// Scene mode and part selections.
+    pub selection: crate::assembly::Selection,
     /// Output format, JUnit and GLB files, baseline.
     pub outputs: crate::output::OutputOptions,
 }
@@ -273,6 +298,11 @@ impl Args {
         if !(1..=64).contains(&self.leaf_size) {
             return Err(Error::Usage(format!("--leaf-size must be 1..=64, got {}", self.leaf_size)));
         }
+        // `meshclash scene FILE`: the word `scene` in place of A (use `./scene` for a file so named).
+        let scene_mode = self.a.as_deref() == Some(std::path::Path::new("scene"));
+        if scene_mode && self.cross_check.is_some() {
+            return Err(Error::Usage("--cross-check works on two files, not with scene".into()));
+        }
         let touch = parse_tolerance("touch-tolerance", &self.touch_tolerance)?;
         let clearance = parse_tolerance("clearance", &self.clearance)?;
         Ok(Config {
@@ -320,6 +350,12 @@ impl Args {
             max_pairs: self.max_pairs,
             deterministic: self.no_timings,
             cross_check: self.cross_check.is_some(),
+            selection: crate::assembly::Selection {
+                scene: scene_mode,
+                select_a: self.select_a.clone(),
+                select_b: self.select_b.clone(),
+                exclude: self.exclude.clone(),
+            },
             outputs: self.outputs.into_options(self.fail_on == FailOnArg::New)?,
         })
     }
@@ -356,8 +392,14 @@ pub fn run_with_progress(cfg: &Config, progress: &(dyn Fn(Phase) + Sync)) -> Res
 fn run_in_pool(cfg: &Config, threads: usize, progress: &(dyn Fn(Phase) + Sync)) -> Result<Outcome> {
     progress(Phase::Load);
     let t0 = Instant::now();
-    let (a, b) = rayon::join(|| query::load_input(&cfg.inputs[0]), || query::load_input(&cfg.inputs[1]));
-    let (a, b) = (a?, b?);
+    let (a, b) = if cfg.selection.scene {
+        // `meshclash scene FILE`: one file, its parts against each other.
+        let a = query::load_input(&cfg.inputs[1])?;
+        (a.clone(), a)
+    } else {
+        let (a, b) = rayon::join(|| query::load_input(&cfg.inputs[0]), || query::load_input(&cfg.inputs[1]));
+        (a?, b?)
+    };
     let load_ms = t0.elapsed().as_secs_f64() * 1e3;
     let size = crate::geom::Aabb::of_points(&a.mesh.positions)
         .union(crate::geom::Aabb::of_points(&b.mesh.positions))
@@ -370,7 +412,10 @@ fn run_in_pool(cfg: &Config, threads: usize, progress: &(dyn Fn(Phase) + Sync)) 
         return Err(Error::Usage("relative tolerance overflows for this model size".into()));
     }
     progress(Phase::Check);
-    let result = query::check(&a.mesh, &b.mesh, &settings);
+    let outcome = crate::assembly::run(&a.mesh, &b.mesh, &cfg.selection, &settings)
+        .map_err(|e| Error::input(&cfg.inputs[1].path, e))?;
+    let assembly = report::assembly_view(&outcome);
+    let result = outcome.result;
     let failed = cfg.fail_on.fails(result.verdict);
     let cross_check = if cfg.cross_check {
         progress(Phase::CrossCheck);
@@ -403,6 +448,7 @@ fn run_in_pool(cfg: &Config, threads: usize, progress: &(dyn Fn(Phase) + Sync)) 
         failed,
         times: (!cfg.deterministic).then(|| (load_ms, t0.elapsed().as_secs_f64() * 1e3)),
         cross_check,
+        assembly,
     };
     let mut rep = report::build(&ctx, &result);
     progress(Phase::Write);

@@ -13,6 +13,8 @@
 //! format. The library never prints.
 #![deny(missing_docs)]
 
+pub mod assembly;
+pub mod bench;
 pub mod bvh;
 pub mod cli;
 pub mod containment;
@@ -22,6 +24,7 @@ pub mod error;
 pub mod geom;
 pub mod load;
 pub mod mesh;
+pub mod output;
 pub mod query;
 pub mod report;
 pub mod traverse;

@@ -2,7 +2,9 @@
 
 use clap::Parser;
 use meshclash::cli::{self, Args};
-use std::io::Write;
+use meshclash::output::progress::{self, Spinner};
+use meshclash::output::{text, Format};
+use std::io::{IsTerminal, Write};
 use std::process::ExitCode;
 
 fn main() -> ExitCode {
@@ -20,14 +22,51 @@ fn main() -> ExitCode {
             return ExitCode::SUCCESS;
         }
     };
+    if let Some(cmd) = &args.command {
+        // `schema`, `completions <shell>`, `man`: generated text on stdout; `bench`: its tables.
+        let text = match cmd {
+            cli::Command::Output(c) => c.render(),
+            cli::Command::Bench(b) => match meshclash::bench::run_command(b) {
+                Ok(t) => t,
+                Err(e) => {
+                    eprintln!("meshclash: error: {e}");
+                    return ExitCode::from(e.exit_code());
+                }
+            },
+        };
+        let mut so = std::io::stdout().lock();
+        let _ = so.write_all(text.as_bytes()).and_then(|_| so.flush());
+        return ExitCode::SUCCESS;
+    }
     let quiet = args.quiet;
-    let outcome = args.into_config().and_then(|cfg| cli::run(&cfg));
+    let format = args.outputs.format;
+    let (stdout_tty, stderr_tty) = (std::io::stdout().is_terminal(), std::io::stderr().is_terminal());
+    let color = std::env::var_os("NO_COLOR").is_none_or(|v| v.is_empty());
+    // Progress and the human summary only for a person at a terminal, never in pipes or CI logs.
+    let spinner = (stderr_tty && !quiet)
+        .then(|| Spinner::start(indicatif::ProgressDrawTarget::stderr(), progress::DEFAULT_DELAY));
+    let on_phase = |p| {
+        if let Some(s) = &spinner {
+            s.phase(p);
+        }
+    };
+    let outcome = args.into_config().and_then(|cfg| cli::run_with_progress(&cfg, &on_phase));
+    if let Some(s) = spinner {
+        s.finish();
+    }
     match outcome {
-        Ok(out) => {
+        Ok(mut out) => {
             if !quiet {
                 for w in &out.warnings {
                     eprintln!("meshclash: warning: {w}");
                 }
+            }
+            let text_on_tty = format == Some(Format::Text) && stdout_tty;
+            if stderr_tty && !quiet && !text_on_tty {
+                eprint!("{}", text::render(&out.report, color));
+            }
+            if text_on_tty && color {
+                out.stdout = Some(text::render(&out.report, true));
             }
             if let Some(json) = out.stdout {
                 let mut so = std::io::stdout().lock();

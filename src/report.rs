@@ -1,13 +1,15 @@
 //! The JSON wire format, documented once here (README repeats it with an example).
 //!
-//! Schema `meshclash.report/1`. Field order is fixed; arrays are sorted; numbers are f64 printed
+//! Schema `meshclash.report/2`: version 1 plus the additive `assembly`, `parts` and `part_pairs`
+//! blocks (every version-1 field keeps its meaning; in scene mode both `inputs` describe the one
+//! file and `pairs` lists triangle pairs between different parts of it). Field order is fixed; arrays are sorted; numbers are f64 printed
 //! shortest-round-trip. With `deterministic` (`--no-timings`) the run-dependent fields
 //! (`settings.threads`, `timings_ms`) are `null`, so the same inputs give byte-identical reports
 //! whatever the thread count.
 //!
 //! ```text
 //! {
-//!   "schema": "meshclash.report/1",
+//!   "schema": "meshclash.report/2",
 //!   "tool": {"name": "meshclash", "version": "0.1.0"},
 //!   "inputs": {
 //!     "a": {"path", "format": "obj|stl|gltf|glb", "vertices", "triangles", "degenerate_triangles", "closed",
@@ -31,6 +33,11 @@
 //!              "distance", "segment": [[x,y,z],[x,y,z]] | null}],
 //!   "pairs_truncated": bool,
 //!   "bvh": {"a": {"nodes", "leaves", "depth", "sah_cost", "bytes"}, "b": {...}},
+//!   "assembly": {"mode": "files|parts", "selected": [a, b], "candidate_part_pairs",
+//!                "built_parts": n | null, "sah_builds": n | null},
+//!   "parts": [{"input": "a|b", "object", "name", "triangles", "bounds"}],
+//!   "part_pairs": [{"a", "b", "a_name", "b_name", "verdict", "crossing_pairs", "touching_pairs",
+//!                   "clearance_pairs", "min_distance": number | null, "contained": string | null}],
 //!   "cross_check": null | {"tool", "intersects", "verdict_agrees", "intersecting_pairs",
 //!                  "distance", "distance_difference", "only_meshclash": [[a,b]], "only_parry": [[a,b]],
 //!                  "only_meshclash_count", "only_parry_count", "parry_ms": [pairs, distance] | null},
@@ -50,7 +57,7 @@ use std::io::Write;
 use std::path::Path;
 
 /// The schema identifier written in every report.
-pub const SCHEMA: &str = "meshclash.report/1";
+pub const SCHEMA: &str = "meshclash.report/2";
 
 /// The whole report.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize, schemars::JsonSchema)]
@@ -80,6 +87,12 @@ pub struct Report {
     pub bvh: Trees,
     /// What parry3d-f64 says on the same input (`--cross-check parry`), else null.
     pub cross_check: Option<CrossCheckReport>,
+    /// How the inputs were split into parts and which part pairs were checked (v2).
+    pub assembly: AssemblyReport,
+    /// Every part of the inputs (A's first; in scene mode only the file's) (v2).
+    pub parts: Vec<PartReport>,
+    /// Part pairs with a finding, sorted by (a, b) (v2).
+    pub part_pairs: Vec<PartPairReport>,
     /// Loader warnings, prefixed with the file.
     pub warnings: Vec<String>,
     /// Phase times (null in deterministic mode).
@@ -87,6 +100,106 @@ pub struct Report {
     /// With `--baseline`: the comparison with the earlier report; absent otherwise.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub baseline: Option<crate::output::baseline::BaselineReport>,
+}
+
+/// The `assembly` block (v2).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, schemars::JsonSchema)]
+#[serde(deny_unknown_fields)]
+pub struct AssemblyReport {
+    /// `files` (two files; pairs grouped by part) or `parts` (scene mode or a selection: each
+    /// candidate part pair checked on its own).
+    pub mode: String,
+    /// Selected parts on the A and B sides.
+    pub selected: [usize; 2],
+    /// Part pairs whose boxes came within the search margin (parts mode), or part pairs with
+    /// findings (files mode).
+    pub candidate_part_pairs: usize,
+    /// Parts that needed a triangle tree; the others cost no build (parts mode only).
+    pub built_parts: Option<usize>,
+    /// Distinct SAH builds: instances of one glTF mesh share one (parts mode only).
+    pub sah_builds: Option<usize>,
+}
+
+/// A part (v2): an OBJ `o`/`g`, an STL `solid`, or a glTF mesh instance.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, schemars::JsonSchema)]
+#[serde(deny_unknown_fields)]
+pub struct PartReport {
+    /// `a` or `b`.
+    pub input: String,
+    /// Object index in that input (`inputs.*.objects`).
+    pub object: u32,
+    /// Name (glTF node path, OBJ group, STL solid).
+    pub name: String,
+    /// Triangle count.
+    pub triangles: usize,
+    /// World box.
+    pub bounds: Bounds,
+}
+
+/// A part pair with findings (v2).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, schemars::JsonSchema)]
+#[serde(deny_unknown_fields)]
+pub struct PartPairReport {
+    /// Index into `parts` (A side).
+    pub a: usize,
+    /// Index into `parts` (B side).
+    pub b: usize,
+    /// Name of part `a`.
+    pub a_name: String,
+    /// Name of part `b`.
+    pub b_name: String,
+    /// The pair's verdict.
+    pub verdict: String,
+    /// Crossing triangle pairs.
+    pub crossing_pairs: u64,
+    /// Touching triangle pairs.
+    pub touching_pairs: u64,
+    /// Clearance triangle pairs.
+    pub clearance_pairs: u64,
+    /// Minimum distance between the two parts, when computed.
+    pub min_distance: Option<f64>,
+    /// Containment between the two parts (a clash), or null.
+    pub contained: Option<String>,
+}
+
+/// Build the v2 part view from an assembly outcome.
+pub fn assembly_view(o: &crate::assembly::Outcome) -> (AssemblyReport, Vec<PartReport>, Vec<PartPairReport>) {
+    let parts = o
+        .parts
+        .iter()
+        .map(|p| PartReport {
+            input: if p.input == 0 { "a".into() } else { "b".into() },
+            object: p.object,
+            name: p.name.clone(),
+            triangles: p.triangles.len(),
+            bounds: Bounds { min: v3(p.bounds.min), max: v3(p.bounds.max) },
+        })
+        .collect();
+    let pairs = o
+        .part_pairs
+        .iter()
+        .map(|pp| PartPairReport {
+            a: pp.a,
+            b: pp.b,
+            a_name: o.parts[pp.a].name.clone(),
+            b_name: o.parts[pp.b].name.clone(),
+            verdict: pp.verdict.name().into(),
+            crossing_pairs: pp.counts.crossing,
+            touching_pairs: pp.counts.touching,
+            clearance_pairs: pp.counts.clearance,
+            min_distance: pp.min_distance,
+            contained: pp.containment.name().map(str::to_string),
+        })
+        .collect();
+    let i = &o.info;
+    let a = AssemblyReport {
+        mode: i.mode.into(),
+        selected: i.selected,
+        candidate_part_pairs: i.candidate_part_pairs,
+        built_parts: i.built_parts,
+        sah_builds: i.sah_builds,
+    };
+    (a, parts, pairs)
 }
 
 /// The `cross_check` block: parry3d-f64's answer and every disagreement with ours.
@@ -372,6 +485,8 @@ pub struct Context<'a> {
     pub times: Option<(f64, f64)>,
     /// The cross-check block, if one was run.
     pub cross_check: Option<CrossCheckReport>,
+    /// The part view (see [`assembly_view`]).
+    pub assembly: (AssemblyReport, Vec<PartReport>, Vec<PartPairReport>),
 }
 
 fn v3(p: DVec3) -> [f64; 3] {
@@ -458,6 +573,9 @@ pub fn build(ctx: &Context, r: &ClashResult) -> Report {
         pairs_truncated: r.pairs.len() > max,
         bvh: Trees { a: tree_report(&r.trees[0]), b: tree_report(&r.trees[1]) },
         cross_check: ctx.cross_check.clone(),
+        assembly: ctx.assembly.0.clone(),
+        parts: ctx.assembly.1.clone(),
+        part_pairs: ctx.assembly.2.clone(),
         warnings,
         timings_ms: ctx.times.map(|(load, total)| TimingsReport {
             load,

@@ -1,0 +1,173 @@
+//! CI-facing outputs built from a finished [`Report`]: the human summary ([`text`]), JUnit XML
+//! ([`junit`]), the baseline diff with stable finding ids ([`baseline`]), a visual GLB scene
+//! ([`glb`]), progress phases ([`progress`]), and the artefacts generated from the command-line
+//! definition (JSON Schema, shell completions, man page).
+//!
+//! Everything here returns strings or bytes, or writes the files it was asked to write; the
+//! library never prints. The binary decides what goes to stdout and stderr.
+
+pub mod baseline;
+pub mod glb;
+pub mod junit;
+pub mod progress;
+pub mod text;
+
+use crate::error::{Error, Result};
+use crate::mesh::Mesh;
+use crate::query::ClashResult;
+use crate::report::{self, Report};
+use clap::CommandFactory;
+use std::path::PathBuf;
+
+/// `--format`: what goes to stdout.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
+pub enum Format {
+    /// The JSON report (`meshclash.report/1`).
+    Json,
+    /// The human summary (the one shown on stderr on a terminal).
+    Text,
+    /// JUnit XML, one test case per checked pair of inputs.
+    Junit,
+}
+
+/// The output flags, flattened into [`crate::cli::Args`].
+#[derive(Debug, Clone, Default, clap::Args)]
+pub struct OutputArgs {
+    /// What to print on stdout: the JSON report, a human summary or JUnit XML [default: json,
+    /// or nothing when -o is given].
+    #[arg(long, value_enum, value_name = "FORMAT")]
+    pub format: Option<Format>,
+    /// Also write JUnit XML to FILE (atomically): one test case per checked pair of inputs,
+    /// failed when the run fails.
+    #[arg(long, value_name = "FILE")]
+    pub junit: Option<PathBuf>,
+    /// Compare with an earlier report: every finding gets a status (new or persistent) and the
+    /// report a `baseline` block with the resolved ones. Findings are matched by stable ids.
+    #[arg(long, value_name = "REPORT")]
+    pub baseline: Option<PathBuf>,
+    /// Write a self-contained GLB scene to FILE: both inputs, the listed pairs highlighted by
+    /// kind, and markers at the closest points and the crossings.
+    #[arg(long, value_name = "FILE")]
+    pub export_glb: Option<PathBuf>,
+}
+
+/// The validated output options (part of [`crate::cli::Config`]).
+#[derive(Debug, Clone, PartialEq, Default)]
+pub struct OutputOptions {
+    /// `--format`, or None for the default (JSON, or nothing when the report goes to a file).
+    pub format: Option<Format>,
+    /// `--junit FILE`.
+    pub junit: Option<PathBuf>,
+    /// `--baseline REPORT`.
+    pub baseline: Option<PathBuf>,
+    /// `--export-glb FILE`.
+    pub export_glb: Option<PathBuf>,
+    /// `--fail-on new`: fail only on new crossings and new containment (needs a baseline).
+    pub fail_on_new: bool,
+}
+
+impl OutputArgs {
+    /// Validate. `fail_on_new` is whether `--fail-on new` was given: it needs `--baseline`.
+    pub fn into_options(self, fail_on_new: bool) -> Result<OutputOptions> {
+        if fail_on_new && self.baseline.is_none() {
+            return Err(Error::Usage("--fail-on new needs --baseline REPORT".into()));
+        }
+        Ok(OutputOptions {
+            format: self.format,
+            junit: self.junit,
+            baseline: self.baseline,
+            export_glb: self.export_glb,
+            fail_on_new,
+        })
+    }
+}
+
+/// The subcommands beside the main `meshclash A B` job. Each prints to stdout.
+#[derive(Debug, Clone, PartialEq, Eq, clap::Subcommand)]
+pub enum Command {
+    /// Print the JSON Schema (draft 2020-12) of the report.
+    Schema,
+    /// Print a shell completion script.
+    Completions {
+        /// The shell.
+        #[arg(value_enum)]
+        shell: clap_complete::Shell,
+    },
+    /// Print the man page (roff).
+    Man,
+}
+
+impl Command {
+    /// What the subcommand prints.
+    pub fn render(&self) -> String {
+        match self {
+            Command::Schema => schema_json(),
+            Command::Completions { shell } => completions(*shell),
+            Command::Man => man_page(),
+        }
+    }
+}
+
+/// The JSON Schema of [`Report`], pretty-printed with a trailing newline.
+pub fn schema_json() -> String {
+    let schema = schemars::schema_for!(Report);
+    let mut s = serde_json::to_string_pretty(&schema).expect("schema serialises");
+    s.push('\n');
+    s
+}
+
+/// A completion script for `shell`, generated from the clap definition.
+pub fn completions(shell: clap_complete::Shell) -> String {
+    let mut cmd = crate::cli::Args::command();
+    let mut out = Vec::new();
+    clap_complete::generate(shell, &mut cmd, "meshclash", &mut out);
+    String::from_utf8_lossy(&out).into_owned()
+}
+
+/// The man page (roff), generated from the clap definition.
+pub fn man_page() -> String {
+    let mut out = Vec::new();
+    clap_mangen::Man::new(crate::cli::Args::command()).render(&mut out).expect("writing to a Vec");
+    String::from_utf8_lossy(&out).into_owned()
+}
+
+/// Complete the report after [`report::build`] and write the side files: finding ids (always),
+/// the baseline comparison and `--fail-on new` (with `--baseline`), the JUnit file and the GLB.
+/// Sets `rep.failed` for `--fail-on new`. `meshes` are the two placed inputs the result was
+/// computed on.
+pub fn finish(
+    opts: &OutputOptions,
+    rep: &mut Report,
+    result: &ClashResult,
+    meshes: [&Mesh; 2],
+) -> Result<()> {
+    let findings = baseline::findings(&result.pairs, meshes[0], meshes[1]);
+    baseline::assign_ids(rep, &findings);
+    if let Some(path) = &opts.baseline {
+        let base = baseline::read(path)?;
+        baseline::compare(rep, &findings, &base);
+    }
+    if opts.fail_on_new {
+        rep.settings.fail_on = "new".into();
+        rep.failed = rep.baseline.as_ref().is_some_and(baseline::fails_on_new);
+    }
+    if let Some(path) = &opts.junit {
+        report::write_atomic(path, junit::from_report(rep).as_bytes())?;
+    }
+    if let Some(path) = &opts.export_glb {
+        report::write_atomic(path, &glb::export(rep, meshes[0], meshes[1]))?;
+    }
+    Ok(())
+}
+
+/// What goes to stdout for `opts.format`, given the finished report and its JSON. With no
+/// `--format` and the report written to a file (`report_to_file`), nothing. Text is uncoloured
+/// (the binary re-renders it in colour on a terminal).
+pub fn stdout_for(opts: &OutputOptions, rep: &Report, json: &str, report_to_file: bool) -> Option<String> {
+    match opts.format {
+        None if report_to_file => None,
+        None | Some(Format::Json) => Some(json.to_string()),
+        Some(Format::Text) => Some(text::render(rep, false)),
+        Some(Format::Junit) => Some(junit::from_report(rep)),
+    }
+}

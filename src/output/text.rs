@@ -1,0 +1,255 @@
+//! The human summary: what a person at a terminal (or reading a CI log) wants first. Verdict and
+//! whether the run failed, the two inputs, counts, the closest points, containment, the worst
+//! findings, the baseline comparison, timings and warnings. ANSI colours only when asked for.
+
+use crate::report::{PairReport, Report};
+use std::fmt::Write;
+
+/// How many findings the summary lists.
+pub const WORST: usize = 5;
+
+const RESET: &str = "\x1b[0m";
+const BOLD: &str = "\x1b[1m";
+const DIM: &str = "\x1b[2m";
+const RED: &str = "\x1b[1;31m";
+const ORANGE: &str = "\x1b[33m";
+const YELLOW: &str = "\x1b[93m";
+const GREEN: &str = "\x1b[1;32m";
+
+struct Paint(bool);
+
+impl Paint {
+    fn p(&self, style: &str, s: &str) -> String {
+        if self.0 {
+            format!("{style}{s}{RESET}")
+        } else {
+            s.to_string()
+        }
+    }
+}
+
+/// A number with 6 significant digits, without trailing zeros (`%g` style).
+pub fn num(x: f64) -> String {
+    if x == 0.0 || !x.is_finite() {
+        return format!("{x}");
+    }
+    let e = x.abs().log10().floor() as i32;
+    let trim = |s: String| {
+        if s.contains('.') {
+            s.trim_end_matches('0').trim_end_matches('.').to_string()
+        } else {
+            s
+        }
+    };
+    if !(-4..6).contains(&e) {
+        let s = format!("{x:.5e}");
+        let (m, exp) = s.split_once('e').expect("exponent");
+        format!("{}e{exp}", trim(m.to_string()))
+    } else {
+        trim(format!("{:.*}", (5 - e).max(0) as usize, x))
+    }
+}
+
+fn point(p: &[f64; 3]) -> String {
+    format!("({}, {}, {})", num(p[0]), num(p[1]), num(p[2]))
+}
+
+fn severity(p: &PairReport) -> (u8, f64) {
+    let rank = match (p.kind.as_str(), p.contact.as_deref()) {
+        ("crossing", _) => 0,
+        ("touching", Some("within_tolerance")) => 2,
+        ("touching", _) => 1,
+        _ => 3,
+    };
+    (rank, p.distance)
+}
+
+/// The listed pairs, worst first: crossing, exact touching, within tolerance, clearance, and
+/// within one kind by distance, then (a, b).
+pub fn worst(r: &Report) -> Vec<&PairReport> {
+    let mut v: Vec<&PairReport> = r.pairs.iter().collect();
+    v.sort_by(|x, y| {
+        let (kx, dx) = severity(x);
+        let (ky, dy) = severity(y);
+        kx.cmp(&ky).then(dx.total_cmp(&dy)).then((x.a, x.b).cmp(&(y.a, y.b)))
+    });
+    v
+}
+
+fn object(r: &Report, side: char, i: u32) -> &str {
+    let objs = if side == 'a' { &r.inputs.a.objects } else { &r.inputs.b.objects };
+    objs.get(i as usize).map_or("?", |o| o.name.as_str())
+}
+
+/// One line describing a pair: kind, triangles with their objects, contact, where.
+pub fn pair_line(r: &Report, p: &PairReport) -> String {
+    let mut s = format!(
+        "{} A#{} ({}) x B#{} ({})",
+        p.kind,
+        p.a,
+        object(r, 'a', p.a_object),
+        p.b,
+        object(r, 'b', p.b_object)
+    );
+    if let Some(c) = &p.contact {
+        let _ = write!(s, " {c}");
+    }
+    if p.distance > 0.0 {
+        let _ = write!(s, " d={}", num(p.distance));
+    }
+    if let Some([x, y]) = &p.segment {
+        if x == y {
+            let _ = write!(s, " at {}", point(x));
+        } else {
+            let _ = write!(s, " {} - {}", point(x), point(y));
+        }
+    }
+    if let Some(st) = &p.status {
+        let _ = write!(s, " [{st}]");
+    }
+    s
+}
+
+/// The summary, several lines ending in a newline; coloured with ANSI escapes if `color`.
+pub fn render(r: &Report, color: bool) -> String {
+    let c = Paint(color);
+    let mut s = String::new();
+    let verdict_style = match r.verdict.as_str() {
+        "clash" => RED,
+        "touching" => ORANGE,
+        "clearance" => YELLOW,
+        _ => GREEN,
+    };
+    let outcome = if r.failed {
+        c.p(RED, &format!("FAILED (--fail-on {})", r.settings.fail_on))
+    } else {
+        c.p(GREEN, &format!("passed (--fail-on {})", r.settings.fail_on))
+    };
+    let _ = writeln!(s, "meshclash: {}  {}", c.p(verdict_style, &r.verdict.to_uppercase()), outcome);
+    for (name, i) in [("A", &r.inputs.a), ("B", &r.inputs.b)] {
+        let _ = writeln!(
+            s,
+            "  {} {}  {}, {} triangles, {} object{}{}",
+            c.p(BOLD, name),
+            i.path,
+            i.format,
+            i.triangles,
+            i.objects.len(),
+            if i.objects.len() == 1 { "" } else { "s" },
+            if i.closed { ", closed" } else { "" }
+        );
+    }
+    let m = &r.summary;
+    let _ = writeln!(
+        s,
+        "  {} crossing, {} touching ({} within tolerance), {} clearance pairs{}",
+        c.p(if m.crossing_pairs > 0 { RED } else { BOLD }, &m.crossing_pairs.to_string()),
+        c.p(if m.touching_pairs > 0 { ORANGE } else { BOLD }, &m.touching_pairs.to_string()),
+        m.within_tolerance_pairs,
+        c.p(if m.clearance_pairs > 0 { YELLOW } else { BOLD }, &m.clearance_pairs.to_string()),
+        if r.pairs_truncated { format!(" ({} listed)", r.pairs.len()) } else { String::new() }
+    );
+    match &r.closest {
+        Some(cl) => {
+            let _ = writeln!(
+                s,
+                "  closest: {} between A#{} ({}) at {} and B#{} ({}) at {}",
+                c.p(BOLD, &num(cl.distance)),
+                cl.a.triangle,
+                object(r, 'a', cl.a.object),
+                point(&cl.a.point),
+                cl.b.triangle,
+                object(r, 'b', cl.b.object),
+                point(&cl.b.point)
+            );
+        }
+        None => s.push_str("  closest: none (an input has no triangles)\n"),
+    }
+    if let Some(ct) = &m.contained {
+        let what = match ct.as_str() {
+            "a_in_b" => "A lies inside B",
+            "b_in_a" => "B lies inside A",
+            "a_partly_in_b" => "part of A lies inside B",
+            "b_partly_in_a" => "part of B lies inside A",
+            _ => "undecided",
+        };
+        let why = m.contained_reason.as_deref().map(|w| format!(": {w}")).unwrap_or_default();
+        let style = if ct == "undecided" { YELLOW } else { RED };
+        let _ = writeln!(s, "  containment: {}{why}", c.p(style, what));
+    }
+    let worst = worst(r);
+    if !worst.is_empty() {
+        let total = m.crossing_pairs + m.touching_pairs + m.clearance_pairs;
+        let _ = writeln!(s, "  worst findings ({} of {total}):", worst.len().min(WORST));
+        for p in worst.iter().take(WORST) {
+            let style = match p.kind.as_str() {
+                "crossing" => RED,
+                "touching" => ORANGE,
+                _ => YELLOW,
+            };
+            let line = pair_line(r, p);
+            let (kind, rest) = line.split_at(p.kind.len());
+            let _ = writeln!(s, "    {}{rest}", c.p(style, kind));
+        }
+    }
+    if let Some(b) = &r.baseline {
+        let _ = writeln!(
+            s,
+            "  baseline {}: {} new ({} new crossing{}), {} persistent, {} resolved{}",
+            b.path,
+            c.p(if b.new > 0 { RED } else { BOLD }, &b.new.to_string()),
+            b.new_crossing,
+            if b.new_containment { ", new containment" } else { "" },
+            b.persistent,
+            c.p(GREEN, &b.resolved.to_string()),
+            if b.complete { "" } else { " (baseline list truncated)" }
+        );
+    }
+    if let Some(x) = &r.cross_check {
+        let _ = writeln!(
+            s,
+            "  cross-check {}: verdict {}, {} pairs only meshclash, {} only parry",
+            x.tool,
+            if x.verdict_agrees { "agrees" } else { "DISAGREES" },
+            x.only_meshclash_count,
+            x.only_parry_count
+        );
+    }
+    if let Some(t) = &r.timings_ms {
+        let _ = writeln!(
+            s,
+            "  {}",
+            c.p(
+                DIM,
+                &format!(
+                    "timings: load {} ms, build {} ms, query {} ms, total {} ms",
+                    num(t.load),
+                    num(t.build),
+                    num(t.query),
+                    num(t.total)
+                )
+            )
+        );
+    }
+    if !r.warnings.is_empty() {
+        let _ = writeln!(s, "  {} warning{}", r.warnings.len(), if r.warnings.len() == 1 { "" } else { "s" });
+    }
+    s
+}
+
+#[cfg(test)]
+mod tests {
+    use super::num;
+
+    #[test]
+    fn numbers_have_six_significant_digits() {
+        assert_eq!(num(0.0), "0");
+        assert_eq!(num(1.0), "1");
+        assert_eq!(num(0.1 + 0.2), "0.3");
+        assert_eq!(num(1750.9), "1750.9");
+        assert_eq!(num(-123456.7), "-123457");
+        assert_eq!(num(1234567.0), "1.23457e6");
+        assert_eq!(num(0.0000123), "1.23e-5");
+        assert_eq!(num(0.054326312), "0.0543263");
+    }
+}

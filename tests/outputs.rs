@@ -1,0 +1,516 @@
+//! The CI-facing outputs through the real binary: JSON Schema (generated, checked in, validated
+//! against real reports), JUnit XML, baseline diff with stable ids and `--fail-on new`, the GLB
+//! scene, text summary, completions and man page, and a quiet stderr when it is not a terminal.
+
+use assert_cmd::Command;
+use meshclash::report::Report;
+use std::collections::BTreeSet;
+use std::path::{Path, PathBuf};
+
+fn root() -> PathBuf {
+    PathBuf::from(env!("CARGO_MANIFEST_DIR"))
+}
+
+fn shipped(name: &str) -> String {
+    root().join("meshes").join(name).display().to_string()
+}
+
+fn bin() -> Command {
+    Command::cargo_bin("meshclash").unwrap()
+}
+
+fn report(stdout: &[u8]) -> Report {
+    serde_json::from_slice(stdout).expect("stdout is a report")
+}
+
+/// One OBJ file with one closed, outward-oriented box per object.
+fn boxes_obj(dir: &Path, file: &str, boxes: &[(&str, [f64; 3], [f64; 3])]) -> String {
+    let mut s = String::new();
+    for (k, (name, lo, hi)) in boxes.iter().enumerate() {
+        s += &format!("o {name}\n");
+        for i in 0..8 {
+            let c = |bit: usize, axis: usize| if i & bit != 0 { hi[axis] } else { lo[axis] };
+            s += &format!("v {} {} {}\n", c(1, 0), c(2, 1), c(4, 2));
+        }
+        let quads = [[0, 2, 3, 1], [4, 5, 7, 6], [0, 1, 5, 4], [2, 6, 7, 3], [0, 4, 6, 2], [1, 3, 7, 5]];
+        let o = 8 * k + 1;
+        for [a, b, c, d] in quads {
+            s += &format!("f {} {} {}\nf {} {} {}\n", a + o, b + o, c + o, a + o, c + o, d + o);
+        }
+    }
+    let path = dir.join(file);
+    std::fs::write(&path, s).unwrap();
+    path.display().to_string()
+}
+
+const SLAB: (&str, [f64; 3], [f64; 3]) = ("slab", [0.0, 0.0, 0.0], [10.0, 10.0, 1.0]);
+
+// ---------------------------------------------------------------- JSON Schema
+
+#[test]
+fn schema_subcommand_matches_the_checked_in_copy() {
+    let out = bin().arg("schema").output().unwrap();
+    assert_eq!(out.status.code(), Some(0));
+    let generated = String::from_utf8(out.stdout).unwrap();
+    let copy = root().join("tests/data/report.schema.json");
+    if std::env::var_os("MESHCLASH_UPDATE_SCHEMA").is_some() {
+        std::fs::write(&copy, &generated).unwrap();
+    }
+    let checked_in = std::fs::read_to_string(&copy).unwrap_or_default();
+    assert!(
+        generated == checked_in,
+        "tests/data/report.schema.json is out of date: run `cargo run -- schema > tests/data/report.schema.json` \
+         (or this test with MESHCLASH_UPDATE_SCHEMA=1)"
+    );
+    let v: serde_json::Value = serde_json::from_str(&generated).unwrap();
+    assert_eq!(v["title"], "Report");
+    assert_eq!(v["additionalProperties"], false, "unknown fields are not allowed");
+}
+
+#[test]
+fn real_reports_validate_against_the_schema() {
+    let schema: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(root().join("tests/data/report.schema.json")).unwrap())
+            .unwrap();
+    let validator = jsonschema::validator_for(&schema).expect("the schema is a valid JSON Schema");
+    let dir = tempfile::tempdir().unwrap();
+    let base = dir.path().join("base.json");
+    let (env, rob) = (shipped("fcl_env.obj"), shipped("fcl_rob.obj"));
+    let runs: Vec<Vec<String>> = vec![
+        vec![env.clone(), rob.clone()],
+        vec![env.clone(), rob.clone(), "--no-timings".into(), "-o".into(), base.display().to_string()],
+        vec![env.clone(), rob.clone(), "--baseline".into(), base.display().to_string()],
+        vec![
+            env.clone(),
+            rob.clone(),
+            "--translate-b".into(),
+            "0,0,300".into(),
+            "--clearance".into(),
+            "500".into(),
+        ],
+        vec![
+            env.clone(),
+            rob.clone(),
+            "--cross-check".into(),
+            "parry".into(),
+            "--max-pairs".into(),
+            "3".into(),
+        ],
+        vec![shipped("SimpleMeshes.gltf"), shipped("pins.glb"), "--touch-tolerance".into(), "1e-3rel".into()],
+    ];
+    let mut saw_baseline = false;
+    for args in runs {
+        let out = bin().args(&args).arg("-q").output().unwrap();
+        assert!(
+            matches!(out.status.code(), Some(0 | 1)),
+            "{args:?}: {}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+        let stdout = if out.stdout.is_empty() { std::fs::read(&base).unwrap() } else { out.stdout };
+        let v: serde_json::Value = serde_json::from_slice(&stdout).unwrap();
+        let errors: Vec<String> = validator.iter_errors(&v).map(|e| e.to_string()).collect();
+        assert!(errors.is_empty(), "{args:?}: {errors:?}");
+        saw_baseline |= v.get("baseline").is_some();
+    }
+    assert!(saw_baseline, "a report with a baseline block was validated");
+
+    // The validation can fail: a wrong type, an unknown field, a missing field.
+    let out = bin().args([&env, &rob, "-q"]).output().unwrap();
+    let good: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    let mut bad = good.clone();
+    bad["verdict"] = serde_json::json!(3);
+    assert!(!validator.is_valid(&bad));
+    let mut bad = good.clone();
+    bad["pairs"][0]["colour"] = serde_json::json!("red");
+    assert!(!validator.is_valid(&bad));
+    let mut bad = good;
+    bad.as_object_mut().unwrap().remove("summary");
+    assert!(!validator.is_valid(&bad));
+}
+
+// ---------------------------------------------------------------- JUnit
+
+fn attr<'a>(n: roxmltree::Node<'a, '_>, name: &str) -> &'a str {
+    n.attribute(name).unwrap_or_else(|| panic!("<{}> has no {name}", n.tag_name().name()))
+}
+
+#[test]
+fn junit_file_has_one_failing_case_with_counts_and_first_findings() {
+    let dir = tempfile::tempdir().unwrap();
+    let xml_path = dir.path().join("junit.xml");
+    let (env, rob) = (shipped("fcl_env.obj"), shipped("fcl_rob.obj"));
+    let out = bin().args([&env, &rob, "-q", "--no-timings", "--junit"]).arg(&xml_path).output().unwrap();
+    assert_eq!(out.status.code(), Some(1));
+    let r = report(&out.stdout); // the JSON still goes to stdout
+    let xml = std::fs::read_to_string(&xml_path).unwrap();
+    let doc = roxmltree::Document::parse(&xml).expect("well-formed XML");
+    let top = doc.root_element();
+    assert_eq!(top.tag_name().name(), "testsuites");
+    let suites: Vec<_> = top.children().filter(|n| n.has_tag_name("testsuite")).collect();
+    assert_eq!(suites.len(), 1);
+    assert_eq!((attr(suites[0], "tests"), attr(suites[0], "failures")), ("1", "1"));
+    let cases: Vec<_> = suites[0].children().filter(|n| n.has_tag_name("testcase")).collect();
+    assert_eq!(cases.len(), 1);
+    assert_eq!(attr(cases[0], "name"), format!("{env} vs {rob}"));
+    let failure = cases[0].children().find(|n| n.has_tag_name("failure")).expect("a failure");
+    assert_eq!(attr(failure, "type"), "clash");
+    let msg = attr(failure, "message");
+    assert!(msg.starts_with("clash: 192 crossing, 0 touching, 0 clearance pairs"), "{msg}");
+    let body = failure.text().unwrap();
+    let lines: Vec<&str> = body.lines().collect();
+    assert_eq!(lines.len(), 11, "{body}");
+    assert_eq!(lines[10], format!("... and {} more", 192 - 10));
+    let first = &r.pairs[0];
+    assert!(lines[0].starts_with(&format!("crossing A#{} (object0) x B#{} (object0)", first.a, first.b)));
+
+    // --format junit puts the same XML on stdout.
+    let out = bin().args([&env, &rob, "-q", "--no-timings", "--format", "junit"]).output().unwrap();
+    assert_eq!(String::from_utf8(out.stdout).unwrap(), xml);
+
+    // A passing run: no failure element.
+    let out = bin().args([&env, &rob, "-q", "--fail-on", "never", "--format", "junit"]).output().unwrap();
+    assert_eq!(out.status.code(), Some(0));
+    let xml = String::from_utf8(out.stdout).unwrap();
+    let doc = roxmltree::Document::parse(&xml).unwrap();
+    assert_eq!(attr(doc.root_element(), "failures"), "0");
+    assert!(doc.descendants().all(|n| !n.has_tag_name("failure")));
+}
+
+#[test]
+fn junit_escapes_names() {
+    let dir = tempfile::tempdir().unwrap();
+    let nasty = "p<1>&\"q'";
+    let a = boxes_obj(dir.path(), "a&b.obj", &[(nasty, [0.0; 3], [2.0; 3])]);
+    let b = boxes_obj(dir.path(), "b.obj", &[("pin", [1.0; 3], [3.0; 3])]);
+    let out = bin().args([&a, &b, "-q", "--format", "junit"]).output().unwrap();
+    assert_eq!(out.status.code(), Some(1));
+    let xml = String::from_utf8(out.stdout).unwrap();
+    let doc = roxmltree::Document::parse(&xml).expect("escaped properly");
+    let case = doc.descendants().find(|n| n.has_tag_name("testcase")).unwrap();
+    assert!(attr(case, "name").contains("a&b.obj"));
+    let failure = case.children().find(|n| n.has_tag_name("failure")).unwrap();
+    assert!(failure.text().unwrap().contains(&format!("({nasty})")));
+}
+
+// ---------------------------------------------------------------- baseline
+
+fn pairs_of<'a>(r: &'a Report, b_object: &str) -> Vec<&'a meshclash::report::PairReport> {
+    let i = r.inputs.b.objects.iter().position(|o| o.name == b_object).unwrap() as u32;
+    r.pairs.iter().filter(|p| p.b_object == i).collect()
+}
+
+fn ids(pairs: &[&meshclash::report::PairReport]) -> BTreeSet<String> {
+    pairs.iter().map(|p| p.id.clone().expect("every pair has an id")).collect()
+}
+
+#[test]
+fn baseline_marks_new_persistent_and_resolved_by_stable_ids() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let a = boxes_obj(d, "fixture.obj", &[SLAB]);
+    let through = |lo: f64| ([lo, lo, -1.0], [lo + 1.0, lo + 1.0, 2.0]);
+    let above = |lo: f64| ([lo, lo, 3.0], [lo + 1.0, lo + 1.0, 5.0]);
+    // Before: pin1 and pin2 go through the slab, pin3 is above it.
+    let (p1, p2, p3) = (through(1.0), through(5.0), above(8.0));
+    let before =
+        boxes_obj(d, "before.obj", &[("pin1", p1.0, p1.1), ("pin2", p2.0, p2.1), ("pin3", p3.0, p3.1)]);
+    // After: pin2 lifted clear, pin3 pushed through, pin1 unchanged but written last (so its
+    // triangle indices change).
+    let (q2, q3) = (above(5.0), through(8.0));
+    let after =
+        boxes_obj(d, "after.obj", &[("pin3", q3.0, q3.1), ("pin2", q2.0, q2.1), ("pin1", p1.0, p1.1)]);
+
+    let base_path = d.join("before.json");
+    let out = bin().args([&a, &before, "-q", "-o"]).arg(&base_path).output().unwrap();
+    assert_eq!(out.status.code(), Some(1));
+    let old: Report = serde_json::from_slice(&std::fs::read(&base_path).unwrap()).unwrap();
+    assert!(old.baseline.is_none() && old.pairs.iter().all(|p| p.status.is_none()));
+
+    let out = bin().args([&a, &after, "-q", "--baseline"]).arg(&base_path).output().unwrap();
+    assert_eq!(out.status.code(), Some(1), "default --fail-on clash still fails");
+    let new = report(&out.stdout);
+
+    let (old1, old2, old3) = (pairs_of(&old, "pin1"), pairs_of(&old, "pin2"), pairs_of(&old, "pin3"));
+    let (new1, new2, new3) = (pairs_of(&new, "pin1"), pairs_of(&new, "pin2"), pairs_of(&new, "pin3"));
+    assert!(!old1.is_empty() && !old2.is_empty() && old3.is_empty());
+    assert!(!new1.is_empty() && new2.is_empty() && !new3.is_empty());
+    let crossing =
+        |v: &[&meshclash::report::PairReport]| v.iter().filter(|p| p.kind == "crossing").count() as u64;
+    assert!(crossing(&new3) > 0 && crossing(&old1) > 0);
+    // pin1's findings: other triangle indices, same ids.
+    assert_ne!(old1.iter().map(|p| p.b).collect::<Vec<_>>(), new1.iter().map(|p| p.b).collect::<Vec<_>>());
+    assert_eq!(ids(&old1), ids(&new1));
+    assert!(new1.iter().all(|p| p.status.as_deref() == Some("persistent")));
+    assert!(new3.iter().all(|p| p.status.as_deref() == Some("new")));
+
+    let b = new.baseline.as_ref().expect("a baseline block");
+    assert_eq!(b.path, base_path.display().to_string());
+    assert_eq!(b.new, new3.len() as u64);
+    assert_eq!(b.new_crossing, crossing(&new3));
+    assert_eq!(b.persistent, new1.len() as u64);
+    assert_eq!(b.resolved, old2.len() as u64);
+    assert_eq!(b.resolved_ids, ids(&old2).into_iter().collect::<Vec<_>>());
+    assert!(!b.new_containment && b.complete);
+    assert!(ids(&new3).is_disjoint(&ids(&old1).union(&ids(&old2)).cloned().collect()));
+
+    // --fail-on new: fails on the new crossing; a run against itself passes although it clashes.
+    let out =
+        bin().args([&a, &after, "-q", "--fail-on", "new", "--baseline"]).arg(&base_path).output().unwrap();
+    assert_eq!(out.status.code(), Some(1));
+    let r = report(&out.stdout);
+    assert!(r.failed);
+    assert_eq!(r.settings.fail_on, "new");
+    let same = d.join("after.json");
+    bin().args([&a, &after, "-q", "-o"]).arg(&same).output().unwrap();
+    let out = bin().args([&a, &after, "-q", "--fail-on", "new", "--baseline"]).arg(&same).output().unwrap();
+    assert_eq!(out.status.code(), Some(0));
+    let r = report(&out.stdout);
+    assert_eq!(r.verdict, "clash");
+    assert!(!r.failed);
+    let b = r.baseline.unwrap();
+    assert_eq!((b.new, b.resolved, b.persistent), (0, 0, r.pairs.len() as u64));
+}
+
+#[test]
+fn fail_on_new_counts_new_containment_and_needs_a_baseline() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let a = boxes_obj(d, "case.obj", &[("case", [0.0; 3], [10.0; 3])]);
+    let outside = boxes_obj(d, "out.obj", &[("part", [20.0; 3], [21.0; 3])]);
+    let inside = boxes_obj(d, "in.obj", &[("part", [4.0; 3], [5.0; 3])]);
+    let base = d.join("base.json");
+    let out = bin().args([&a, &outside, "-q", "-o"]).arg(&base).output().unwrap();
+    assert_eq!(out.status.code(), Some(0));
+    let out = bin().args([&a, &inside, "-q", "--fail-on", "new", "--baseline"]).arg(&base).output().unwrap();
+    assert_eq!(out.status.code(), Some(1));
+    let r = report(&out.stdout);
+    assert_eq!(r.summary.contained.as_deref(), Some("b_in_a"));
+    let b = r.baseline.unwrap();
+    assert!(b.new_containment);
+    assert_eq!(b.new_crossing, 0);
+
+    let out = bin().args([&a, &inside, "--fail-on", "new"]).output().unwrap();
+    assert_eq!(out.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&out.stderr).contains("--baseline"));
+    // A baseline from an older version (no ids) is bad input.
+    let mut old: serde_json::Value = serde_json::from_slice(
+        &bin().args([&shipped("fcl_env.obj"), &shipped("fcl_rob.obj"), "-q"]).output().unwrap().stdout,
+    )
+    .unwrap();
+    for p in old["pairs"].as_array_mut().unwrap() {
+        p.as_object_mut().unwrap().remove("id");
+    }
+    std::fs::write(&base, old.to_string()).unwrap();
+    let out = bin().args([&a, &inside, "--baseline"]).arg(&base).output().unwrap();
+    assert_eq!(out.status.code(), Some(2));
+    let err = String::from_utf8_lossy(&out.stderr).into_owned();
+    assert_eq!(err.lines().count(), 1, "{err}");
+    assert!(err.contains("no id"), "{err}");
+}
+
+// ---------------------------------------------------------------- GLB
+
+/// Load a GLB: (node name -> (mesh index, triangle count of its TRIANGLES primitives)), the
+/// document, and the BIN chunk.
+fn load_glb(path: &Path) -> (Vec<(String, usize)>, gltf::Document, Vec<u8>) {
+    let bytes = std::fs::read(path).unwrap();
+    let g = gltf::Gltf::from_slice(&bytes).expect("a valid GLB");
+    let blob = g.blob.clone().expect("a BIN chunk");
+    let doc = g.document;
+    let mut nodes = Vec::new();
+    for node in doc.nodes() {
+        let mut tris = 0;
+        if let Some(mesh) = node.mesh() {
+            for prim in mesh.primitives() {
+                if prim.mode() == gltf::mesh::Mode::Triangles {
+                    let reader = prim.reader(|_| Some(&blob));
+                    let idx: Vec<u32> = reader.read_indices().expect("indexed").into_u32().collect();
+                    let n = reader.read_positions().unwrap().count() as u32;
+                    assert!(idx.iter().all(|&i| i < n));
+                    assert_eq!(idx.len() % 3, 0);
+                    tris += idx.len() / 3;
+                }
+            }
+        }
+        nodes.push((node.name().unwrap_or("").to_string(), tris));
+    }
+    (nodes, doc, blob)
+}
+
+fn distinct(r: &Report, kind: &str) -> usize {
+    let ps = r.pairs.iter().filter(|p| p.kind == kind);
+    ps.clone().map(|p| p.a).collect::<BTreeSet<_>>().len() + ps.map(|p| p.b).collect::<BTreeSet<_>>().len()
+}
+
+#[test]
+fn glb_shows_inputs_highlights_and_markers() {
+    let dir = tempfile::tempdir().unwrap();
+    let glb = dir.path().join("clash.glb");
+    let (env, rob) = (shipped("fcl_env.obj"), shipped("fcl_rob.obj"));
+    let out = bin().args([&env, &rob, "-q", "--export-glb"]).arg(&glb).output().unwrap();
+    assert_eq!(out.status.code(), Some(1));
+    let r = report(&out.stdout);
+    let (nodes, doc, blob) = load_glb(&glb);
+    let names: Vec<&str> = nodes.iter().map(|(n, _)| n.as_str()).collect();
+    let a_name = format!("A: {env}");
+    let b_name = format!("B: {rob}");
+    assert_eq!(
+        names,
+        ["meshclash", &a_name, &b_name, "crossing pairs", "closest points", "crossing markers"]
+    );
+    assert_eq!(doc.meshes().count(), 5);
+    let tris = |name: &str| nodes.iter().find(|(n, _)| n == name).unwrap().1;
+    assert_eq!(tris(&a_name), r.inputs.a.triangles);
+    assert_eq!(tris(&b_name), r.inputs.b.triangles);
+    assert_eq!(tris("crossing pairs"), distinct(&r, "crossing"));
+    assert_eq!(tris("crossing markers"), 8 * r.summary.crossing_pairs as usize);
+    assert_eq!(tris("closest points"), 16);
+    // Inputs are semi-transparent; highlights are opaque red.
+    let node = |name: &str| doc.nodes().find(|n| n.name() == Some(name)).unwrap();
+    let mat = |name: &str| node(name).mesh().unwrap().primitives().next().unwrap().material();
+    assert_eq!(mat(&a_name).alpha_mode(), gltf::material::AlphaMode::Blend);
+    assert!(mat(&a_name).pbr_metallic_roughness().base_color_factor()[3] < 1.0);
+    assert_eq!(mat("crossing pairs").pbr_metallic_roughness().base_color_factor(), [1.0, 0.0, 0.0, 1.0]);
+    // Positions are relative to the root's translation: together they give back A's bounds.
+    let t = node("meshclash").transform().decomposed().0;
+    let prim = node(&a_name).mesh().unwrap().primitives().next().unwrap();
+    let p: Vec<[f32; 3]> = prim.reader(|_| Some(&blob)).read_positions().unwrap().collect();
+    for k in 0..3 {
+        let lo = p.iter().map(|v| v[k]).fold(f32::INFINITY, f32::min) as f64 + t[k] as f64;
+        let hi = p.iter().map(|v| v[k]).fold(f32::NEG_INFINITY, f32::max) as f64 + t[k] as f64;
+        assert!((lo - r.inputs.a.bounds.min[k]).abs() < 1e-2, "{lo} vs {:?}", r.inputs.a.bounds);
+        assert!((hi - r.inputs.a.bounds.max[k]).abs() < 1e-2);
+    }
+}
+
+#[test]
+fn glb_highlights_each_kind_in_its_own_mesh() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let a = boxes_obj(d, "slab.obj", &[SLAB]);
+    let b = boxes_obj(
+        d,
+        "parts.obj",
+        &[
+            ("through", [1.0, 1.0, -1.0], [2.0, 2.0, 2.0]),
+            ("sitting", [4.0, 4.0, 1.0], [5.0, 5.0, 2.0]),
+            ("hovering", [7.0, 7.0, 1.5], [8.0, 8.0, 2.5]),
+        ],
+    );
+    let glb = d.join("kinds.glb");
+    let out = bin().args([&a, &b, "-q", "--clearance", "1", "--export-glb"]).arg(&glb).output().unwrap();
+    assert_eq!(out.status.code(), Some(1));
+    let r = report(&out.stdout);
+    assert!(r.summary.crossing_pairs > 0 && r.summary.touching_pairs > 0 && r.summary.clearance_pairs > 0);
+    let (nodes, doc, _) = load_glb(&glb);
+    let tris = |name: &str| nodes.iter().find(|(n, _)| n == name).unwrap_or_else(|| panic!("no {name}")).1;
+    assert_eq!(tris("crossing pairs"), distinct(&r, "crossing"));
+    assert_eq!(tris("touching pairs"), distinct(&r, "touching"));
+    assert_eq!(tris("clearance pairs"), distinct(&r, "clearance"));
+    let colour = |name: &str| {
+        let n = doc.nodes().find(|n| n.name() == Some(name)).unwrap();
+        n.mesh().unwrap().primitives().next().unwrap().material().pbr_metallic_roughness().base_color_factor()
+    };
+    assert_eq!(colour("touching pairs"), [1.0, 0.5, 0.0, 1.0]);
+    assert_eq!(colour("clearance pairs"), [1.0, 0.9, 0.0, 1.0]);
+    assert_eq!(doc.meshes().count(), 2 + 3 + 2);
+}
+
+// ---------------------------------------------------------------- text, stderr, completions
+
+#[test]
+fn format_text_prints_the_summary_and_o_still_writes_json() {
+    let dir = tempfile::tempdir().unwrap();
+    let json = dir.path().join("r.json");
+    let out = bin()
+        .args([&shipped("fcl_env.obj"), &shipped("fcl_rob.obj"), "-q", "--format", "text", "-o"])
+        .arg(&json)
+        .output()
+        .unwrap();
+    assert_eq!(out.status.code(), Some(1));
+    let text = String::from_utf8(out.stdout).unwrap();
+    assert!(text.starts_with("meshclash: CLASH  FAILED (--fail-on clash)\n"), "{text}");
+    assert!(text.contains("192 crossing, 0 touching (0 within tolerance), 0 clearance pairs"));
+    assert!(text.contains("closest: 0 between A#"));
+    assert!(text.contains("worst findings (5 of 192):"));
+    assert!(!text.contains('\x1b'), "no colour when stdout is not a terminal");
+    let r: Report = serde_json::from_slice(&std::fs::read(&json).unwrap()).unwrap();
+    assert_eq!(r.summary.crossing_pairs, 192);
+}
+
+#[test]
+fn stderr_that_is_not_a_terminal_gets_no_summary_and_no_progress() {
+    // No warnings for these inputs: stderr must be empty (assert_cmd's stderr is a pipe).
+    let out = bin().args([&shipped("joined_tetrahedra.obj"), &shipped("multibody.stl")]).output().unwrap();
+    assert!(matches!(out.status.code(), Some(0 | 1)));
+    assert_eq!(String::from_utf8_lossy(&out.stderr), "");
+    // With warnings: exactly the warning lines.
+    let out = bin().args([&shipped("fcl_env.obj"), &shipped("fcl_rob.obj")]).output().unwrap();
+    let err = String::from_utf8(out.stderr).unwrap();
+    assert_eq!(err.lines().count(), 2, "{err}");
+    assert!(err.lines().all(|l| l.starts_with("meshclash: warning: ")), "{err}");
+}
+
+/// Run under a pseudo-terminal with util-linux `script`, if there is one.
+fn on_a_terminal(args: &[String], env: &[(&str, &str)]) -> Option<String> {
+    let exe = assert_cmd::cargo::cargo_bin("meshclash");
+    let cmd = std::iter::once(exe.display().to_string())
+        .chain(args.iter().cloned())
+        .map(|a| format!("'{}'", a.replace('\'', "'\\''")))
+        .collect::<Vec<_>>()
+        .join(" ");
+    let mut c = std::process::Command::new("script");
+    c.args(["-qec", &cmd, "/dev/null"]).env_remove("NO_COLOR").stdin(std::process::Stdio::null());
+    for (k, v) in env {
+        c.env(k, v);
+    }
+    let out = c.output().ok()?;
+    let s = String::from_utf8_lossy(&out.stdout).into_owned();
+    (out.status.code() == Some(1) && s.contains("meshclash")).then_some(s)
+}
+
+#[test]
+fn a_terminal_gets_the_summary_in_colour_unless_no_color() {
+    let dir = tempfile::tempdir().unwrap();
+    let json = dir.path().join("r.json").display().to_string();
+    let args = vec![shipped("fcl_env.obj"), shipped("fcl_rob.obj"), "-o".to_string(), json];
+    let Some(tty) = on_a_terminal(&args, &[]) else {
+        eprintln!("skipped: no usable `script` for a pseudo-terminal");
+        return;
+    };
+    assert!(tty.contains("192"), "{tty}");
+    assert!(tty.contains("\x1b[1;31mCLASH\x1b[0m"), "{tty:?}");
+    let plain = on_a_terminal(&args, &[("NO_COLOR", "1")]).unwrap();
+    let line = plain.lines().find(|l| l.contains("CLASH")).expect("summary");
+    assert!(line.contains("meshclash: CLASH  FAILED"), "{line:?}");
+    assert!(!line.contains("\x1b[1;31m"), "{line:?}");
+    let mut quiet = args.clone();
+    quiet.push("-q".into());
+    assert!(!on_a_terminal(&quiet, &[]).unwrap_or_default().contains("CLASH"));
+}
+
+#[test]
+fn completions_and_man_page_mention_the_flags() {
+    for shell in ["bash", "zsh", "fish", "powershell", "elvish"] {
+        let out = bin().args(["completions", shell]).output().unwrap();
+        assert_eq!(out.status.code(), Some(0), "{shell}");
+        let s = String::from_utf8(out.stdout).unwrap();
+        let flag = if shell == "fish" { "-l clearance" } else { "--clearance" };
+        assert!(s.contains(flag), "{shell}: {s}");
+        assert!(s.contains("export-glb"), "{shell}");
+    }
+    let out = bin().arg("man").output().unwrap();
+    assert_eq!(out.status.code(), Some(0));
+    let man = String::from_utf8(out.stdout).unwrap();
+    assert!(man.starts_with(".ie") || man.contains(".TH meshclash"), "{man}");
+    assert!(man.contains("\\-\\-clearance"));
+    assert!(bin().args(["completions", "tcsh"]).output().unwrap().status.code() == Some(2));
+}
+
+#[test]
+fn subcommand_names_are_files_once_a_mesh_is_given() {
+    // `meshclash A schema` checks A against a file called `schema`.
+    let out = bin().args([&shipped("fcl_env.obj"), "schema", "-q"]).output().unwrap();
+    assert_eq!(out.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&out.stderr).starts_with("meshclash: error: schema: "));
+}
