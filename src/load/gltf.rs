@@ -15,7 +15,8 @@
 //!   warning); `EXT_mesh_gpu_instancing` is ignored with a warning unless required.
 //! - **Vertices**: every primitive instance contributes its own vertices, transformed to world
 //!   space in f64 (no merging across primitives or instances). A scene expanding to more than
-//!   [`MAX_SCENE_VERTICES`] vertices is refused before anything is allocated for it.
+//!   [`MAX_SCENE_VERTICES`] vertices or [`MAX_SCENE_TRIANGLES`] triangles is refused before
+//!   anything is allocated for it.
 //! - **Triangle order**: scene traversal order (depth-first pre-order over the scene's root
 //!   nodes in the order listed, children in listed order); within a node, its mesh's primitives
 //!   in order; within a primitive, index order.
@@ -42,6 +43,10 @@ pub(crate) const MAX_DEPTH: usize = 1024;
 /// The most vertices a scene may expand to through instancing (2^28, 6 GiB of f64
 /// positions): a small file instancing a big mesh many times must fail, not exhaust memory.
 pub(crate) const MAX_SCENE_VERTICES: usize = 1 << 28;
+
+/// The most triangles a scene may expand to through instancing (2^28, 4 GiB of triangles and
+/// object ids): many instances of a mesh with few vertices but many indices must fail too.
+pub(crate) const MAX_SCENE_TRIANGLES: usize = 1 << 28;
 
 /// Loads `.gltf` or `.glb` `bytes` (the GLB magic decides); see the module doc.
 pub(crate) fn load(path: &Path, bytes: &[u8]) -> Result<Loaded> {
@@ -71,6 +76,16 @@ pub(crate) fn load(path: &Path, bytes: &[u8]) -> Result<Loaded> {
             format!(
                 "glTF scene has {total_v} vertices after instancing, more than the \
                  {MAX_SCENE_VERTICES} supported"
+            ),
+        ));
+    }
+
+    if total_t > MAX_SCENE_TRIANGLES {
+        return Err(Error::input(
+            path,
+            format!(
+                "glTF scene has {total_t} triangles after instancing, more than the \
+                 {MAX_SCENE_TRIANGLES} supported"
             ),
         ));
     }

@@ -1,0 +1,9 @@
+#![no_main]
+//! `meshclash::load::load_bytes` as Gltf on arbitrary bytes; invariants checked on `Ok`.
+
+use libfuzzer_sys::fuzz_target;
+use meshclash::load::Format;
+
+fuzz_target!(|data: &[u8]| {
+    meshclash_fuzz::check("fuzz.gltf", data, Format::Gltf);
+});

@@ -1,0 +1,9 @@
+#![no_main]
+//! `meshclash::load::load_bytes` as Stl on arbitrary bytes; invariants checked on `Ok`.
+
+use libfuzzer_sys::fuzz_target;
+use meshclash::load::Format;
+
+fuzz_target!(|data: &[u8]| {
+    meshclash_fuzz::check("fuzz.stl", data, Format::Stl);
+});
