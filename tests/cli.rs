@@ -38,6 +38,9 @@ fn parse(stdout: &[u8]) -> Report {
         "pairs_truncated",
         "bvh",
         "cross_check",
+        "assembly",
+        "parts",
+        "part_pairs",
         "warnings",
         "timings_ms",
     ];
@@ -54,7 +57,7 @@ fn main_job_on_shipped_meshes_reports_the_clash_and_exits_1() {
     let out = bin().args([shipped("fcl_env.obj"), shipped("fcl_rob.obj")]).output().unwrap();
     assert_eq!(out.status.code(), Some(1));
     let r = parse(&out.stdout);
-    assert_eq!(r.schema, "meshclash.report/1");
+    assert_eq!(r.schema, "meshclash.report/2");
     assert_eq!(r.verdict, "clash");
     assert!(r.failed);
     assert_eq!(r.summary.min_distance, Some(0.0));
@@ -268,11 +271,16 @@ fn a_part_hidden_inside_another_is_a_clash() {
     assert_eq!(r.summary.min_distance, Some(4.0));
     let out = bin().args([&outer, &inner]).output().unwrap();
     assert_eq!(parse(&out.stdout).summary.contained.as_deref(), Some("b_in_a"));
-    // Touching the container from inside: a face-to-face contact, no containment claim.
+    // Touching the container's wall from inside: the faces coincide with the same outward
+    // normal, so the solids share volume: a clash, though no pair crosses.
     let touching = cube_obj(dir.path(), "touch.obj", [0.0, 4.0, 4.0], [1.0, 5.0, 5.0]);
     let r = parse(&bin().args([&touching, &outer]).output().unwrap().stdout);
-    assert_eq!(r.verdict, "touching");
-    assert_eq!(r.summary.contained, None);
+    assert_eq!((r.verdict.as_str(), r.summary.crossing_pairs), ("clash", 0));
+    assert_eq!(r.summary.contained.as_deref(), Some("volumes_overlap"));
+    // Stacked on the outside: opposite normals, plain contact.
+    let stacked = cube_obj(dir.path(), "stack.obj", [10.0, 4.0, 4.0], [11.0, 5.0, 5.0]);
+    let r = parse(&bin().args([&stacked, &outer]).output().unwrap().stdout);
+    assert_eq!((r.verdict.as_str(), r.summary.contained.as_deref()), ("touching", None));
     // Outside: clear.
     let apart = cube_obj(dir.path(), "apart.obj", [20.0; 3], [21.0; 3]);
     let r = parse(&bin().args([&apart, &outer]).output().unwrap().stdout);
@@ -311,4 +319,65 @@ fn relative_tolerances_resolve_against_model_size() {
     assert_eq!(r.verdict, "clearance");
     let r = parse(&bin().args([&a, &b, "--clearance", "0.3"]).output().unwrap().stdout);
     assert_eq!((r.verdict.as_str(), r.settings.clearance_given.as_str()), ("clearance", "0.3"));
+}
+
+#[test]
+fn coordinates_outside_the_exact_range_are_rejected_or_flagged() {
+    let dir = tempfile::tempdir().unwrap();
+    let ok = shipped("fcl_rob.obj");
+    let huge = dir.path().join("huge.obj");
+    std::fs::write(&huge, "v 0 0 0\nv 1e120 0 0\nv 0 1e120 0\nf 1 2 3\n").unwrap();
+    let err = error_line(&[&ok, huge.to_str().unwrap()]);
+    assert!(err.contains("huge.obj") && err.contains("2^250"), "{err}");
+    let tiny = dir.path().join("tiny.obj");
+    std::fs::write(&tiny, "v 0 0 0\nv 1 0 1e-300\nv 0 1 0\nf 1 2 3\n").unwrap();
+    let out = bin().args([&ok, tiny.to_str().unwrap()]).output().unwrap();
+    assert_eq!(out.status.code(), Some(0));
+    let r = parse(&out.stdout);
+    assert!(r.warnings.iter().any(|w| w.contains("below 2^-250")), "{:?}", r.warnings);
+}
+
+#[test]
+fn scene_checks_every_part_against_every_other() {
+    let out = bin().args(["scene", &shipped("pins.glb"), "--no-timings"]).output().unwrap();
+    assert_eq!(out.status.code(), Some(1));
+    let r = parse(&out.stdout);
+    assert_eq!(r.schema, "meshclash.report/2");
+    assert_eq!(r.assembly.mode, "parts");
+    assert_eq!(r.parts.len(), 7);
+    // The six dowels pass through the plate; no dowel meets another.
+    assert_eq!(r.part_pairs.len(), 6);
+    assert!(r.part_pairs.iter().all(|p| p.verdict == "clash" && p.a_name.contains("sides")));
+    assert!(r.assembly.sah_builds.unwrap() <= 2, "one build per distinct mesh");
+    let total: u64 = r.part_pairs.iter().map(|p| p.crossing_pairs).sum();
+    assert_eq!(total, r.summary.crossing_pairs);
+    // A selection: one dowel against the plate.
+    let dowel = &r.part_pairs[0].b_name;
+    let out = bin()
+        .args(["scene", &shipped("pins.glb"), "--select-a", "*sides*", "--select-b", dowel, "--no-timings"])
+        .output()
+        .unwrap();
+    let s = parse(&out.stdout);
+    assert_eq!(s.part_pairs.len(), 1);
+    assert_eq!(s.part_pairs[0].crossing_pairs, r.part_pairs[0].crossing_pairs);
+    // Excluding the plate leaves only dowels, which do not meet.
+    let out = bin().args(["scene", &shipped("pins.glb"), "--exclude", "*sides*"]).output().unwrap();
+    assert_eq!(out.status.code(), Some(0));
+    assert_eq!(parse(&out.stdout).verdict, "clear");
+    // A selection matching nothing is an error naming it.
+    assert!(error_line(&["scene", &shipped("pins.glb"), "--select-a", "nothing*"]).contains("nothing*"));
+}
+
+#[test]
+fn two_files_report_part_pairs_by_object() {
+    let out = bin().args([&shipped("multibody.stl"), &shipped("multibody.stl"), "-q"]).output().unwrap();
+    let r = parse(&out.stdout);
+    assert_eq!(r.assembly.mode, "files");
+    assert_eq!(r.parts.len(), 4); // two solids in each input
+                                  // Each solid coincides with its own copy and is 0.507 away from the other one.
+    let mut pairs: Vec<(String, String)> =
+        r.part_pairs.iter().map(|p| (p.a_name.clone(), p.b_name.clone())).collect();
+    pairs.sort();
+    assert_eq!(pairs.len(), 2);
+    assert!(pairs.iter().all(|(a, b)| a == b));
 }
