@@ -26,6 +26,7 @@ pub mod load;
 pub mod mesh;
 pub mod output;
 pub mod query;
+pub mod regions;
 pub mod report;
 pub mod traverse;
 pub mod tri_tri;

@@ -38,6 +38,8 @@
 //!   "parts": [{"input": "a|b", "object", "name", "triangles", "bounds"}],
 //!   "part_pairs": [{"a", "b", "a_name", "b_name", "verdict", "crossing_pairs", "touching_pairs",
 //!                   "clearance_pairs", "min_distance": number | null, "contained": string | null}],
+//!   "regions": [{"id", "a_object", "b_object", "a_name", "b_name", "pairs", "crossing_pairs",
+//!                "center": [x,y,z], "bounds", "extent"}],
 //!   "cross_check": null | {"tool", "intersects", "verdict_agrees", "intersecting_pairs",
 //!                  "distance", "distance_difference", "only_meshclash": [[a,b]], "only_parry": [[a,b]],
 //!                  "only_meshclash_count", "only_parry_count", "parry_ms": [pairs, distance] | null},
@@ -93,6 +95,9 @@ pub struct Report {
     pub parts: Vec<PartReport>,
     /// Part pairs with a finding, sorted by (a, b) (v2).
     pub part_pairs: Vec<PartPairReport>,
+    /// Connected interferences: all pairs (not only the listed ones) grouped per part pair,
+    /// sorted by their stable id (v2).
+    pub regions: Vec<RegionReport>,
     /// Loader warnings, prefixed with the file.
     pub warnings: Vec<String>,
     /// Phase times (null in deterministic mode).
@@ -100,6 +105,32 @@ pub struct Report {
     /// With `--baseline`: the comparison with the earlier report; absent otherwise.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub baseline: Option<crate::output::baseline::BaselineReport>,
+}
+
+/// A clash region (v2), see [`crate::regions`].
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, schemars::JsonSchema)]
+#[serde(deny_unknown_fields)]
+pub struct RegionReport {
+    /// Stable id: the smallest finding id among its pairs.
+    pub id: String,
+    /// Object of A (`inputs.a.objects`).
+    pub a_object: u32,
+    /// Object of B.
+    pub b_object: u32,
+    /// Name of that object of A.
+    pub a_name: String,
+    /// Name of that object of B.
+    pub b_name: String,
+    /// Triangle pairs in the region.
+    pub pairs: usize,
+    /// Of those, crossing.
+    pub crossing_pairs: usize,
+    /// Centre of the contact set.
+    pub center: [f64; 3],
+    /// Box of the contact set.
+    pub bounds: Bounds,
+    /// Diagonal of that box (size of the interference; not a penetration depth).
+    pub extent: f64,
 }
 
 /// The `assembly` block (v2).
@@ -576,6 +607,21 @@ pub fn build(ctx: &Context, r: &ClashResult) -> Report {
         assembly: ctx.assembly.0.clone(),
         parts: ctx.assembly.1.clone(),
         part_pairs: ctx.assembly.2.clone(),
+        regions: crate::regions::regions(&r.pairs, &ia.mesh, &ib.mesh)
+            .into_iter()
+            .map(|g| RegionReport {
+                a_name: ia.mesh.objects[g.objects.0 as usize].name.clone(),
+                b_name: ib.mesh.objects[g.objects.1 as usize].name.clone(),
+                id: g.id,
+                a_object: g.objects.0,
+                b_object: g.objects.1,
+                pairs: g.pairs,
+                crossing_pairs: g.crossing,
+                center: v3(g.center),
+                bounds: Bounds { min: v3(g.bounds.min), max: v3(g.bounds.max) },
+                extent: g.extent,
+            })
+            .collect(),
         warnings,
         timings_ms: ctx.times.map(|(load, total)| TimingsReport {
             load,

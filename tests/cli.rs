@@ -41,6 +41,7 @@ fn parse(stdout: &[u8]) -> Report {
         "assembly",
         "parts",
         "part_pairs",
+        "regions",
         "warnings",
         "timings_ms",
     ];
@@ -351,6 +352,12 @@ fn scene_checks_every_part_against_every_other() {
     assert!(r.assembly.sah_builds.unwrap() <= 2, "one build per distinct mesh");
     let total: u64 = r.part_pairs.iter().map(|p| p.crossing_pairs).sum();
     assert_eq!(total, r.summary.crossing_pairs);
+    // One interference region per dowel, covering every pair, with distinct stable ids.
+    assert_eq!(r.regions.len(), 6);
+    let in_regions: usize = r.regions.iter().map(|g| g.pairs).sum();
+    assert_eq!(in_regions as u64, r.summary.crossing_pairs + r.summary.touching_pairs);
+    let ids: std::collections::BTreeSet<&str> = r.regions.iter().map(|g| g.id.as_str()).collect();
+    assert_eq!(ids.len(), 6);
     // A selection: one dowel against the plate.
     let dowel = &r.part_pairs[0].b_name;
     let out = bin()
