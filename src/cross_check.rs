@@ -75,6 +75,10 @@ pub struct ParryResult {
     pub pairs_ms: f64,
     /// Wall time of parry's distance query (plus the witness points), ms; 0 when skipped.
     pub distance_ms: f64,
+    /// Wall time of building both `TriMesh`es (parry's BVH build included), ms.
+    pub build_ms: f64,
+    /// Bytes of parry's two BVHs (`Bvh::total_memory_size`), vertex and index buffers excluded.
+    pub tree_bytes: usize,
 }
 
 /// Pairs only one side reports: (only in ours, only in parry's).
@@ -162,7 +166,10 @@ macro_rules! impl_parry {
                 }
                 Ok(mesh)
             };
+            let build_start = Instant::now();
             let (ta, tb) = (build(a, "a")?, build(b, "b")?);
+            let build_ms = build_start.elapsed().as_secs_f64() * 1e3;
+            let tree_bytes = ta.bvh().total_memory_size() + tb.bvh().total_memory_size();
             let id = Pose::identity();
             let unsupported = |what: &str| format!("parry: {what} unsupported for these shapes");
             // Start rayon's pool outside the timed region.
@@ -204,7 +211,7 @@ macro_rules! impl_parry {
                 (f64::NAN, None, 0.0)
             };
 
-            Ok(ParryResult { intersecting_pairs, distance, points, pairs_ms, distance_ms })
+            Ok(ParryResult { intersecting_pairs, distance, points, pairs_ms, distance_ms, build_ms, tree_bytes })
         }
     };
 }
@@ -232,7 +239,7 @@ impl_parry!(
 mod f32_variant {
     use super::*;
 
-    #[cfg(feature = "parry-f32")]
+    // parry3d is a normal dependency now (`meshclash bench`), so this is always built.
     impl_parry!(
         /// [`parry_f64`] with parry3d (f32): every position is first rounded to the nearest f32,
         /// and parry's tolerances are those of f32. Witness points are converted back to f64.
