@@ -1,5 +1,7 @@
 //! Assemblies: part pairs from the broad phase + lazy per-part trees (+ shared instance
 //! topology) against the plain whole-mesh check grouped by object, on real CAD exports.
+#![allow(clippy::type_complexity, clippy::large_enum_variant, clippy::field_reassign_with_default)]
+#![allow(clippy::doc_lazy_continuation)] // test helpers: tuple rows and long case docs read better as they are
 
 use glam::DMat4;
 use meshclash::assembly::{check_parts, parts_of, Pairing};

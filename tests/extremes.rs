@@ -13,6 +13,8 @@
 //!
 //! Set `EXTREMES_LOG=<file>` to append the measured distance errors, and
 //! `EXTREMES_PARRY_TABLE=<file>` to write the parry3d-f64 comparison table.
+#![allow(clippy::type_complexity, clippy::large_enum_variant, clippy::field_reassign_with_default)]
+#![allow(clippy::doc_lazy_continuation)] // test helpers: tuple rows and long case docs read better as they are
 
 #[allow(dead_code)]
 #[path = "extremes/gen.rs"]
@@ -345,7 +347,7 @@ fn oracle_containment(a: &Mesh, b: &Mesh, rows: &[Row]) -> Cont {
         for r in rows.iter().filter(|r| r.3 == Some(Contact::CoplanarArea)) {
             let (x, y) = (tris(a)[r.0 as usize], tris(b)[r.1 as usize]);
             let n = |t: &[DVec3; 3]| {
-                let [p, q, w] = t.map(|v| oracle::pt(v));
+                let [p, q, w] = t.map(oracle::pt);
                 // Exact normal direction through orient with a point off the plane along +z, +y, +x.
                 [DVec3::Z, DVec3::Y, DVec3::X]
                     .iter()

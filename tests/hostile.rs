@@ -218,7 +218,7 @@ const ONE_NODE: &str = r#""nodes":[{"mesh":0}],"scenes":[{"nodes":[0]}],"scene":
 /// A GLB container: JSON chunk (space-padded) and optional BIN chunk (zero-padded).
 fn glb(json: &str, bin: Option<&[u8]>) -> Vec<u8> {
     let mut j = json.as_bytes().to_vec();
-    while j.len() % 4 != 0 {
+    while !j.len().is_multiple_of(4) {
         j.push(b' ');
     }
     let mut body = Vec::new();

@@ -61,7 +61,7 @@ proptest! {
     #[test]
     fn pairs_and_distances_match_parry_f64(
         ax in (-1.0f64..1.0, -1.0f64..1.0, 0.1f64..1.0),
-        angle in 0.0f64..6.28,
+        angle in 0.0f64..std::f64::consts::TAU,
         tx in -2.5f64..2.5, ty in -2.5f64..2.5, tz in -2.5f64..2.5,
         ra in 0.6f64..1.2, rb in 0.4f64..1.0,
     ) {

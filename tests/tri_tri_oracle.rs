@@ -13,6 +13,8 @@
 //!
 //! Nothing from `meshclash` is used by the oracle; only `classify` and its result types are
 //! imported, to be compared with it.
+#![allow(clippy::type_complexity, clippy::large_enum_variant, clippy::field_reassign_with_default)]
+#![allow(clippy::doc_lazy_continuation)] // test helpers: tuple rows and long case docs read better as they are
 
 use meshclash::geom::DVec3;
 use meshclash::tri_tri::{classify, Contact, Hit};
@@ -170,7 +172,7 @@ fn clip(pts: &[H], h: &Half) -> Vec<H> {
     let vals: Vec<Z> = pts.iter().map(|p| vdot(&h.w, &p.x) - &h.d * &p.w).collect();
     let mut out: Vec<H> = Vec::new();
     let push = |p: H, out: &mut Vec<H>| {
-        if out.last().map_or(true, |l| !heq(l, &p)) {
+        if out.last().is_none_or(|l| !heq(l, &p)) {
             out.push(p);
         }
     };

@@ -504,9 +504,9 @@ struct Case {
 }
 
 fn size_name(n: usize) -> String {
-    if n >= 1_000_000 && n % 100_000 == 0 {
+    if n >= 1_000_000 && n.is_multiple_of(100_000) {
         format!("{}M", n as f64 / 1e6)
-    } else if n >= 1000 && n % 100 == 0 {
+    } else if n >= 1000 && n.is_multiple_of(100) {
         format!("{}k", n as f64 / 1e3)
     } else {
         n.to_string()
@@ -1003,7 +1003,7 @@ fn table(out: &mut String, title: &str, header: &[&str], rows: &[Vec<String>]) {
     let mut sep = String::from("|");
     for (k, wk) in w.iter().enumerate() {
         sep.push_str(if k == 0 { " :" } else { " " });
-        sep.push_str(&"-".repeat(if k == 0 { wk - 1 } else { wk - 1 }.max(1)));
+        sep.push_str(&"-".repeat((wk - 1).max(1)));
         sep.push_str(if k == 0 { " |" } else { ": |" });
     }
     let _ = writeln!(out, "{sep}");
@@ -1043,7 +1043,7 @@ fn f_opt_ms(v: Option<f64>, note: &Option<String>) -> String {
 
 fn f_dist(d: Option<f64>) -> String {
     match d {
-        Some(d) if d == 0.0 => "0".into(),
+        Some(0.0) => "0".into(),
         Some(d) => format!("{d:.6}"),
         None => "–".into(),
     }
@@ -1074,6 +1074,7 @@ pub fn render(rep: &BenchReport) -> String {
         let (m, p, q) = (&r.meshclash, &r.parry_f64, &r.parry_f32);
         let total = |t: &ToolRun| t.distance_ms.map(|d| t.build_ms + t.pairs_ms + d);
         let mc_total = total(m).unwrap_or(m.build_ms + m.pairs_ms);
+        #[allow(clippy::type_complexity)] // one row per phase: name, meshclash, parry f64/f32, note
         let phase_rows: [(&str, f64, Option<f64>, Option<f64>, Option<String>); 4] = [
             ("build", m.build_ms, Some(p.build_ms), Some(q.build_ms), None),
             ("pairs", m.pairs_ms, Some(p.pairs_ms), Some(q.pairs_ms), None),
