@@ -352,6 +352,12 @@ fn scene_checks_every_part_against_every_other() {
     assert!(r.assembly.sah_builds.unwrap() <= 2, "one build per distinct mesh");
     let total: u64 = r.part_pairs.iter().map(|p| p.crossing_pairs).sum();
     assert_eq!(total, r.summary.crossing_pairs);
+    // JUnit: the whole run plus one failing case per clashing part pair, named by the parts.
+    let junit = bin().args(["scene", &shipped("pins.glb"), "--format", "junit"]).output().unwrap();
+    let xml = String::from_utf8(junit.stdout).unwrap();
+    assert_eq!(xml.matches("<testcase").count(), 7);
+    assert_eq!(xml.matches("<failure").count(), 7);
+    assert!(xml.contains(&r.part_pairs[0].b_name));
     // One interference region per dowel, covering every pair, with distinct stable ids.
     assert_eq!(r.regions.len(), 6);
     let in_regions: usize = r.regions.iter().map(|g| g.pairs).sum();

@@ -101,7 +101,7 @@ pub fn render(suite: &str, cases: &[Case]) -> String {
     s
 }
 
-/// The cases of a report: today one, the two input files.
+/// The cases of a report: the whole run (the two inputs), then one per part pair with a finding.
 pub fn cases(r: &Report) -> Vec<Case> {
     let m = &r.summary;
     let mut counts = format!(
@@ -119,7 +119,7 @@ pub fn cases(r: &Report) -> Vec<Case> {
         );
     }
     let worst = super::text::worst(r);
-    vec![Case {
+    let mut cases = vec![Case {
         name: format!("{} vs {}", r.inputs.a.path, r.inputs.b.path),
         verdict: r.verdict.clone(),
         counts,
@@ -128,7 +128,61 @@ pub fn cases(r: &Report) -> Vec<Case> {
         failed: r.failed,
         time_s: r.timings_ms.as_ref().map_or(0.0, |t| t.total / 1e3),
         output: super::text::render(r, false),
-    }]
+    }];
+    // Two single-part inputs: the part pair is the whole run; say it once.
+    if r.assembly.mode == "parts" || r.parts.len() > 2 {
+        cases.extend(part_pair_cases(r));
+    }
+    cases
+}
+
+/// One case per part pair with a finding (assemblies), after the whole-run case, so CI
+/// dashboards show which parts clash with which.
+fn part_pair_cases(r: &Report) -> Vec<Case> {
+    let fails = |verdict: &str, new_crossing: bool| -> bool {
+        let v = crate::report::verdict_from_name(verdict);
+        match r.settings.fail_on.as_str() {
+            "never" => false,
+            "new" => new_crossing,
+            level => match (v, crate::report::verdict_from_name(level)) {
+                (Some(v), Some(l)) => v >= l,
+                _ => false,
+            },
+        }
+    };
+    r.part_pairs
+        .iter()
+        .map(|pp| {
+            let (pa, pb) = (&r.parts[pp.a], &r.parts[pp.b]);
+            let mine: Vec<&crate::report::PairReport> = r
+                .pairs
+                .iter()
+                .filter(|p| {
+                    let objs = (p.a_object, p.b_object);
+                    objs == (pa.object, pb.object) || objs == (pb.object, pa.object)
+                })
+                .collect();
+            let new_crossing =
+                mine.iter().any(|p| p.kind == "crossing" && p.status.as_deref() == Some("new"));
+            let mut counts = format!(
+                "{} crossing, {} touching, {} clearance pairs",
+                pp.crossing_pairs, pp.touching_pairs, pp.clearance_pairs
+            );
+            if let Some(c) = &pp.contained {
+                let _ = write!(counts, ", contained: {c}");
+            }
+            Case {
+                name: format!("{} vs {}", pp.a_name, pp.b_name),
+                verdict: pp.verdict.clone(),
+                counts,
+                findings: mine.iter().take(FIRST).map(|p| super::text::pair_line(r, p)).collect(),
+                total: pp.crossing_pairs + pp.touching_pairs + pp.clearance_pairs,
+                failed: fails(&pp.verdict, new_crossing),
+                time_s: 0.0,
+                output: String::new(),
+            }
+        })
+        .collect()
 }
 
 /// The JUnit XML of a report.
