@@ -222,25 +222,19 @@ pub fn point_in_closed_mesh(p: DVec3, m: &Mesh, t: &Bvh) -> Inside {
         let q = p + DVec3::from(d) * reach;
         let seg = Aabb { min: p.min(q), max: p.max(q) };
         let mut crossings = 0usize;
-        let mut stack = vec![0u32];
-        while let Some(i) = stack.pop() {
-            let node = &t.nodes[i as usize];
-            if !node.bounds.overlaps(&seg) {
-                continue;
-            }
-            if !node.is_leaf() {
-                stack.push(node.a);
-                stack.push(i + 1);
-                continue;
-            }
-            for &tri in t.leaf_prims(node) {
-                let [a, b, c] = bvh::triangle(m, tri);
-                match segment_crosses(p, q, a, b, c) {
-                    Crossing::No => {}
-                    Crossing::Yes => crossings += 1,
-                    Crossing::Degenerate => continue 'dir,
+        let degenerate = crate::traverse::any_in_box(t, &seg, |tri| {
+            let [a, b, c] = bvh::triangle(m, tri);
+            match segment_crosses(p, q, a, b, c) {
+                Crossing::No => false,
+                Crossing::Yes => {
+                    crossings += 1;
+                    false
                 }
+                Crossing::Degenerate => true,
             }
+        });
+        if degenerate {
+            continue 'dir;
         }
         return if crossings % 2 == 1 { Inside::Yes } else { Inside::No };
     }
@@ -268,25 +262,9 @@ pub fn winding_number(p: DVec3, m: &Mesh) -> f64 {
 
 /// Is `p` exactly on a triangle of `m`?
 fn on_surface(p: DVec3, m: &Mesh, t: &Bvh) -> bool {
-    let pt = Aabb { min: p, max: p };
-    let mut stack = vec![0u32];
-    while let Some(i) = stack.pop() {
-        let node = &t.nodes[i as usize];
-        if !node.bounds.overlaps(&pt) {
-            continue;
-        }
-        if !node.is_leaf() {
-            stack.push(node.a);
-            stack.push(i + 1);
-            continue;
-        }
-        for &tri in t.leaf_prims(node) {
-            if crate::tri_tri::classify(&[p, p, p], &bvh::triangle(m, tri)).is_some() {
-                return true;
-            }
-        }
-    }
-    false
+    crate::traverse::any_in_box(t, &Aabb { min: p, max: p }, |tri| {
+        crate::tri_tri::classify(&[p, p, p], &bvh::triangle(m, tri)).is_some()
+    })
 }
 
 /// Do two closed, consistently oriented solids overlap in volume through a face-to-face

@@ -464,8 +464,9 @@ fn contact_witness(a: &Mesh, b: &Mesh, p: &PairFinding) -> Closest {
     Closest { distance: 0.0, a: (p.a, point), b: (p.b, point) }
 }
 
-/// Branch-and-bound closest pair of two meshes known not to touch.
-fn closest_pair(a: &Mesh, ta: &Bvh, b: &Mesh, tb: &Bvh, err: DistanceError) -> Option<Closest> {
+/// Branch-and-bound closest pair of two meshes known not to touch (their trees built), within
+/// the allowed distance error.
+pub fn closest_pair(a: &Mesh, ta: &Bvh, b: &Mesh, tb: &Bvh, err: DistanceError) -> Option<Closest> {
     let scale = ta.bounds().max_abs().max(tb.bounds().max_abs());
     let slack = predicates::distance_rounding_slack(scale);
     // With an error allowance, a node pair whose lower bound lb has (1 + rel)·lb + abs >= best

@@ -99,6 +99,30 @@ where
     parts.into_iter().flatten().collect()
 }
 
+/// One-tree walk: call `visit` on every triangle in a leaf whose box overlaps `query` (exact
+/// closed overlap), stopping early — and returning true — as soon as `visit` returns true.
+pub fn any_in_box(tree: &Bvh, query: &Aabb, mut visit: impl FnMut(u32) -> bool) -> bool {
+    if tree.nodes.is_empty() {
+        return false;
+    }
+    let mut stack = vec![0u32];
+    while let Some(i) = stack.pop() {
+        let node = &tree.nodes[i as usize];
+        if !node.bounds.overlaps(query) {
+            continue;
+        }
+        if !node.is_leaf() {
+            stack.push(node.a);
+            stack.push(i + 1);
+            continue;
+        }
+        if tree.leaf_prims(node).iter().any(|&t| visit(t)) {
+            return true;
+        }
+    }
+    false
+}
+
 /// A candidate for [`min_pair`]: its distance and a key that breaks ties deterministically.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Candidate<R> {

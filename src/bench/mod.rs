@@ -33,7 +33,7 @@ use crate::geom::predicates;
 use crate::geom::Aabb;
 use crate::mesh::Mesh;
 use crate::query::{self, ClashResult, DistanceError, Mode, Settings};
-use crate::traverse::{self, Candidate};
+use crate::traverse;
 use crate::tri_tri;
 use serde::Serialize;
 use std::path::PathBuf;
@@ -434,40 +434,7 @@ pub fn distance_within(a: &Mesh, ta: &Bvh, b: &Mesh, tb: &Bvh, err: DistanceErro
     if !hit.is_empty() {
         return Some(0.0);
     }
-    let scale = ta.bounds().max_abs().max(tb.bounds().max_abs());
-    let best = traverse::min_pair(
-        ta,
-        tb,
-        |x, y| {
-            let lb = x.distance_sq(y).sqrt();
-            if err.rel == 0.0 && err.abs == 0.0 {
-                lb
-            } else {
-                (lb * (1.0 + err.rel) + err.abs).max(lb)
-            }
-        },
-        predicates::distance_rounding_slack(scale),
-        |la, lb, bound| {
-            let mut best: Option<Candidate<()>> = None;
-            for &i in la {
-                let ti = bvh::triangle(a, i);
-                let bi = Aabb::of_triangle(&ti);
-                for &j in lb {
-                    let tj = bvh::triangle(b, j);
-                    if bi.distance_sq(&Aabb::of_triangle(&tj)).sqrt() > bound {
-                        continue;
-                    }
-                    let d = crate::distance::triangle_distance(&ti, &tj).distance;
-                    let c = Candidate { distance: d, key: (i, j), data: () };
-                    if best.as_ref().is_none_or(|m| (c.distance, c.key) < (m.distance, m.key)) {
-                        best = Some(c);
-                    }
-                }
-            }
-            best
-        },
-    )?;
-    Some(best.distance)
+    crate::query::closest_pair(a, ta, b, tb, err).map(|c| c.distance)
 }
 
 /// Candidate triangle pairs (boxes overlap), at most `cap`.
