@@ -33,27 +33,29 @@ pub struct Topology {
     /// For each vertex of the mesh, its component (index into `component_seeds`), or
     /// `u32::MAX` for a vertex no triangle uses.
     pub component_of: Vec<u32>,
-    /// For a closed mesh: per triangle, +1 if its normal (right-hand rule) points out of the
-    /// solid, −1 if in, 0 for zero-area triangles. Found by propagating a consistent winding
-    /// across shared edges within each component and taking the sign of each component's
-    /// signed volume, so input winding does not matter. `None` for open meshes, or if some
-    /// component cannot be oriented consistently.
-    pub outward: Option<Vec<i8>>,
+    /// Exactly-coincident-vertex ids (index into the distinct positions), per vertex; used by
+    /// [`outward`] when it is needed.
+    pub merged: Vec<u32>,
 }
 
 /// Merge exactly coincident vertices (+0 and −0 are the same point) and count edge uses.
 pub fn topology(mesh: &Mesh) -> Topology {
-    let mut ids: HashMap<[u64; 3], u32> = HashMap::with_capacity(mesh.positions.len());
-    let merged: Vec<u32> = mesh
-        .positions
-        .iter()
-        .map(|p| {
-            let key = [p.x + 0.0, p.y + 0.0, p.z + 0.0].map(f64::to_bits);
-            let next = ids.len() as u32;
-            *ids.entry(key).or_insert(next)
-        })
-        .collect();
-    let mut parent: Vec<u32> = (0..ids.len() as u32).collect();
+    use rayon::prelude::*;
+    // Merge exactly coincident vertices by sorting their bit patterns (parallel; a hash map of
+    // millions of keys was most of the cost of a check on large inputs).
+    let key = |p: &DVec3| [p.x + 0.0, p.y + 0.0, p.z + 0.0].map(f64::to_bits);
+    let mut order: Vec<u32> = (0..mesh.positions.len() as u32).collect();
+    order.par_sort_unstable_by_key(|&i| (key(&mesh.positions[i as usize]), i));
+    let mut merged = vec![0u32; mesh.positions.len()];
+    let mut next = 0u32;
+    for (k, &i) in order.iter().enumerate() {
+        if k > 0 && key(&mesh.positions[order[k - 1] as usize]) != key(&mesh.positions[i as usize]) {
+            next += 1;
+        }
+        merged[i as usize] = next;
+    }
+    let distinct = if order.is_empty() { 0 } else { next as usize + 1 };
+    let mut parent: Vec<u32> = (0..distinct as u32).collect();
     fn find(parent: &mut [u32], mut x: u32) -> u32 {
         while parent[x as usize] != x {
             parent[x as usize] = parent[parent[x as usize] as usize];
@@ -61,8 +63,11 @@ pub fn topology(mesh: &Mesh) -> Topology {
         }
         x
     }
-    let mut edges: HashMap<(u32, u32), u32> = HashMap::with_capacity(mesh.triangles.len() * 3 / 2);
-    let mut directed: HashMap<(u32, u32), i32> = HashMap::with_capacity(mesh.triangles.len() * 3 / 2);
+    let proper: Vec<bool> = (0..mesh.triangles.len() as u32)
+        .into_par_iter()
+        .map(|t| !Shape::of(&bvh::triangle(mesh, t)).is_degenerate())
+        .collect();
+    let mut edges: Vec<u64> = Vec::with_capacity(mesh.triangles.len() * 3);
     for (t, tri) in mesh.triangles.iter().enumerate() {
         let v = tri.map(|i| merged[i as usize]);
         for k in 0..3 {
@@ -71,17 +76,16 @@ pub fn topology(mesh: &Mesh) -> Topology {
                 parent[a.max(b) as usize] = a.min(b);
             }
         }
-        if Shape::of(&bvh::triangle(mesh, t as u32)).is_degenerate() {
-            continue;
-        }
-        for k in 0..3 {
-            let (a, b) = (v[k], v[(k + 1) % 3]);
-            *edges.entry((a.min(b), a.max(b))).or_insert(0) += 1;
-            // Net direction: +1 for a -> b with a < b, -1 for the other way.
-            *directed.entry((a.min(b), a.max(b))).or_insert(0) += if a < b { 1 } else { -1 };
+        if proper[t] {
+            for k in 0..3 {
+                let (a, b) = (v[k], v[(k + 1) % 3]);
+                edges.push((a.min(b) as u64) << 32 | a.max(b) as u64);
+            }
         }
     }
-    let closed = !edges.is_empty() && edges.values().all(|&c| c == 2);
+    // Closed: every undirected edge of the proper triangles used exactly twice.
+    edges.par_sort_unstable();
+    let closed = !edges.is_empty() && edges.chunk_by(|x, y| x == y).all(|run| run.len() == 2);
     // The first vertex (in triangle order) of each component.
     let mut comp_of_root = vec![u32::MAX; parent.len()];
     let mut component_seeds = Vec::new();
@@ -102,12 +106,22 @@ pub fn topology(mesh: &Mesh) -> Topology {
     let component_of = (0..mesh.positions.len())
         .map(|v| if used[v] { comp_of_root[find(&mut parent, merged[v]) as usize] } else { u32::MAX })
         .collect();
-    let _ = directed;
-    let outward = if closed { orient(mesh, &merged) } else { None };
-    Topology { closed, component_seeds, component_of, outward }
+    Topology { closed, component_seeds, component_of, merged }
 }
 
-/// Consistent outward winding of a closed mesh (see [`Topology::outward`]).
+/// For a closed mesh: per triangle, +1 if its normal (right-hand rule) points out of the solid,
+/// −1 if in, 0 for zero-area triangles. Found by propagating a consistent winding across shared
+/// edges within each component and taking the sign of each component's signed volume, so input
+/// winding does not matter. `None` for open meshes, or if some component cannot be oriented
+/// consistently. Computed only when a face-to-face contact needs it (it is the costly part).
+pub fn outward(mesh: &Mesh, topo: &Topology) -> Option<Vec<i8>> {
+    if !topo.closed {
+        return None;
+    }
+    orient(mesh, &topo.merged)
+}
+
+/// See [`outward`].
 fn orient(mesh: &Mesh, merged: &[u32]) -> Option<Vec<i8>> {
     let n = mesh.triangles.len();
     let proper: Vec<bool> =

@@ -397,7 +397,11 @@ fn volumes_overlap(
     topo_b: &containment::Topology,
     pairs: &[PairFinding],
 ) -> bool {
-    let (Some(oa), Some(ob)) = (&topo_a.outward, &topo_b.outward) else { return false };
+    if !pairs.iter().any(|p| p.contact == Some(Contact::CoplanarArea)) || !topo_a.closed || !topo_b.closed {
+        return false;
+    }
+    let (oa, ob) = rayon::join(|| containment::outward(a, topo_a), || containment::outward(b, topo_b));
+    let (Some(oa), Some(ob)) = (oa, ob) else { return false };
     pairs.iter().filter(|p| p.contact == Some(Contact::CoplanarArea)).any(|p| {
         let (ta, tb) = (bvh::triangle(a, p.a), bvh::triangle(b, p.b));
         containment::coplanar_overlap(&ta, oa[p.a as usize], &tb, ob[p.b as usize])

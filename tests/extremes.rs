@@ -339,10 +339,11 @@ fn oracle_containment(a: &Mesh, b: &Mesh, rows: &[Row]) -> Cont {
     if rows.iter().any(|r| r.2 == PairKind::Crossing) {
         return Cont::None;
     }
-    // Shared volume: the outward winding comes from meshclash's own `topology` (winding
+    // Shared volume: the outward winding comes from meshclash's own `outward` (winding
     // propagation is not what this suite checks); the coplanarity and normal directions are
     // decided here exactly.
-    let (oa, ob) = (meshclash::containment::topology(a).outward, meshclash::containment::topology(b).outward);
+    let out = |m: &Mesh| meshclash::containment::outward(m, &meshclash::containment::topology(m));
+    let (oa, ob) = (out(a), out(b));
     if let (Some(oa), Some(ob)) = (oa, ob) {
         for r in rows.iter().filter(|r| r.3 == Some(Contact::CoplanarArea)) {
             let (x, y) = (tris(a)[r.0 as usize], tris(b)[r.1 as usize]);
@@ -771,7 +772,7 @@ fn duplicate_mesh_pairs_every_triangle_with_its_twin_and_neighbours() {
             let twins = got.iter().filter(|p| p.0 == p.1 && p.3 == Some(Contact::CoplanarArea)).count();
             // A duplicated solid shares all its volume with its twin (a clash); a duplicated
             // open sheet only touches.
-            let solid = meshclash::containment::topology(&m).outward.is_some();
+            let solid = meshclash::containment::outward(&m, &meshclash::containment::topology(&m)).is_some();
             let want_verdict = if solid { Verdict::Clash } else { Verdict::Touching };
             if got != want || twins != t.len() || r.verdict != want_verdict {
                 let only_got: Vec<_> = got.iter().filter(|x| !want.contains(x)).take(6).collect();
