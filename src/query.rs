@@ -311,9 +311,9 @@ pub fn check(a: &Mesh, b: &Mesh, settings: &Settings) -> ClashResult {
     r
 }
 
-/// As [`check`], with both trees already built (assemblies reuse one tree for many pairs).
-pub fn check_built(a: &Mesh, ta: &Bvh, b: &Mesh, tb: &Bvh, settings: &Settings) -> ClashResult {
-    let t1 = Instant::now();
+/// The pair walk alone: every pair that meets (or comes within the tolerances), classified,
+/// sorted by (a, b); and whether `first_hit` stopped it early.
+pub fn find_pairs(a: &Mesh, ta: &Bvh, b: &Mesh, tb: &Bvh, settings: &Settings) -> (Vec<PairFinding>, bool) {
     let tol = settings.tolerances;
     let stop = AtomicBool::new(false);
     let mut pairs = traverse::collect_pairs(
@@ -343,6 +343,13 @@ pub fn check_built(a: &Mesh, ta: &Bvh, b: &Mesh, tb: &Bvh, settings: &Settings) 
         },
     );
     pairs.par_sort_unstable_by_key(|p| (p.a, p.b));
+    (pairs, stop.load(Ordering::Relaxed))
+}
+
+/// As [`check`], with both trees already built (assemblies reuse one tree for many pairs).
+pub fn check_built(a: &Mesh, ta: &Bvh, b: &Mesh, tb: &Bvh, settings: &Settings) -> ClashResult {
+    let t1 = Instant::now();
+    let (pairs, stopped) = find_pairs(a, ta, b, tb, settings);
     let mut counts = Counts::default();
     for p in &pairs {
         match p.kind {
@@ -356,7 +363,7 @@ pub fn check_built(a: &Mesh, ta: &Bvh, b: &Mesh, tb: &Bvh, settings: &Settings) 
     }
     let closest = match pairs.iter().find(|p| p.contact.is_some()) {
         Some(p) => Some(contact_witness(a, b, p)),
-        None if stop.load(Ordering::Relaxed) => None,
+        None if stopped => None,
         None => closest_pair(a, ta, b, tb, settings.distance_error),
     };
     let (topo_a, topo_b) = rayon::join(|| containment::topology(a), || containment::topology(b));

@@ -375,28 +375,8 @@ type ExactPair = (u32, u32, bool);
 
 /// The pairs phase: dual walk, exact classification of every candidate (zero tolerances).
 pub fn exact_pairs(a: &Mesh, ta: &Bvh, b: &Mesh, tb: &Bvh) -> Vec<ExactPair> {
-    let mut v = traverse::collect_pairs(
-        ta,
-        tb,
-        |x, y| x.overlaps(y),
-        |la, lb, out| {
-            for &i in la {
-                let ti = bvh::triangle(a, i);
-                let bi = Aabb::of_triangle(&ti);
-                for &j in lb {
-                    let tj = bvh::triangle(b, j);
-                    if !bi.overlaps(&Aabb::of_triangle(&tj)) {
-                        continue;
-                    }
-                    if let Some(h) = tri_tri::classify(&ti, &tj) {
-                        out.push((i, j, h.crossing));
-                    }
-                }
-            }
-        },
-    );
-    v.sort_unstable_by_key(|p| (p.0, p.1));
-    v
+    let (pairs, _) = crate::query::find_pairs(a, ta, b, tb, &Settings::default());
+    pairs.iter().map(|p| (p.a, p.b, p.kind == crate::query::PairKind::Crossing)).collect()
 }
 
 /// The distance a standalone distance query needs: 0 at the first contact found, else the
