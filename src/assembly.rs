@@ -443,10 +443,7 @@ pub fn run(a: &Mesh, b: &Mesh, sel: &Selection, settings: &Settings) -> Result<O
         }
         let r = &pp.result;
         merged.extend(r.pairs.iter().copied());
-        counts.crossing += r.counts.crossing;
-        counts.touching += r.counts.touching;
-        counts.within_tolerance += r.counts.within_tolerance;
-        counts.clearance += r.counts.clearance;
+        counts.merge(&r.counts);
         if let Some(c) = r.closest {
             if closest.is_none_or(|m| (c.distance, c.a.0, c.b.0) < (m.distance, m.a.0, m.b.0)) {
                 closest = Some(c);
@@ -504,21 +501,7 @@ fn group_by_part(parts: &[Part], a: &Mesh, b: &Mesh, r: &ClashResult) -> Vec<Par
             min_distance: None,
             containment: Containment::None,
         });
-        let v = match p.kind {
-            crate::query::PairKind::Crossing => {
-                e.counts.crossing += 1;
-                Verdict::Clash
-            }
-            crate::query::PairKind::Touching => {
-                e.counts.touching += 1;
-                e.counts.within_tolerance += p.contact.is_none() as u64;
-                Verdict::Touching
-            }
-            crate::query::PairKind::Clearance => {
-                e.counts.clearance += 1;
-                Verdict::Clearance
-            }
-        };
+        let v = e.counts.record(p);
         e.verdict = e.verdict.max(v);
         e.min_distance = Some(e.min_distance.map_or(p.distance, |d: f64| d.min(p.distance)));
     }

@@ -232,6 +232,35 @@ pub struct Counts {
     pub clearance: u64,
 }
 
+impl Counts {
+    /// Count one pair; returns the verdict that pair alone implies.
+    pub fn record(&mut self, p: &PairFinding) -> Verdict {
+        match p.kind {
+            PairKind::Crossing => {
+                self.crossing += 1;
+                Verdict::Clash
+            }
+            PairKind::Touching => {
+                self.touching += 1;
+                self.within_tolerance += p.contact.is_none() as u64;
+                Verdict::Touching
+            }
+            PairKind::Clearance => {
+                self.clearance += 1;
+                Verdict::Clearance
+            }
+        }
+    }
+
+    /// Add another set of counts.
+    pub fn merge(&mut self, o: &Counts) {
+        self.crossing += o.crossing;
+        self.touching += o.touching;
+        self.within_tolerance += o.within_tolerance;
+        self.clearance += o.clearance;
+    }
+}
+
 /// Facts about one input.
 #[derive(Debug, Clone, PartialEq)]
 pub struct MeshInfo {
@@ -352,14 +381,7 @@ pub fn check_built(a: &Mesh, ta: &Bvh, b: &Mesh, tb: &Bvh, settings: &Settings) 
     let (pairs, stopped) = find_pairs(a, ta, b, tb, settings);
     let mut counts = Counts::default();
     for p in &pairs {
-        match p.kind {
-            PairKind::Crossing => counts.crossing += 1,
-            PairKind::Touching => {
-                counts.touching += 1;
-                counts.within_tolerance += p.contact.is_none() as u64;
-            }
-            PairKind::Clearance => counts.clearance += 1,
-        }
+        counts.record(p);
     }
     let closest = match pairs.iter().find(|p| p.contact.is_some()) {
         Some(p) => Some(contact_witness(a, b, p)),

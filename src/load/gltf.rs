@@ -70,24 +70,15 @@ pub(crate) fn load(path: &Path, bytes: &[u8]) -> Result<Loaded> {
             total_t = total_t.saturating_add(p.triangles.len());
         }
     }
-    if total_v > MAX_SCENE_VERTICES {
-        return Err(Error::input(
-            path,
-            format!(
-                "glTF scene has {total_v} vertices after instancing, more than the \
-                 {MAX_SCENE_VERTICES} supported"
-            ),
-        ));
-    }
-
-    if total_t > MAX_SCENE_TRIANGLES {
-        return Err(Error::input(
-            path,
-            format!(
-                "glTF scene has {total_t} triangles after instancing, more than the \
-                 {MAX_SCENE_TRIANGLES} supported"
-            ),
-        ));
+    for (total, limit, what) in
+        [(total_v, MAX_SCENE_VERTICES, "vertices"), (total_t, MAX_SCENE_TRIANGLES, "triangles")]
+    {
+        if total > limit {
+            return Err(Error::input(
+                path,
+                format!("glTF scene has {total} {what} after instancing, more than the {limit} supported"),
+            ));
+        }
     }
 
     let mut mesh = Mesh {
