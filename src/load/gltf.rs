@@ -1,8 +1,18 @@
 //! glTF 2.0 loader (`.gltf` JSON and `.glb` binary), without the `gltf` crate's `import`.
 //!
-//! - **Buffers**: the GLB binary chunk, base64 `data:` URIs, or relative files next to the
-//!   glTF (percent-decoded; other schemes are refused). Each must hold its `byteLength`; every
-//!   bufferView and accessor range is checked before reading (see `gltf_data`).
+//! - **Buffers**: the GLB binary chunk, base64 `data:` URIs, or files given by a relative
+//!   path that stays inside the glTF's directory (percent-decoded, then checked: a scheme such
+//!   as `file:` or `https:`, an absolute path, a drive letter or UNC prefix, or a `..` that
+//!   climbs above the directory is refused with an error naming the URI). Each must hold its
+//!   `byteLength`; every bufferView and accessor range is checked before reading (see
+//!   `gltf_data`).
+//! - **Extensions**: a file may *require* `KHR_mesh_quantization`, `EXT_mesh_gpu_instancing`
+//!   (both decoded) and extensions that only add appearance or metadata (`KHR_materials_*`,
+//!   `KHR_texture_transform`, `EXT_mesh_features`, …). Any other required extension is an
+//!   error naming it (Draco and meshopt compression cannot be decoded). Extensions that are
+//!   only *used* never fail a file: geometry is read from the core data, and an accessor with
+//!   no data at all (neither bufferView nor sparse, i.e. supplied by an extension) is an error
+//!   naming the extensions used.
 //! - **Scene**: the default scene, else the first scene, else every root node (a node that is
 //!   nobody's child). The hierarchy is walked iteratively; a node with two parents, a cycle,
 //!   or more than [`MAX_DEPTH`] levels is an error. World = parent × local, computed in f64
@@ -10,30 +20,53 @@
 //! - **Primitives**: modes TRIANGLES, TRIANGLE_STRIP (triangle `i` is `(i, i+1, i+2)`, with the
 //!   last two swapped for odd `i` to keep the winding) and TRIANGLE_FAN (`(0, i+1, i+2)`),
 //!   indexed (u8/u16/u32) or not. POINTS/LINES/LINE_LOOP/LINE_STRIP are skipped with a warning.
-//!   Positions must be float VEC3 (sparse accessors are applied); quantized positions
-//!   (KHR_mesh_quantization) are an error for now. Skins and morph targets are ignored (with a
-//!   warning); `EXT_mesh_gpu_instancing` is ignored with a warning unless required.
+//!   Skins and morph targets are ignored (with a warning); application-specific attributes
+//!   (`_BATCHID`, `_FEATURE_ID_0`, …) are ignored.
+//! - **Positions** (VEC3; sparse substitution applied for every component type), in f64:
+//!   `FLOAT` widened exactly; with `KHR_mesh_quantization`, `BYTE`/`UNSIGNED_BYTE`/`SHORT`/
+//!   `UNSIGNED_SHORT` unnormalized are the integer itself (exact), normalized are the correctly
+//!   rounded f64 quotient `c / 127`, `c / 255`, `c / 32767`, `c / 65535`, clamped below at -1
+//!   for the signed types (so -128 and -127 both give -1). The node transform then
+//!   dequantizes, like any node transform.
+//! - **World coordinates**: each vertex is `W · v` with `W` the f64 world matrix of its part,
+//!   evaluated as glam's `transform_point3`: `((W₀·x + W₁·y) + W₂·z) + W₃` per row, plain f64
+//!   multiplies and adds, no FMA, so the result is the same on every platform. Verdicts are
+//!   exact for these coordinates.
+//! - **`EXT_mesh_gpu_instancing`** (honoured on any node with a mesh that carries it, declared
+//!   or not): attributes `TRANSLATION` (VEC3 FLOAT), `ROTATION` (VEC4 FLOAT, or normalized
+//!   BYTE/SHORT decoded as above) and `SCALE` (VEC3 FLOAT), each optional; every attribute,
+//!   application-specific ones included, must have the same count, the number of instances.
+//!   Instance `k` gets `W = node world · (T · R · S)`, the product in f64, `R` from the
+//!   quaternion divided by its f64 length (zero length, or a non-finite value, is an error).
+//!   The node's own, non-instanced draw is not emitted; its children are ordinary nodes.
+//! - **Limits**: a scene expanding to more than [`MAX_SCENE_VERTICES`] vertices,
+//!   [`MAX_SCENE_TRIANGLES`] triangles or [`MAX_SCENE_PARTS`] parts (node instances plus GPU
+//!   instances) is refused from the declared counts, before any instance is read or anything
+//!   is allocated for it.
 //! - **Vertices**: every primitive instance contributes its own vertices, transformed to world
-//!   space in f64 (no merging across primitives or instances). A scene expanding to more than
-//!   [`MAX_SCENE_VERTICES`] vertices or [`MAX_SCENE_TRIANGLES`] triangles is refused before
-//!   anything is allocated for it.
+//!   space in f64 (no merging across primitives or instances).
 //! - **Triangle order**: scene traversal order (depth-first pre-order over the scene's root
-//!   nodes in the order listed, children in listed order); within a node, its mesh's primitives
-//!   in order; within a primitive, index order.
+//!   nodes in the order listed, children in listed order); within a node, its GPU instances in
+//!   order, within those its mesh's primitives in order; within a primitive, index order.
 //! - **Objects**: one per node that draws a mesh (node × mesh), named by the node path from the
-//!   scene root joined with `/` (each node by its `name`, or `node<index>`), with
-//!   `gltf_mesh = Some(mesh index)` and `world = Some(world matrix)`. Instances that yield no
-//!   triangles get no object.
+//!   scene root joined with `/` (each node by its `name`, or `node<index>`); a node with
+//!   `EXT_mesh_gpu_instancing` gives one object per instance instead, named `<node path>#<k>`
+//!   (`k` from 0 in accessor order). Every object has `gltf_mesh = Some(mesh index)` (so
+//!   instances share one BVH build in assemblies) and `world = Some(the matrix applied)`.
+//!   Instances that yield no triangles get no object. Winding is kept as stored, also under
+//!   mirroring transforms (containment decides orientation from the geometry).
 
 use std::borrow::Cow;
 use std::path::Path;
 
 use ::gltf::mesh::Mode;
 use ::gltf::scene::Transform;
-use ::gltf::Document;
+use ::gltf::{Accessor, Document};
 use glam::{DMat4, DQuat, DVec3};
 
-use super::gltf_data::{load_buffers, parse_document, split_glb, Reader};
+use super::gltf_data::{
+    load_buffers, parse_document, parse_extensions, split_glb, Extensions, GpuInstancing, Reader,
+};
 use crate::error::{Error, Result};
 use crate::mesh::{Loaded, Mesh, Object};
 
@@ -48,31 +81,49 @@ pub(crate) const MAX_SCENE_VERTICES: usize = 1 << 28;
 /// object ids): many instances of a mesh with few vertices but many indices must fail too.
 pub(crate) const MAX_SCENE_TRIANGLES: usize = 1 << 28;
 
+/// The most parts (objects) a scene may expand to (2^24, some 4 GiB of names, matrices and
+/// part records): `EXT_mesh_gpu_instancing` makes one part per instance from as little as
+/// 12 bytes of file, so a tiny mesh instanced many times must fail too.
+pub(crate) const MAX_SCENE_PARTS: usize = 1 << 24;
+
 /// Loads `.gltf` or `.glb` `bytes` (the GLB magic decides); see the module doc.
 pub(crate) fn load(path: &Path, bytes: &[u8]) -> Result<Loaded> {
     let (json, bin) = if bytes.starts_with(b"glTF") { split_glb(path, bytes)? } else { (bytes, None) };
     let mut warnings = Vec::new();
-    let doc = parse_document(path, json, &mut warnings)?;
+    let doc = parse_document(path, json)?;
+    let ext = parse_extensions(path, json, doc.accessors().len())?;
     let buffers = load_buffers(path, &doc, bin)?;
     let input_bytes = buffers.iter().map(|b| b.len()).fold(bytes.len(), usize::saturating_add);
     let reader = Reader { path, buffers: &buffers, input_bytes };
-    let instances = traverse(path, &doc, &mut warnings)?;
+    let accessors: Vec<Accessor> = doc.accessors().collect();
+    let instances = traverse(path, &doc, &ext, &reader, &accessors, &mut warnings)?;
 
-    // Decode each mesh once, whatever its number of instances.
+    // Decode each mesh once, whatever its number of instances; check the expanded scene
+    // against the limits from declared counts, before any instance is read or allocated.
     let mut decoded: Vec<Option<Vec<Prim>>> = vec![None; doc.meshes().len()];
-    let (mut total_v, mut total_t) = (0usize, 0usize);
+    let (mut total_v, mut total_t, mut total_parts) = (0usize, 0usize, 0usize);
     for inst in &instances {
         if decoded[inst.mesh].is_none() {
             decoded[inst.mesh] = Some(decode_mesh(&reader, &doc, inst.mesh, &mut warnings)?);
         }
-        for p in decoded[inst.mesh].iter().flatten().filter(|p| !p.triangles.is_empty()) {
-            total_v = total_v.saturating_add(p.positions.len());
-            total_t = total_t.saturating_add(p.triangles.len());
+        let copies = inst.gpu.as_ref().map_or(1, |g| g.count);
+        let prims = decoded[inst.mesh].iter().flatten().filter(|p| !p.triangles.is_empty());
+        let (mut v, mut t) = (0usize, 0usize);
+        for p in prims {
+            v = v.saturating_add(p.positions.len());
+            t = t.saturating_add(p.triangles.len());
+        }
+        if t > 0 {
+            total_v = total_v.saturating_add(v.saturating_mul(copies));
+            total_t = total_t.saturating_add(t.saturating_mul(copies));
+            total_parts = total_parts.saturating_add(copies);
         }
     }
-    for (total, limit, what) in
-        [(total_v, MAX_SCENE_VERTICES, "vertices"), (total_t, MAX_SCENE_TRIANGLES, "triangles")]
-    {
+    for (total, limit, what) in [
+        (total_v, MAX_SCENE_VERTICES, "vertices"),
+        (total_t, MAX_SCENE_TRIANGLES, "triangles"),
+        (total_parts, MAX_SCENE_PARTS, "parts"),
+    ] {
         if total > limit {
             return Err(Error::input(
                 path,
@@ -85,7 +136,7 @@ pub(crate) fn load(path: &Path, bytes: &[u8]) -> Result<Loaded> {
         positions: Vec::with_capacity(total_v),
         triangles: Vec::with_capacity(total_t),
         tri_object: Vec::with_capacity(total_t),
-        objects: Vec::new(),
+        objects: Vec::with_capacity(total_parts),
     };
     let names = node_names(&doc);
     for inst in &instances {
@@ -93,35 +144,114 @@ pub(crate) fn load(path: &Path, bytes: &[u8]) -> Result<Loaded> {
         if prims.iter().all(|p| p.triangles.is_empty()) {
             continue;
         }
-        let object = mesh.objects.len() as u32;
-        mesh.objects.push(Object {
-            name: node_path(&inst.path, &names),
-            gltf_mesh: Some(inst.mesh as u32),
-            world: Some(inst.world),
-        });
-        for p in prims.iter().filter(|p| !p.triangles.is_empty()) {
-            let base = mesh.positions.len() as u32;
-            for (i, &v) in p.positions.iter().enumerate() {
-                let w = inst.world.transform_point3(v);
-                if let Some(bad) = super::non_finite(w.to_array()) {
-                    return Err(Error::input(
-                        path,
-                        format!(
-                            "position {i} of mesh {} is not finite ({bad}) after the transform of \
-                             node {}",
-                            inst.mesh, inst.node
-                        ),
-                    ));
-                }
-                mesh.positions.push(w);
+        let name = node_path(&inst.path, &names);
+        let Some(gpu) = &inst.gpu else {
+            add_instance(&mut mesh, path, inst, prims, name, inst.world, "")?;
+            continue;
+        };
+        let trs = InstanceTransforms::read(&reader, &accessors, inst.node, gpu)?;
+        for k in 0..gpu.count {
+            let world = inst.world * trs.matrix(k)?;
+            if !world.is_finite() {
+                return Err(Error::input(
+                    path,
+                    format!(
+                        "glTF node {}: world transform of GPU instance {k} is not finite (overflow)",
+                        inst.node
+                    ),
+                ));
             }
-            for t in &p.triangles {
-                mesh.triangles.push([base + t[0], base + t[1], base + t[2]]);
-                mesh.tri_object.push(object);
-            }
+            let part = format!("{name}#{k}");
+            add_instance(&mut mesh, path, inst, prims, part, world, &format!(" instance {k}"))?;
         }
     }
     Ok(Loaded { mesh, warnings })
+}
+
+/// Appends one part: `prims` transformed by `world`, as object `name`.
+fn add_instance(
+    mesh: &mut Mesh,
+    path: &Path,
+    inst: &Instance,
+    prims: &[Prim],
+    name: String,
+    world: DMat4,
+    which: &str,
+) -> Result<()> {
+    let object = mesh.objects.len() as u32;
+    mesh.objects.push(Object { name, gltf_mesh: Some(inst.mesh as u32), world: Some(world) });
+    for p in prims.iter().filter(|p| !p.triangles.is_empty()) {
+        let base = mesh.positions.len() as u32;
+        for (i, &v) in p.positions.iter().enumerate() {
+            let w = world.transform_point3(v);
+            if let Some(bad) = super::non_finite(w.to_array()) {
+                return Err(Error::input(
+                    path,
+                    format!(
+                        "position {i} of mesh {} is not finite ({bad}) after the transform of node {}{which}",
+                        inst.mesh, inst.node
+                    ),
+                ));
+            }
+            mesh.positions.push(w);
+        }
+        for t in &p.triangles {
+            mesh.triangles.push([base + t[0], base + t[1], base + t[2]]);
+            mesh.tri_object.push(object);
+        }
+    }
+    Ok(())
+}
+
+/// The decoded attributes of one `EXT_mesh_gpu_instancing` node (components decoded by
+/// [`super::gltf_data::component`]); missing ones are the identity (zero translation,
+/// identity rotation, unit scale). Matrices are made one at a time by [`Self::matrix`].
+struct InstanceTransforms<'a> {
+    path: &'a Path,
+    node: usize,
+    t: Option<Vec<[f64; 3]>>,
+    r: Option<Vec<[f64; 4]>>,
+    s: Option<Vec<[f64; 3]>>,
+}
+
+impl<'a> InstanceTransforms<'a> {
+    fn read(r: &Reader<'a, '_>, accessors: &[Accessor], node: usize, gpu: &Gpu) -> Result<Self> {
+        let what = format!("node {node} EXT_mesh_gpu_instancing");
+        let get = |a: Option<usize>| a.and_then(|a| accessors.get(a));
+        Ok(InstanceTransforms {
+            path: r.path,
+            node,
+            t: get(gpu.attrs.translation).map(|a| r.vectors(a, &what)).transpose()?,
+            r: get(gpu.attrs.rotation).map(|a| r.vectors(a, &what)).transpose()?,
+            s: get(gpu.attrs.scale).map(|a| r.vectors(a, &what)).transpose()?,
+        })
+    }
+
+    /// `T * R * S` of instance `k`: the rotation divided by its f64 length (a zero or
+    /// non-finite value is an error), the matrix built from the f64 values as a node's TRS is
+    /// ([`DMat4::from_scale_rotation_translation`]).
+    fn matrix(&self, k: usize) -> Result<DMat4> {
+        let t = self.t.as_ref().and_then(|v| v.get(k)).copied().unwrap_or([0.0; 3]);
+        let q = self.r.as_ref().and_then(|v| v.get(k)).copied().unwrap_or([0.0, 0.0, 0.0, 1.0]);
+        let s = self.s.as_ref().and_then(|v| v.get(k)).copied().unwrap_or([1.0; 3]);
+        let bad =
+            |m: String| Error::input(self.path, format!("glTF node {} GPU instance {k}: {m}", self.node));
+        for (name, bad_value) in [
+            ("TRANSLATION", super::non_finite(t)),
+            ("ROTATION", super::non_finite(q)),
+            ("SCALE", super::non_finite(s)),
+        ] {
+            if let Some(word) = bad_value {
+                return Err(bad(format!("{name} is not finite ({word})")));
+            }
+        }
+        let q = DQuat::from_array(q);
+        let len = q.length();
+        if len == 0.0 || !len.is_finite() {
+            return Err(bad("ROTATION is a zero quaternion".into()));
+        }
+        Ok(DMat4::from_scale_rotation_translation(DVec3::from_array(s), q / len, DVec3::from_array(t)))
+    }
 }
 
 /// One node drawing a mesh, in traversal order.
@@ -131,6 +261,14 @@ struct Instance {
     world: DMat4,
     /// Node indices from the scene root down to `node`.
     path: Vec<usize>,
+    /// The node's `EXT_mesh_gpu_instancing`, checked (types, equal counts), not yet read.
+    gpu: Option<Gpu>,
+}
+
+/// A checked `EXT_mesh_gpu_instancing`: its attributes and the common count.
+struct Gpu {
+    attrs: GpuInstancing,
+    count: usize,
 }
 
 /// One decoded primitive in mesh-local space (triangles index `positions`).
@@ -154,9 +292,41 @@ fn node_path(path: &[usize], names: &[Cow<'_, str>]) -> String {
     parts.join("/")
 }
 
+/// Checks a node's `EXT_mesh_gpu_instancing` without reading it: accessor types, and one
+/// count shared by every attribute (the number of instances).
+fn check_gpu(r: &Reader, accessors: &[Accessor], node: usize, attrs: &GpuInstancing) -> Result<Gpu> {
+    let mut count: Option<(usize, &str)> = None;
+    for (name, a) in &attrs.all {
+        let Some(acc) = accessors.get(*a) else {
+            return Err(Error::input(
+                r.path,
+                format!("glTF node {node}: EXT_mesh_gpu_instancing accessor {a} does not exist"),
+            ));
+        };
+        r.check_instance_attribute(acc, name, node)?;
+        match count {
+            None => count = Some((acc.count(), name)),
+            Some((c, first)) if c != acc.count() => {
+                let (name, n) = (super::clip(name, 40), acc.count());
+                let msg = format!("attributes have different counts ({first}: {c}, {name}: {n})");
+                return Err(Error::input(r.path, format!("glTF node {node}: EXT_mesh_gpu_instancing {msg}")));
+            }
+            Some(_) => {}
+        }
+    }
+    Ok(Gpu { attrs: attrs.clone(), count: count.map_or(0, |c| c.0) })
+}
+
 /// Checks the node graph (single parents, no cycles, bounded depth) and lists the mesh
 /// instances of the chosen scene in depth-first pre-order.
-fn traverse(path: &Path, doc: &Document, warnings: &mut Vec<String>) -> Result<Vec<Instance>> {
+fn traverse(
+    path: &Path,
+    doc: &Document,
+    ext: &Extensions,
+    r: &Reader,
+    accessors: &[Accessor],
+    warnings: &mut Vec<String>,
+) -> Result<Vec<Instance>> {
     let err = |m: String| Error::input(path, m);
     let n = doc.nodes().len();
     let mut parent: Vec<Option<usize>> = vec![None; n];
@@ -213,9 +383,13 @@ fn traverse(path: &Path, doc: &Document, warnings: &mut Vec<String>) -> Result<V
         if !world.is_finite() {
             return Err(err(format!("glTF node {i}: world transform is not finite (overflow)")));
         }
+        let gpu = ext.instancing.get(i).and_then(Option::as_ref);
         if let Some(mesh) = node.mesh() {
             skinned |= node.skin().is_some();
-            instances.push(Instance { node: i, mesh: mesh.index(), world, path: chain.clone() });
+            let gpu = gpu.map(|g| check_gpu(r, accessors, i, g)).transpose()?;
+            instances.push(Instance { node: i, mesh: mesh.index(), world, path: chain.clone(), gpu });
+        } else if gpu.is_some() {
+            warnings.push(format!("glTF node {i} has EXT_mesh_gpu_instancing but no mesh: ignored"));
         }
         let children: Vec<usize> = node.children().map(|c| c.index()).collect();
         for &c in children.iter().rev() {
@@ -326,7 +500,7 @@ fn decode_mesh(r: &Reader, doc: &Document, m: usize, warnings: &mut Vec<String>)
             warnings
                 .push(format!("{what}: {leftover} trailing indices do not form a triangle and were ignored"));
         }
-        let positions = positions.iter().map(|p| DVec3::from_array(p.map(f64::from))).collect();
+        let positions = positions.into_iter().map(DVec3::from_array).collect();
         out.push(Prim { positions, triangles });
     }
     Ok(out)

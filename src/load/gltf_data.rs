@@ -1,6 +1,8 @@
-//! glTF binary plumbing for [`super::gltf`]: GLB framing, JSON parsing and validation,
+//! glTF binary plumbing for [`super::gltf`]: GLB framing, JSON parsing and validation, the
+//! extension member the `gltf` crate does not expose (`EXT_mesh_gpu_instancing` on nodes,
+//! read by a second, typed serde pass over the same JSON that skips everything else),
 //! buffer resolution (GLB chunk, base64 `data:` URIs, external files) and bounds-checked
-//! accessor reading (strided, sparse).
+//! accessor reading (strided, sparse, quantized).
 //!
 //! Accessors are read here rather than with `gltf::mesh::Reader`, whose iterators silently
 //! stop (or, for malformed sparse data, panic) on out-of-range views: every byte range is
@@ -18,14 +20,24 @@ use base64::Engine as _;
 use super::io_message;
 use crate::error::{Error, Result};
 
-/// Required extensions that do not change geometry, so files requiring them still load.
-const HARMLESS_REQUIRED: &[&str] = &[
+/// Required extensions a file may list and still load: those decoded here
+/// (`KHR_mesh_quantization`, `EXT_mesh_gpu_instancing`) and those that only add appearance
+/// or metadata, never geometry (`KHR_materials_*` is accepted by prefix as well).
+const SUPPORTED_REQUIRED: &[&str] = &[
+    "KHR_mesh_quantization",
+    "EXT_mesh_gpu_instancing",
     "KHR_texture_transform",
     "KHR_texture_basisu",
     "EXT_texture_webp",
     "EXT_texture_avif",
     "MSFT_texture_dds",
     "KHR_lights_punctual",
+    "EXT_lights_image_based",
+    "KHR_xmp_json_ld",
+    "EXT_mesh_features",
+    "EXT_instance_features",
+    "EXT_structural_metadata",
+    "CESIUM_primitive_outline",
 ];
 
 /// Splits a GLB file into its JSON chunk and optional BIN chunk, checking every declared
@@ -86,16 +98,20 @@ fn le_u32(b: &[u8], o: usize) -> Option<usize> {
 }
 
 /// Parses and validates the glTF JSON. Required extensions are checked here (named in the
-/// error when unsupported); `EXT_mesh_gpu_instancing` used but not required gives a warning.
-pub(crate) fn parse_document(path: &Path, json: &[u8], warnings: &mut Vec<String>) -> Result<Document> {
-    let json = json.strip_prefix(&[0xEF, 0xBB, 0xBF]).unwrap_or(json);
+/// error when they cannot be decoded). Application-specific vertex attributes (`_BATCHID`,
+/// `_FEATURE_ID_0`, …), which this build of `gltf-json` would reject as invalid semantics,
+/// are dropped before validation: only POSITION and the indices are read.
+pub(crate) fn parse_document(path: &Path, json: &[u8]) -> Result<Document> {
+    let json = strip_bom(json);
     let mut root = ::gltf::json::Root::from_slice(json)
         .map_err(|e| Error::input(path, format!("invalid glTF JSON: {e}")))?;
     for ext in &root.extensions_required {
-        if !ext.starts_with("KHR_materials_") && !HARMLESS_REQUIRED.contains(&ext.as_str()) {
+        if !ext.starts_with("KHR_materials_") && !SUPPORTED_REQUIRED.contains(&ext.as_str()) {
             let hint = match ext.as_str() {
-                "KHR_mesh_quantization" => " (quantized positions are not supported yet)",
-                "EXT_mesh_gpu_instancing" => " (GPU instancing is not supported yet)",
+                "KHR_draco_mesh_compression" => " (Draco-compressed geometry cannot be decoded)",
+                "EXT_meshopt_compression" | "KHR_meshopt_compression" => {
+                    " (meshopt-compressed buffers cannot be decoded)"
+                }
                 _ => "",
             };
             return Err(Error::input(
@@ -106,12 +122,28 @@ pub(crate) fn parse_document(path: &Path, json: &[u8], warnings: &mut Vec<String
     }
     // Checked above; the gltf crate would reject any it does not itself implement.
     root.extensions_required.clear();
-    if root.extensions_used.iter().any(|e| e == "EXT_mesh_gpu_instancing") {
-        warnings.push(
-            "EXT_mesh_gpu_instancing is not supported: instanced meshes are loaded once, at \
-             their node's transform"
-                .to_string(),
-        );
+    for mesh in &mut root.meshes {
+        for prim in &mut mesh.primitives {
+            prim.attributes.retain(|k, _| matches!(k, ::gltf::json::validation::Checked::Valid(_)));
+        }
+    }
+    // An accessor with neither bufferView nor sparse values has its data supplied by an
+    // extension (core spec, § 3.6.2.4): a compressed file whose extension we cannot decode.
+    if let Some(a) = root.accessors.iter().position(|a| a.buffer_view.is_none() && a.sparse.is_none()) {
+        let by: Vec<&str> = root
+            .extensions_used
+            .iter()
+            .map(String::as_str)
+            .filter(|e| !e.starts_with("KHR_materials_") && !SUPPORTED_REQUIRED.contains(e))
+            .collect();
+        let by = if by.is_empty() { "none".to_string() } else { by.join(", ") };
+        return Err(Error::input(
+            path,
+            format!(
+                "glTF accessor {a} has no data (neither bufferView nor sparse values): it would \
+                 come from an extension that is not supported (extensions used: {by})"
+            ),
+        ));
     }
     // gltf-json's validation indexes `accessors` with the POSITION index unchecked (a panic on a
     // dangling index), so check those references before validating.
@@ -149,6 +181,107 @@ pub(crate) fn parse_document(path: &Path, json: &[u8], warnings: &mut Vec<String
         };
         Error::input(path, msg)
     })
+}
+
+fn strip_bom(json: &[u8]) -> &[u8] {
+    json.strip_prefix(&[0xEF, 0xBB, 0xBF]).unwrap_or(json)
+}
+
+/// The `EXT_mesh_gpu_instancing` attributes of one node: accessor indices, checked to exist.
+#[derive(Debug, Clone, Default, PartialEq)]
+pub(crate) struct GpuInstancing {
+    /// `TRANSLATION` accessor.
+    pub translation: Option<usize>,
+    /// `ROTATION` accessor.
+    pub rotation: Option<usize>,
+    /// `SCALE` accessor.
+    pub scale: Option<usize>,
+    /// Every attribute (the three above and application-specific ones such as `_ID`), by
+    /// name: all must have the same count, which is the number of instances.
+    pub all: Vec<(String, usize)>,
+}
+
+/// What the second JSON pass finds: per node its `EXT_mesh_gpu_instancing`.
+#[derive(Debug, Default)]
+pub(crate) struct Extensions {
+    /// By node index; `None` for nodes without `EXT_mesh_gpu_instancing`.
+    pub instancing: Vec<Option<GpuInstancing>>,
+}
+
+/// Serde view of the parts of the glTF JSON the `gltf` crate (without its `extensions`
+/// feature) drops; every other member is skipped unparsed.
+#[derive(serde::Deserialize, Default)]
+#[serde(default)]
+struct ExtRoot {
+    nodes: Vec<ExtNode>,
+}
+
+#[derive(serde::Deserialize, Default)]
+#[serde(default)]
+struct ExtNode {
+    extensions: Option<ExtNodeExtensions>,
+}
+
+#[derive(serde::Deserialize, Default)]
+#[serde(default)]
+struct ExtNodeExtensions {
+    #[serde(rename = "EXT_mesh_gpu_instancing")]
+    gpu_instancing: Option<serde_json::Value>,
+}
+
+/// Reads the extension members of nodes and primitives from the glTF `json` (already
+/// validated by [`parse_document`]); `accessors` is the number of accessors, for range checks.
+///
+/// `EXT_mesh_gpu_instancing` is honoured wherever a node carries it, whether or not the file
+/// lists it in `extensionsUsed` (instances left out would be clashes missed).
+pub(crate) fn parse_extensions(path: &Path, json: &[u8], accessors: usize) -> Result<Extensions> {
+    let root: ExtRoot = serde_json::from_slice(strip_bom(json))
+        .map_err(|e| Error::input(path, format!("invalid glTF JSON: {e}")))?;
+    let mut out = Extensions::default();
+    for (i, node) in root.nodes.into_iter().enumerate() {
+        let gpu = match node.extensions.and_then(|e| e.gpu_instancing) {
+            Some(v) => Some(gpu_instancing(path, i, &v, accessors)?),
+            None => None,
+        };
+        out.instancing.push(gpu);
+    }
+    Ok(out)
+}
+
+fn gpu_instancing(
+    path: &Path,
+    node: usize,
+    v: &serde_json::Value,
+    accessors: usize,
+) -> Result<GpuInstancing> {
+    let err = |m: String| Error::input(path, format!("glTF node {node}: EXT_mesh_gpu_instancing {m}"));
+    let Some(attrs) = v.get("attributes").and_then(|a| a.as_object()) else {
+        return Err(err("has no 'attributes' object".into()));
+    };
+    if attrs.is_empty() {
+        return Err(err("has no attributes, so no instance count".into()));
+    }
+    let mut out = GpuInstancing::default();
+    for (name, index) in attrs {
+        let shown = super::clip(name, 40);
+        let Some(a) = index.as_u64() else {
+            return Err(err(format!("attribute {shown} is not an accessor index")));
+        };
+        if a >= accessors as u64 {
+            return Err(err(format!(
+                "attribute {shown} uses accessor {a} but there are {accessors} accessors"
+            )));
+        }
+        let a = a as usize;
+        match name.as_str() {
+            "TRANSLATION" => out.translation = Some(a),
+            "ROTATION" => out.rotation = Some(a),
+            "SCALE" => out.scale = Some(a),
+            _ => {}
+        }
+        out.all.push((name.clone(), a));
+    }
+    Ok(out)
 }
 
 /// Resolves every buffer: the GLB binary chunk, a base64 `data:` URI, or a relative file
@@ -211,21 +344,53 @@ fn decode_data_uri(uri: &str) -> std::result::Result<Vec<u8>, String> {
     engine.decode(payload.trim()).map_err(|e| format!("bad base64: {e}"))
 }
 
+/// Why a buffer URI may not be read, or `None` when it is a relative reference that stays
+/// inside the glTF's directory. `name` is the percent-decoded URI; `/` and `\\` both count
+/// as separators, so the check is the same on every platform.
+fn unsafe_relative_path(name: &str) -> Option<&'static str> {
+    if name.starts_with(['/', '\\']) {
+        return Some("an absolute path");
+    }
+    let mut depth = 0usize;
+    for segment in name.split(['/', '\\']) {
+        match segment {
+            _ if segment.contains(':') => return Some("a scheme or drive letter"),
+            ".." if depth == 0 => return Some("'..' leaving the glTF's directory"),
+            ".." => depth -= 1,
+            "" | "." => {}
+            _ => depth += 1,
+        }
+    }
+    if name.contains('\0') {
+        return Some("a NUL byte");
+    }
+    None
+}
+
+/// Reads an external buffer. Policy: only relative references that stay inside the directory
+/// of the glTF file (after percent-decoding: no scheme such as `file:` or `https:`, no
+/// absolute path, no drive letter or UNC prefix, no `..` climbing above that directory); a
+/// file inside it that is a symbolic link is followed.
 fn read_external(path: &Path, i: usize, uri: &str, declared: usize) -> Result<Vec<u8>> {
     let shown = super::clip(uri, 80);
-    let scheme = uri.split(['/', '\\']).next().unwrap_or("");
-    if scheme.contains(':') {
-        return Err(Error::input(
+    let refuse = |why: &str| {
+        Error::input(
             path,
             format!(
-                "glTF buffer {i} URI '{shown}' is not supported (only data: URIs and relative \
-                 file paths)"
+                "glTF buffer {i} URI '{shown}' is refused: {why} (only data: URIs and relative \
+                 paths inside the glTF's directory are read)"
             ),
-        ));
+        )
+    };
+    if let Some(why) = unsafe_relative_path(uri) {
+        return Err(refuse(why));
     }
     let name = percent_decode(uri).map_err(|()| {
         Error::input(path, format!("glTF buffer {i} URI '{shown}' is not valid UTF-8 when percent-decoded"))
     })?;
+    if let Some(why) = unsafe_relative_path(&name) {
+        return Err(refuse(why));
+    }
     let file = path.parent().unwrap_or(Path::new("")).join(&name);
     let cannot = |e: std::io::Error| {
         Error::input(path, format!("glTF external buffer '{shown}' cannot be read: {}", io_message(&e)))
@@ -313,29 +478,71 @@ impl Reader<'_, '_> {
         Error::input(self.path, msg)
     }
 
-    /// A POSITION accessor as f32 triples (`what` names the mesh/primitive for messages).
-    pub(crate) fn positions(&self, acc: &Accessor, what: &str) -> Result<Vec<[f32; 3]>> {
-        if acc.data_type() != DataType::F32 {
-            return Err(self.err(format!(
-                "positions accessor of {what} uses component type {} (KHR_mesh_quantization is \
-                 not supported yet)",
-                type_name(acc.data_type())
-            )));
-        }
+    /// A POSITION accessor as f64 triples (`what` names the mesh/primitive for messages).
+    ///
+    /// `FLOAT` components are widened exactly. The integer component types of
+    /// `KHR_mesh_quantization` are decoded as [`component`] says (exact for unnormalized
+    /// integers; one correctly rounded f64 division for normalized ones). Sparse substitution
+    /// works for every type, the sparse values having the accessor's component type.
+    pub(crate) fn positions(&self, acc: &Accessor, what: &str) -> Result<Vec<[f64; 3]>> {
         if acc.dimensions() != Dimensions::Vec3 {
             return Err(self.err(format!(
                 "positions accessor of {what} has type {} (expected VEC3)",
                 dims_name(acc.dimensions())
             )));
         }
-        let f = |b: &[u8], o: usize| f32::from_le_bytes([b[o], b[o + 1], b[o + 2], b[o + 3]]);
-        let out = self.read(acc, what, 12, |b| [f(b, 0), f(b, 4), f(b, 8)])?;
+        if acc.data_type() == DataType::U32 {
+            return Err(self.err(format!(
+                "positions accessor of {what} uses component type UNSIGNED_INT (expected FLOAT, or \
+                 BYTE, UNSIGNED_BYTE, SHORT or UNSIGNED_SHORT with KHR_mesh_quantization)"
+            )));
+        }
+        let out = self.vectors::<3>(acc, what)?;
         for (i, p) in out.iter().enumerate() {
-            if let Some(bad) = super::non_finite([p[0] as f64, p[1] as f64, p[2] as f64]) {
+            if let Some(bad) = super::non_finite(*p) {
                 return Err(self.err(format!("position {i} of {what} has a non-finite coordinate ({bad})")));
             }
         }
         Ok(out)
+    }
+
+    /// Reads `acc` (any component type except `UNSIGNED_INT`) as `N`-vectors of f64, decoded
+    /// by [`component`]. The caller checks the accessor type and component type it allows.
+    pub(crate) fn vectors<const N: usize>(&self, acc: &Accessor, what: &str) -> Result<Vec<[f64; N]>> {
+        let t = acc.data_type();
+        let size = t.size();
+        let norm = acc.normalized();
+        self.read(acc, what, N * size, |b| std::array::from_fn(|k| component(t, norm, &b[k * size..])))
+    }
+
+    /// An `EXT_mesh_gpu_instancing` attribute of `node`: `TRANSLATION` and `SCALE` are FLOAT
+    /// VEC3, `ROTATION` is VEC4 of FLOAT or normalized BYTE or SHORT (the extension's table).
+    /// Other (application-specific) attributes are not read.
+    pub(crate) fn check_instance_attribute(&self, acc: &Accessor, name: &str, node: usize) -> Result<()> {
+        let (dims, ok) = match name {
+            "TRANSLATION" | "SCALE" => (Dimensions::Vec3, acc.data_type() == DataType::F32),
+            "ROTATION" => (
+                Dimensions::Vec4,
+                acc.data_type() == DataType::F32
+                    || (matches!(acc.data_type(), DataType::I8 | DataType::I16) && acc.normalized()),
+            ),
+            _ => return Ok(()),
+        };
+        if acc.dimensions() != dims || !ok {
+            let expected = match name {
+                "ROTATION" => "VEC4 of FLOAT, or of normalized BYTE or SHORT",
+                _ => "VEC3 of FLOAT",
+            };
+            return Err(self.err(format!(
+                "glTF node {node}: EXT_mesh_gpu_instancing {name} accessor {} is {} of {}{} \
+                 (expected {expected})",
+                acc.index(),
+                dims_name(acc.dimensions()),
+                if acc.normalized() { "normalized " } else { "" },
+                type_name(acc.data_type()),
+            )));
+        }
+        Ok(())
     }
 
     /// An index accessor (u8, u16 or u32 scalars) as u32.
@@ -402,7 +609,8 @@ impl Reader<'_, '_> {
     }
 
     /// Reads `acc` as elements of `elem` bytes decoded by `decode`, applying sparse values.
-    fn read<T: Copy + Default>(
+    /// Without a bufferView the base values are all-zero bytes, decoded.
+    fn read<T: Copy>(
         &self,
         acc: &Accessor,
         what: &str,
@@ -439,7 +647,7 @@ impl Reader<'_, '_> {
                         self.input_bytes
                     )));
                 }
-                vec![T::default(); count]
+                vec![decode(&vec![0u8; elem]); count]
             }
         };
         if let Some(sparse) = acc.sparse() {
@@ -473,6 +681,34 @@ impl Reader<'_, '_> {
             }
         }
         Ok(out)
+    }
+}
+
+/// One accessor component at the start of `b` as f64.
+///
+/// - `FLOAT`: the f32 value, widened exactly.
+/// - Integer types, not normalized: the integer itself (exact).
+/// - Normalized (glTF 2.0 § 3.11, as KHR_mesh_quantization restates): `c / 255`,
+///   `c / 65535` for unsigned bytes and shorts, `max(c / 127, -1)`, `max(c / 32767, -1)` for
+///   signed ones, each quotient one IEEE-754 f64 division (correctly rounded, so the same on
+///   every platform); the clamp only maps -128 and -32768 to exactly -1.
+/// - `UNSIGNED_INT` (never allowed for the attributes read here): the integer, normalized by
+///   `2^32 - 1` if flagged.
+///
+/// `b` must hold at least the component's size (the caller's ranges guarantee it).
+pub(crate) fn component(t: DataType, normalized: bool, b: &[u8]) -> f64 {
+    let (v, max) = match t {
+        DataType::F32 => return f64::from(f32::from_le_bytes([b[0], b[1], b[2], b[3]])),
+        DataType::I8 => (f64::from(b[0] as i8), 127.0),
+        DataType::U8 => (f64::from(b[0]), 255.0),
+        DataType::I16 => (f64::from(i16::from_le_bytes([b[0], b[1]])), 32767.0),
+        DataType::U16 => (f64::from(u16::from_le_bytes([b[0], b[1]])), 65535.0),
+        DataType::U32 => (f64::from(u32::from_le_bytes([b[0], b[1], b[2], b[3]])), 4294967295.0),
+    };
+    if normalized {
+        (v / max).max(-1.0)
+    } else {
+        v
     }
 }
 
