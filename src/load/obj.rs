@@ -138,7 +138,11 @@ impl<'p> Parser<'p> {
             return Ok(());
         };
         match keyword {
-            b"v" => self.vertex(line, start, &mut tokens),
+            b"v" => match std::str::from_utf8(text) {
+                // One UTF-8 check per line, not per coordinate (it was a fifth of the parse).
+                Ok(valid) => self.vertex(line, start, &mut tokens, Some(valid)),
+                Err(_) => self.vertex(line, start, &mut tokens, None),
+            },
             b"f" | b"fo" => self.face(line, start, &mut tokens),
             b"o" | b"g" => {
                 let name = String::from_utf8_lossy(tokens.rest()).trim().to_string();
@@ -163,13 +167,18 @@ impl<'p> Parser<'p> {
         }
     }
 
-    fn vertex(&mut self, line: usize, start: usize, tokens: &mut Tokens) -> Result<()> {
+    /// `valid`: the whole line, when it is known to be UTF-8.
+    fn vertex(&mut self, line: usize, start: usize, tokens: &mut Tokens, valid: Option<&str>) -> Result<()> {
         let mut c = [0.0f64; 3];
         for (k, slot) in c.iter_mut().enumerate() {
             let Some((off, tok)) = tokens.next() else {
                 return Err(self.err(line, format!("vertex has {k} coordinates (needs 3)")));
             };
-            let s = self.utf8(line, start + off, tok)?;
+            // Tokens end at ASCII whitespace, so they are char boundaries of a valid line.
+            let s = match valid {
+                Some(text) => &text[off..off + tok.len()],
+                None => self.utf8(line, start + off, tok)?,
+            };
             *slot = s.parse::<f64>().map_err(|_| {
                 self.err(line, format!("cannot parse '{}' as a vertex coordinate", clip(s, 40)))
             })?;
@@ -191,10 +200,15 @@ impl<'p> Parser<'p> {
         let defined = self.mesh.positions.len() as i64;
         while let Some((off, tok)) = tokens.next() {
             let v = tok.split(|&b| b == b'/').next().unwrap_or(tok);
-            let s = self.utf8(line, start + off, v)?;
-            let idx: i64 = s.parse().map_err(|_| {
-                self.err(line, format!("cannot parse '{}' as a face vertex index", clip(s, 40)))
-            })?;
+            let idx = match plain_index(v) {
+                Some(i) => i,
+                None => {
+                    let s = self.utf8(line, start + off, v)?;
+                    s.parse().map_err(|_| {
+                        self.err(line, format!("cannot parse '{}' as a face vertex index", clip(s, 40)))
+                    })?
+                }
+            };
             let zero_based = match idx {
                 0 => return Err(self.err(line, "face refers to vertex 0 (OBJ indices start at 1)")),
                 i if i < 0 => {
@@ -255,7 +269,7 @@ impl<'a> Lines<'a> {
         }
         let start = self.pos;
         let rest = &self.bytes[start..];
-        let len = rest.iter().position(|&b| b == b'\n').unwrap_or(rest.len());
+        let len = memchr::memchr(b'\n', rest).unwrap_or(rest.len());
         self.pos = start + len + 1;
         self.line += 1;
         let mut text = &rest[..len];
@@ -283,6 +297,21 @@ impl<'a> Lines<'a> {
         }
         Some((line, start, Cow::Owned(joined)))
     }
+}
+
+/// The common face index spelling, `[-]digits` with at most 18 digits (cannot overflow), read
+/// without a UTF-8 check; anything else (a `+`, more digits, garbage) goes through `str::parse`,
+/// which gives the same value or the error.
+fn plain_index(t: &[u8]) -> Option<i64> {
+    let (neg, digits) = match t {
+        [b'-', rest @ ..] => (true, rest),
+        _ => (false, t),
+    };
+    if digits.is_empty() || digits.len() > 18 || !digits.iter().all(u8::is_ascii_digit) {
+        return None;
+    }
+    let v = digits.iter().fold(0i64, |v, &d| v * 10 + (d - b'0') as i64);
+    Some(if neg { -v } else { v })
 }
 
 fn continues(text: &[u8]) -> bool {
@@ -323,7 +352,6 @@ impl<'a> Tokens<'a> {
         }
         Some((start, &t[start..self.pos]))
     }
-
     /// The rest of the line (up to a `#` that starts a token), untrimmed.
     fn rest(&mut self) -> &'a [u8] {
         let t = &self.text[self.pos.min(self.text.len())..];
@@ -369,6 +397,16 @@ mod tests {
         assert_eq!(l.mesh.objects.len(), 1);
         assert_eq!(l.mesh.objects[0].name, "object0");
         assert!(l.warnings.is_empty(), "{:?}", l.warnings);
+    }
+
+    #[test]
+    fn plain_index_agrees_with_str_parse() {
+        for t in ["1", "-1", "0", "-0", "007", "123456789012345678", "-123456789012345678"] {
+            assert_eq!(plain_index(t.as_bytes()), Some(t.parse::<i64>().unwrap()), "{t}");
+        }
+        for t in ["", "-", "+1", "1e3", "1.0", "1234567890123456789", "--1", "1-", "x"] {
+            assert_eq!(plain_index(t.as_bytes()), None, "{t}");
+        }
     }
 
     #[test]
