@@ -101,18 +101,17 @@ pub struct Stats {
 
 impl Bvh {
     /// Build over all triangles of `mesh`. Uses rayon for large subtrees.
+    ///
+    /// The build allocates no per-triangle box array: besides the tree (nodes + indices) it
+    /// needs 32 bytes per triangle while it chooses the splits, freed before the nodes are
+    /// allocated (see `build.rs`).
     pub fn build(mesh: &Mesh, opts: BuildOptions) -> Bvh {
-        let boxes: Vec<Aabb> = mesh
-            .triangles
-            .iter()
-            .map(|t| Aabb::of_triangle(&t.map(|i| mesh.positions[i as usize])))
-            .collect();
-        build::build(&boxes, opts)
+        build::build(mesh.triangles.len(), |t| Aabb::of_triangle(&triangle(mesh, t)), opts)
     }
 
     /// Build over precomputed triangle boxes.
     pub fn build_from_boxes(boxes: &[Aabb], opts: BuildOptions) -> Bvh {
-        build::build(boxes, opts)
+        build::build(boxes.len(), |t| boxes[t as usize], opts)
     }
 
     /// The root box.
