@@ -8,10 +8,17 @@
 //! ([`crate::output::baseline::finding_id`], derived from geometry and part names) among its
 //! pairs, so ids do not depend on thread timing or file order.
 
+use crate::bvh::{self, BuildOptions, Bvh};
+use crate::containment::{self, Inside};
 use crate::geom::{Aabb, DVec3};
 use crate::mesh::Mesh;
 use crate::query::{PairFinding, PairKind};
+use rayon::prelude::*;
 use std::collections::HashMap;
+
+/// At most this many vertices (taken at an even stride in a fixed order) are measured per
+/// region and side, so the estimate costs a bounded number of point queries.
+pub const PENETRATION_SAMPLES: usize = 4096;
 
 /// One connected interference.
 #[derive(Debug, Clone, PartialEq)]
@@ -28,9 +35,28 @@ pub struct Region {
     pub center: DVec3,
     /// Box of the contact set.
     pub bounds: Aabb,
-    /// Diagonal of that box: the size of the interference curve or patch (not a penetration
-    /// depth, which needs the volumes and is not computed).
+    /// Diagonal of that box: the size of the interference curve or patch.
     pub extent: f64,
+    /// Penetration estimate (see [`estimate_penetration`]); `None` until estimated, or when
+    /// neither part is closed.
+    pub penetration: Option<Penetration>,
+    /// Indices into the pairs the region was made from.
+    pub members: Vec<usize>,
+}
+
+/// How deep one part reaches into the other at a region.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Penetration {
+    /// The largest distance found from a sampled point of one part's surface that lies inside
+    /// the other (closed) part, near this region, to the other part's surface; 0 when none is.
+    pub depth: f64,
+    /// That point (the centre of the region when `depth` is 0).
+    pub point: DVec3,
+    /// Whose point: 0 = a point of A's surface inside B, 1 = of B's inside A.
+    pub side: u8,
+    /// Points found inside the other part and measured (sampled: at most about
+    /// 2 × [`PENETRATION_SAMPLES`] per region and side).
+    pub samples: usize,
 }
 
 fn key(p: DVec3) -> [u64; 3] {
@@ -102,11 +128,244 @@ pub fn regions(pairs: &[PairFinding], a: &Mesh, b: &Mesh) -> Vec<Region> {
                 center: sum / members.len() as f64,
                 bounds,
                 extent: bounds.extent().length(),
+                penetration: None,
+                members,
             }
         })
         .collect();
     out.sort_by(|x, y| x.id.cmp(&y.id));
     out
+}
+
+fn point_distance(p: DVec3, m: &Mesh, t: &Bvh) -> f64 {
+    let pb = Aabb { min: p, max: p };
+    let mut best = f64::INFINITY;
+    let mut stack = vec![0u32];
+    while let Some(i) = stack.pop() {
+        let n = &t.nodes[i as usize];
+        if n.bounds.distance_sq(&pb) >= best * best {
+            continue;
+        }
+        if n.is_leaf() {
+            for &tri in t.leaf_prims(n) {
+                let [a, b, c] = bvh::triangle(m, tri);
+                best = best.min((crate::distance::closest_point_on_triangle(p, a, b, c) - p).length());
+            }
+        } else {
+            let (l, r) = (i + 1, n.a);
+            let dl = t.nodes[l as usize].bounds.distance_sq(&pb);
+            let dr = t.nodes[r as usize].bounds.distance_sq(&pb);
+            let order = if dl <= dr { [r, l] } else { [l, r] };
+            stack.extend(order);
+        }
+    }
+    best
+}
+
+/// One part of one input, ready for point queries: its triangles, tree, and whether it is
+/// closed (only a closed part has an inside).
+struct Solid {
+    mesh: Mesh,
+    tree: Bvh,
+}
+
+/// Estimate each region's penetration depth.
+///
+/// For each side (A's vertices inside B's part, then B's inside A's), when the *other* part
+/// is closed: the inner part's triangles that meet no triangle of the other part ("free"
+/// triangles) form connected pieces, each entirely inside or entirely outside the other part
+/// (a piece that reached the other surface would have a triangle meeting it), so one exact
+/// ray-parity test decides a piece. The candidates are the vertices of the pieces sharing a
+/// vertex with the region's triangles, plus the region's own vertices and its triangles'
+/// centroids and edge midpoints that are inside (exact parity) and off the other surface; the
+/// depth is the largest distance from a candidate to the other part's surface, over both
+/// sides. It is a lower bound on how far the surfaces interpenetrate there (the surface
+/// between samples is not searched), exact when the deepest point is a sample — a box corner,
+/// a pin's end. Distances are f64 (rounded like `min_distance`).
+///
+/// Needs the complete pair list (not `--first-hit`). Parts are copied and a tree built only
+/// for parts that have a region.
+pub fn estimate_penetration(regs: &mut [Region], pairs: &[PairFinding], a: &Mesh, b: &Mesh, opts: BuildOptions) {
+    if regs.is_empty() {
+        return;
+    }
+    let meshes = [a, b];
+    // Solids: the parts that are the "outer" side of some region, built in parallel.
+    let mut wanted: Vec<(u8, u32)> =
+        regs.iter().flat_map(|r| [(0u8, r.objects.0), (1u8, r.objects.1)]).collect();
+    wanted.sort_unstable();
+    wanted.dedup();
+    let solids: HashMap<(u8, u32), Option<Solid>> = wanted
+        .par_iter()
+        .map(|&(side, o)| {
+            let m = meshes[side as usize];
+            let tris: Vec<u32> = (0..m.triangles.len() as u32).filter(|&t| m.tri_object[t as usize] == o).collect();
+            let mesh = m.sub_mesh(&tris);
+            let solid = containment::topology(&mesh).closed.then(|| {
+                let tree = Bvh::build(&mesh, opts);
+                Solid { mesh, tree }
+            });
+            ((side, o), solid)
+        })
+        .collect();
+    let merged = [crate::bodies::merge_vertices(&a.positions).0, crate::bodies::merge_vertices(&b.positions).0];
+    // Per part pair: which triangles of each side meet the other part.
+    let mut cut: HashMap<(u32, u32), [Vec<u32>; 2]> = HashMap::new();
+    for p in pairs {
+        let e = cut.entry((a.tri_object[p.a as usize], b.tri_object[p.b as usize])).or_default();
+        e[0].push(p.a);
+        e[1].push(p.b);
+    }
+    for c in cut.values_mut() {
+        for v in c.iter_mut() {
+            v.sort_unstable();
+            v.dedup();
+        }
+    }
+    let estimates: Vec<Option<Penetration>> = regs
+        .par_iter()
+        .map(|r| {
+            let mut best: Option<Penetration> = None;
+            for side in 0..2u8 {
+                let (inner, outer_obj, inner_obj) = match side {
+                    0 => (a, (1u8, r.objects.1), r.objects.0),
+                    _ => (b, (0u8, r.objects.0), r.objects.1),
+                };
+                let Some(Some(outer)) = solids.get(&outer_obj) else { continue };
+                let cuts = &cut[&r.objects][side as usize];
+                let found = side_depth(r, pairs, side, inner, inner_obj, &merged[side as usize], cuts, outer);
+                let replace = match (&best, &found) {
+                    (_, None) => false,
+                    (None, Some(_)) => true,
+                    (Some(x), Some(y)) => y.depth > x.depth,
+                };
+                if replace {
+                    best = found;
+                }
+            }
+            best
+        })
+        .collect();
+    for (r, e) in regs.iter_mut().zip(estimates) {
+        r.penetration = e;
+    }
+}
+
+#[allow(clippy::too_many_arguments)]
+fn side_depth(
+    r: &Region,
+    pairs: &[PairFinding],
+    side: u8,
+    inner: &Mesh,
+    inner_obj: u32,
+    merged: &[u32],
+    cuts: &[u32],
+    outer: &Solid,
+) -> Option<Penetration> {
+    let tri_of = |p: &PairFinding| if side == 0 { p.a } else { p.b };
+    // Free triangles of the inner part, joined into pieces through shared (merged) vertices.
+    let mut parent: HashMap<u32, u32> = HashMap::new();
+    fn find(parent: &mut HashMap<u32, u32>, mut x: u32) -> u32 {
+        loop {
+            let p = *parent.entry(x).or_insert(x);
+            if p == x {
+                return x;
+            }
+            let g = *parent.entry(p).or_insert(p);
+            parent.insert(x, g);
+            x = g;
+        }
+    }
+    let free: Vec<u32> = (0..inner.triangles.len() as u32)
+        .filter(|&t| inner.tri_object[t as usize] == inner_obj && cuts.binary_search(&t).is_err())
+        .collect();
+    for &t in &free {
+        let v = inner.triangles[t as usize].map(|i| merged[i as usize]);
+        for k in 1..3 {
+            let (x, y) = (find(&mut parent, v[0]), find(&mut parent, v[k]));
+            if x != y {
+                parent.insert(x.max(y), x.min(y));
+            }
+        }
+    }
+    // The region's vertices (one position per merged id, in a fixed order).
+    let mut region_vertices: Vec<(u32, u32)> = r
+        .members
+        .iter()
+        .flat_map(|&i| inner.triangles[tri_of(&pairs[i]) as usize])
+        .map(|v| (merged[v as usize], v))
+        .collect();
+    region_vertices.sort_unstable();
+    region_vertices.dedup_by_key(|x| x.0);
+    // Pieces touching the region, and the region's vertices that belong to no free triangle.
+    let mut pieces: Vec<u32> = Vec::new();
+    let mut loose: Vec<u32> = Vec::new();
+    for &(m, v) in &region_vertices {
+        if parent.contains_key(&m) {
+            pieces.push(find(&mut parent, m));
+        } else {
+            loose.push(v);
+        }
+    }
+    pieces.sort_unstable();
+    pieces.dedup();
+    // Vertices of the inside pieces (one per merged id), then loose points.
+    let mut candidates: Vec<DVec3> = Vec::new();
+    if !pieces.is_empty() {
+        let mut seen: HashMap<u32, u32> = HashMap::new(); // merged id -> vertex
+        for &t in &free {
+            for v in inner.triangles[t as usize] {
+                seen.entry(merged[v as usize]).or_insert(v);
+            }
+        }
+        let mut by_piece: HashMap<u32, Vec<(u32, u32)>> = HashMap::new();
+        for (&m, &v) in &seen {
+            let root = find(&mut parent, m);
+            if pieces.binary_search(&root).is_ok() {
+                by_piece.entry(root).or_default().push((m, v));
+            }
+        }
+        for root in &pieces {
+            let mut verts = by_piece.remove(root).unwrap_or_default();
+            verts.sort_unstable();
+            // A free vertex is off the other surface, so the parity test applies.
+            let probe = inner.positions[verts[0].1 as usize];
+            if containment::point_in_closed_mesh(probe, &outer.mesh, &outer.tree) == Inside::Yes {
+                candidates.extend(verts.iter().map(|x| inner.positions[x.1 as usize]));
+            }
+        }
+    }
+    // Loose points: the region's vertices on no free triangle, and the centroid and edge
+    // midpoints of the region's triangles (a long triangle crossing a thin wall has its
+    // deepest points between its vertices), sampled.
+    let mut loose: Vec<DVec3> = loose.iter().map(|&v| inner.positions[v as usize]).collect();
+    let mut tris: Vec<u32> = r.members.iter().map(|&i| tri_of(&pairs[i])).collect();
+    tris.sort_unstable();
+    tris.dedup();
+    for &t in tris.iter().step_by(tris.len().div_ceil(PENETRATION_SAMPLES / 4).max(1)) {
+        let [a, b, c] = bvh::triangle(inner, t);
+        loose.extend([(a + b + c) / 3.0, (a + b) * 0.5, (b + c) * 0.5, (c + a) * 0.5]);
+    }
+    let mut measured: Vec<(DVec3, f64)> = Vec::new();
+    for &p in loose.iter().step_by(loose.len().div_ceil(PENETRATION_SAMPLES).max(1)) {
+        // A point on the other surface (exactly) is not inside, and the parity test needs it off.
+        if !containment::on_surface(p, &outer.mesh, &outer.tree)
+            && containment::point_in_closed_mesh(p, &outer.mesh, &outer.tree) == Inside::Yes
+        {
+            measured.push((p, point_distance(p, &outer.mesh, &outer.tree)));
+        }
+    }
+    let stride = candidates.len().div_ceil(PENETRATION_SAMPLES).max(1);
+    let mut best = Penetration { depth: 0.0, point: r.center, side, samples: 0 };
+    let pieces = candidates.iter().step_by(stride).map(|&p| (p, point_distance(p, &outer.mesh, &outer.tree)));
+    for (p, d) in pieces.chain(measured) {
+        best.samples += 1;
+        if d > best.depth {
+            best.depth = d;
+            best.point = p;
+        }
+    }
+    Some(best)
 }
 
 #[cfg(test)]
@@ -170,6 +429,95 @@ mod tests {
         // Stable: the same regions from the pairs in another order.
         let mut rev = r.pairs.clone();
         rev.reverse();
-        assert_eq!(regions(&rev, &a, &b), regs);
+        let strip = |v: Vec<Region>| v.into_iter().map(|g| Region { members: vec![], ..g }).collect::<Vec<_>>();
+        assert_eq!(strip(regions(&rev, &a, &b)), strip(regs));
+    }
+
+    /// A closed box from `lo` to `hi` with each face cut into `n`×`n` quads (shared vertices).
+    fn grid_box(lo: DVec3, hi: DVec3, n: usize) -> Mesh {
+        let mut index: HashMap<[u64; 3], u32> = HashMap::new();
+        let mut m = mesh(&[]);
+        let mut vid = |m: &mut Mesh, p: DVec3| {
+            *index.entry(key(p)).or_insert_with(|| {
+                m.positions.push(p);
+                (m.positions.len() - 1) as u32
+            })
+        };
+        let at = |axis: usize, side: f64, u: f64, v: f64| {
+            let (i, j) = ((axis + 1) % 3, (axis + 2) % 3);
+            let mut p = [0.0; 3];
+            p[axis] = lo[axis] + side * (hi[axis] - lo[axis]);
+            p[i] = lo[i] + u * (hi[i] - lo[i]);
+            p[j] = lo[j] + v * (hi[j] - lo[j]);
+            DVec3::from(p)
+        };
+        for axis in 0..3 {
+            for side in [0.0, 1.0] {
+                for x in 0..n {
+                    for y in 0..n {
+                        let f = |dx: usize, dy: usize| at(axis, side, (x + dx) as f64 / n as f64, (y + dy) as f64 / n as f64);
+                        let q = [f(0, 0), f(1, 0), f(1, 1), f(0, 1)].map(|p| vid(&mut m, p));
+                        m.triangles.push([q[0], q[1], q[2]]);
+                        m.triangles.push([q[0], q[2], q[3]]);
+                    }
+                }
+            }
+        }
+        m.tri_object = vec![0; m.triangles.len()];
+        m
+    }
+
+    fn estimated(a: &Mesh, b: &Mesh) -> Vec<Region> {
+        let r = check(a, b, &Settings::default());
+        let mut regs = regions(&r.pairs, a, b);
+        estimate_penetration(&mut regs, &r.pairs, a, b, BuildOptions::default());
+        regs
+    }
+
+    #[test]
+    fn penetration_of_a_box_pushed_into_another_is_the_deepest_vertex() {
+        // B pokes 3 units into A through A's face x = 4 and is wider than A's cells: the
+        // deepest vertex is A's face vertex (4, 2, 2), 1.5 inside B (its faces y, z = 0.5, 3.5);
+        // B's deepest vertices are on its face x = 1, 1 inside A.
+        let a = grid_box(DVec3::ZERO, DVec3::splat(4.0), 4);
+        let b = grid_box(DVec3::new(1.0, 0.5, 0.5), DVec3::new(6.0, 3.5, 3.5), 3);
+        let regs = estimated(&a, &b);
+        assert_eq!(regs.len(), 1, "{regs:?}");
+        let p = regs[0].penetration.expect("both closed");
+        assert_eq!((p.depth, p.point, p.side), (1.5, DVec3::new(4.0, 2.0, 2.0), 0));
+        // Swapped inputs: the same vertex, now B's.
+        let p = estimated(&b, &a)[0].penetration.unwrap();
+        assert_eq!((p.depth, p.point, p.side), (1.5, DVec3::new(4.0, 2.0, 2.0), 1));
+    }
+
+    #[test]
+    fn penetration_of_coarse_boxes_uses_the_region_vertices() {
+        // 12-triangle boxes: B's face x = 1.5 lies inside A, its corners 0.5 from A's walls.
+        let a = grid_box(DVec3::ZERO, DVec3::splat(2.0), 1);
+        let b = grid_box(DVec3::new(1.5, 0.5, 0.5), DVec3::new(3.5, 1.5, 1.5), 1);
+        // A's face x = 2 reaches 0.5 into B too, at its diagonal's midpoint (2, 1, 1): a tie,
+        // which A's side wins.
+        let p = estimated(&a, &b)[0].penetration.unwrap();
+        assert_eq!((p.depth, p.side, p.point), (0.5, 0, DVec3::new(2.0, 1.0, 1.0)));
+        // Open outer parts have no inside: no estimate from that side, and none at all when
+        // both are open.
+        let mut open_a = a.clone();
+        open_a.triangles.pop();
+        open_a.tri_object.pop();
+        let p = estimated(&open_a, &b)[0].penetration;
+        assert!(p.is_none_or(|p| p.side == 0), "{p:?}");
+        let mut open_b = b.clone();
+        open_b.triangles.pop();
+        open_b.tri_object.pop();
+        assert!(estimated(&open_a, &open_b).iter().all(|g| g.penetration.is_none()));
+    }
+
+    #[test]
+    fn boxes_that_only_touch_have_zero_penetration() {
+        let a = grid_box(DVec3::ZERO, DVec3::splat(2.0), 2);
+        let b = grid_box(DVec3::new(2.0, 0.5, 0.5), DVec3::new(3.0, 1.5, 1.5), 2);
+        let regs = estimated(&a, &b);
+        assert!(!regs.is_empty());
+        assert!(regs.iter().all(|g| g.penetration.unwrap().depth == 0.0), "{regs:?}");
     }
 }
