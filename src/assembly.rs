@@ -7,16 +7,28 @@
 //! candidate pair is checked exactly with [`crate::query::check_built`]. Parts whose boxes never
 //! come within the search margin of another cost nothing beyond their box.
 //!
-//! Instances of one glTF mesh share the tree *topology* (one SAH build per distinct mesh); each
-//! instance refits the boxes to its own world coordinates, so boxes stay exact (a transformed
-//! box would need outward rounding and would cull less).
+//! Nothing is copied per part: a part is a view of the loaded mesh (its world coordinates, as
+//! the loader computed them) through a *layout* — its triangles re-indexed to its own vertices,
+//! numbered in order of first use — and instances of one glTF mesh share one layout and one tree
+//! (one SAH build per distinct mesh). The first needed instance (the *leader*) owns the tree,
+//! built over its own world coordinates (exact boxes). Every other instance walks the same tree
+//! through the relative transform `world(instance) · world(leader)⁻¹`: node boxes are mapped
+//! into its world coordinates and widened by a bound on rounding and on the measured deviation
+//! of its vertices from the mapped leader's ([`BoxMap`], proved in
+//! [`crate::geom::predicates`]), so culling stays conservative for mirrored, rotated and
+//! non-uniformly scaled instances; the root box is the part's exact world box. Triangles at the
+//! leaves, containment and distances all read the instance's own world coordinates, so every
+//! verdict is exactly what a copied sub-mesh would give. An instance whose coordinates are not
+//! an affine image of the leader's (to rounding), or without node matrices, falls back to a
+//! refitted copy of the leader's tree (exact boxes, a copy of the nodes).
 
 use crate::bvh::{BuildOptions, Bvh, Node};
 use crate::containment::Containment;
+use crate::geom::predicates::BoxMap;
 use crate::geom::{Aabb, DVec3};
-use crate::mesh::Mesh;
+use crate::mesh::{Mesh, Object, TriMesh};
 use crate::query::{check_built, ClashResult, PairFinding, Settings, Verdict};
-use crate::traverse;
+use crate::traverse::{self, Tree};
 use rayon::prelude::*;
 use std::collections::HashMap;
 use std::time::Instant;
@@ -87,34 +99,156 @@ pub fn glob_match(pattern: &str, name: &str) -> bool {
     p[i..].iter().all(|&c| c == '*')
 }
 
-/// The sub-mesh of one part (its triangles, re-indexed), for building and checking.
-fn sub_mesh(mesh: &Mesh, part: &Part) -> Mesh {
-    let mut remap: HashMap<u32, u32> = HashMap::new();
-    let mut positions = Vec::new();
-    let triangles = part
-        .triangles
-        .iter()
-        .map(|&t| {
-            mesh.triangles[t as usize].map(|v| {
-                *remap.entry(v).or_insert_with(|| {
-                    positions.push(mesh.positions[v as usize]);
-                    (positions.len() - 1) as u32
+/// The triangles of one part re-indexed to its own vertices, numbered in order of first use (as
+/// a copied sub-mesh would number them): built once per distinct glTF mesh and shared by every
+/// instance whose triangles index the loaded mesh in the same pattern.
+#[derive(Debug)]
+struct Layout {
+    /// Triangles in part-local vertex indices, in the part's (file) order.
+    tris: Vec<[u32; 3]>,
+    /// For each part-local vertex, its index in the loaded mesh for the part the layout was
+    /// made from; another instance adds its `shift`. Empty when `run` says it counts up.
+    vmap: Vec<u32>,
+    /// Number of part-local vertices.
+    vertices: usize,
+    /// `Some(vmap[0])` when `vmap` counts up by one from there (the usual glTF case): the
+    /// part's vertices are then a slice of the loaded mesh's, borrowed as they are.
+    run: Option<u32>,
+}
+
+impl Layout {
+    fn of(mesh: &Mesh, part: &Part) -> Layout {
+        let mut remap: HashMap<u32, u32> = HashMap::new();
+        let mut vmap = Vec::new();
+        let tris = part
+            .triangles
+            .iter()
+            .map(|&t| {
+                mesh.triangles[t as usize].map(|v| {
+                    *remap.entry(v).or_insert_with(|| {
+                        vmap.push(v);
+                        (vmap.len() - 1) as u32
+                    })
                 })
             })
-        })
-        .collect::<Vec<_>>();
-    let n = triangles.len();
-    Mesh {
-        positions,
-        triangles,
-        tri_object: vec![0; n],
-        objects: vec![mesh.objects[part.object as usize].clone()],
+            .collect();
+        let run = vmap.first().copied().filter(|&s| vmap.iter().zip(s..).all(|(&v, w)| v == w));
+        let vertices = vmap.len();
+        if run.is_some() {
+            vmap = Vec::new();
+        }
+        Layout { tris, vmap, vertices, run }
+    }
+
+    fn bytes(&self) -> usize {
+        self.tris.len() * 12 + self.vmap.len() * 4
     }
 }
 
+/// The vertex-index offset that makes `inst` read like `leader` (same triangle count, and each
+/// corner of each triangle the leader's corner plus one common offset), if there is one.
+fn shift_of(mesh: &Mesh, leader: &Part, inst: &Part) -> Option<i64> {
+    if leader.triangles.len() != inst.triangles.len() || leader.triangles.is_empty() {
+        return None;
+    }
+    let first = |p: &Part| mesh.triangles[p.triangles[0] as usize][0] as i64;
+    let shift = first(inst) - first(leader);
+    let same = leader.triangles.iter().zip(&inst.triangles).all(|(&l, &i)| {
+        let (l, i) = (mesh.triangles[l as usize], mesh.triangles[i as usize]);
+        (0..3).all(|k| i[k] as i64 == l[k] as i64 + shift)
+    });
+    same.then_some(shift)
+}
+
+/// One part seen through its layout: vertex `v` is `world[vmap[v] + shift]`. Nothing is copied.
+#[derive(Debug, Clone, Copy)]
+struct PartMesh<'a> {
+    world: &'a [DVec3],
+    layout: &'a Layout,
+    shift: i64,
+}
+
+impl TriMesh for PartMesh<'_> {
+    #[inline]
+    fn vertex_count(&self) -> usize {
+        self.layout.vertices
+    }
+    #[inline]
+    fn vertex(&self, v: u32) -> DVec3 {
+        let at = match self.layout.run {
+            Some(s) => s as i64 + v as i64,
+            None => self.layout.vmap[v as usize] as i64,
+        };
+        self.world[(at + self.shift) as usize]
+    }
+    #[inline]
+    fn triangle_count(&self) -> usize {
+        self.layout.tris.len()
+    }
+    #[inline]
+    fn indices(&self, t: u32) -> [u32; 3] {
+        self.layout.tris[t as usize]
+    }
+    fn positions(&self) -> std::borrow::Cow<'_, [DVec3]> {
+        match self.layout.run {
+            Some(s) => {
+                let at = (s as i64 + self.shift) as usize;
+                std::borrow::Cow::Borrowed(&self.world[at..at + self.layout.vertices])
+            }
+            None => (0..self.vertex_count() as u32).map(|v| self.vertex(v)).collect::<Vec<_>>().into(),
+        }
+    }
+}
+
+/// A part's tree as the walks see it: a tree built over this part's own coordinates (exact
+/// boxes), or another instance's tree whose boxes are mapped conservatively into this part's
+/// world coordinates by the relative transform between the two instances ([`BoxMap`]). The
+/// root box is always the part's exact world box.
+#[derive(Debug, Clone, Copy)]
+struct PartTree<'a> {
+    bvh: &'a Bvh,
+    map: Option<BoxMap>,
+    root: Aabb,
+}
+
+impl Tree for PartTree<'_> {
+    #[inline]
+    fn nodes(&self) -> &[Node] {
+        &self.bvh.nodes
+    }
+    #[inline]
+    fn node_box(&self, i: u32) -> Aabb {
+        match (&self.map, i) {
+            (_, 0) => self.root,
+            (None, _) => self.bvh.nodes[i as usize].bounds,
+            (Some(m), _) => m.map_box(&self.bvh.nodes[i as usize].bounds),
+        }
+    }
+    #[inline]
+    fn prims_of(&self, n: &Node) -> &[u32] {
+        self.bvh.leaf_prims(n)
+    }
+    fn stats(&self) -> crate::bvh::Stats {
+        self.bvh.stats()
+    }
+}
+
+/// The affine map from `leader`'s world coordinates to `inst`'s: `world(inst) · world(leader)⁻¹`
+/// from the glTF node matrices, as [`BoxMap`] rows. `None` without matrices or for a singular
+/// leader matrix.
+fn relative_rows(leader: &Object, inst: &Object) -> Option<[[f64; 4]; 3]> {
+    let (l, i) = (leader.world?, inst.world?);
+    let det = l.determinant();
+    if det == 0.0 || !det.is_finite() {
+        return None;
+    }
+    let r = i * l.inverse();
+    Some([0, 1, 2].map(|k| [r.x_axis[k], r.y_axis[k], r.z_axis[k], r.w_axis[k]]))
+}
+
 /// Refit a tree built for another instance of the same mesh to this instance's coordinates:
-/// same topology and leaf order, exact boxes.
-fn refit(template: &Bvh, mesh: &Mesh) -> Bvh {
+/// same topology and leaf order, exact boxes (the fallback when no box map fits).
+fn refit(template: &Bvh, mesh: &PartMesh) -> Bvh {
     let mut nodes: Vec<Node> = template.nodes.clone();
     for i in (0..nodes.len()).rev() {
         let n = nodes[i];
@@ -122,12 +256,27 @@ fn refit(template: &Bvh, mesh: &Mesh) -> Bvh {
             template
                 .leaf_prims(&n)
                 .iter()
-                .fold(Aabb::EMPTY, |b, &t| b.union(Aabb::of_triangle(&crate::bvh::triangle(mesh, t))))
+                .fold(Aabb::EMPTY, |b, &t| b.union(Aabb::of_triangle(&mesh.triangle(t))))
         } else {
             nodes[i + 1].bounds.union(nodes[n.a as usize].bounds)
         };
     }
     Bvh { nodes, prims: template.prims.clone() }
+}
+
+fn tree_bytes(t: &Bvh) -> usize {
+    t.nodes.len() * std::mem::size_of::<Node>() + t.prims.len() * 4
+}
+
+/// How a needed part gets its triangles and its tree.
+#[derive(Debug, Clone, Copy)]
+struct Plan {
+    /// Index into the layouts.
+    layout: usize,
+    /// Vertex offset against the layout's part.
+    shift: i64,
+    /// The part whose tree this part uses (itself for a leader).
+    leader: usize,
 }
 
 /// The result for one part pair.
@@ -151,12 +300,27 @@ pub struct AssemblyResult {
     pub part_pairs: Vec<PartPair>,
     /// Parts for which a triangle tree was needed (the others were skipped).
     pub built: Vec<bool>,
-    /// Distinct SAH builds (instances of one glTF mesh share one build, refit per instance).
+    /// Distinct SAH builds (instances of one glTF mesh share one build).
     pub sah_builds: usize,
+    /// How the instances shared trees.
+    pub sharing: Sharing,
     /// Time to build the part trees, ms.
     pub build_ms: f64,
     /// Time for the broad phase and all part-pair checks, ms.
     pub query_ms: f64,
+}
+
+/// How instances of one glTF mesh shared one tree (see [`check_parts`]).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub struct Sharing {
+    /// Trees used by more than one part (a leader and at least one mapped instance).
+    pub shared_trees: usize,
+    /// Parts that walked another part's tree through a box map instead of owning one.
+    pub mapped_instances: usize,
+    /// Bytes not allocated compared with copying every needed part into its own sub-mesh
+    /// (positions, triangles, object ids) with its own tree: the copies' total minus the
+    /// shared layouts, trees, refitted fallbacks and box maps.
+    pub memory_saved_bytes: usize,
 }
 
 /// Which part pairs to check.
@@ -207,55 +371,112 @@ pub fn check_parts(
     );
     candidates.sort_unstable();
     candidates.dedup();
-    // Lazy trees: only parts in some candidate pair; one SAH build per distinct glTF mesh.
+    // Lazy trees: only parts in some candidate pair.
     let mut built = vec![false; parts.len()];
     for &(a, b) in &candidates {
         built[a] = true;
         built[b] = true;
     }
     let needed: Vec<usize> = (0..parts.len()).filter(|&i| built[i]).collect();
-    let subs: Vec<Option<Mesh>> = (0..parts.len())
-        .into_par_iter()
-        .map(|i| built[i].then(|| sub_mesh(meshes[parts[i].input as usize], &parts[i])))
-        .collect();
-    // Group instances: the first needed part of each (input, glTF mesh) is built; others refit.
-    let mut leader: HashMap<(u8, u32), usize> = HashMap::new();
-    let mut template_of = vec![None; parts.len()];
+    let mesh_of = |i: usize| meshes[parts[i].input as usize];
+    // Group instances: the first needed part of each (input, glTF mesh) leads; another instance
+    // shares its layout and tree when its triangles index the mesh in the same pattern.
+    let mut leader_of_mesh: HashMap<(u8, u32), usize> = HashMap::new();
+    let mut leaders: Vec<usize> = Vec::new();
+    let mut plan: Vec<Option<Plan>> = vec![None; parts.len()];
     for &i in &needed {
-        if let Some(m) = parts[i].gltf_mesh {
-            let l = *leader.entry((parts[i].input, m)).or_insert(i);
-            if l != i && parts[l].triangles.len() == parts[i].triangles.len() {
-                template_of[i] = Some(l);
-            }
-        }
+        let shared = parts[i].gltf_mesh.and_then(|m| {
+            let l = *leader_of_mesh.entry((parts[i].input, m)).or_insert(i);
+            let shift = if l == i { None } else { shift_of(mesh_of(i), &parts[l], &parts[i]) }?;
+            Some(Plan { leader: l, shift, ..plan[l]? })
+        });
+        plan[i] = Some(shared.unwrap_or_else(|| {
+            leaders.push(i);
+            Plan { layout: leaders.len() - 1, shift: 0, leader: i }
+        }));
     }
-    let leaders: Vec<usize> = needed.iter().copied().filter(|&i| template_of[i].is_none()).collect();
-    let mut trees: Vec<Option<Bvh>> = vec![None; parts.len()];
-    let built_leaders: Vec<(usize, Bvh)> = leaders
+    let layouts: Vec<Layout> = leaders.par_iter().map(|&i| Layout::of(mesh_of(i), &parts[i])).collect();
+    let view = |i: usize| {
+        let p = plan[i].expect("needed part has a plan");
+        PartMesh { world: &mesh_of(i).positions, layout: &layouts[p.layout], shift: p.shift }
+    };
+    let own: Vec<Bvh> = leaders
         .par_iter()
-        .map(|&i| (i, Bvh::build(subs[i].as_ref().expect("needed part has a sub-mesh"), settings.bvh)))
-        .collect();
-    let sah_builds = built_leaders.len();
-    for (i, t) in built_leaders {
-        trees[i] = Some(t);
-    }
-    let refits: Vec<(usize, Bvh)> = needed
-        .par_iter()
-        .filter_map(|&i| {
-            let l = template_of[i]?;
-            Some((i, refit(trees[l].as_ref().expect("leader built"), subs[i].as_ref().expect("sub-mesh"))))
+        .map(|&i| {
+            let v = view(i);
+            let boxes: Vec<Aabb> =
+                (0..v.triangle_count() as u32).map(|t| Aabb::of_triangle(&v.triangle(t))).collect();
+            Bvh::build_from_boxes(&boxes, settings.bvh)
         })
         .collect();
-    for (i, t) in refits {
-        trees[i] = Some(t);
+    let sah_builds = own.len();
+    // Every other instance maps its leader's boxes by the relative transform; when no map fits
+    // (no matrices, or coordinates that are not an affine image to rounding), it refits a copy.
+    enum Shared {
+        Map(BoxMap),
+        Refit(Bvh),
     }
+    let shared: Vec<(usize, Shared)> = needed
+        .par_iter()
+        .filter(|&&i| plan[i].is_some_and(|p| p.leader != i))
+        .map(|&i| {
+            let p = plan[i].expect("planned");
+            let (vl, vi) = (view(p.leader), view(i));
+            let template = &own[p.layout];
+            let objects = &mesh_of(i).objects;
+            let rows =
+                relative_rows(&objects[parts[p.leader].object as usize], &objects[parts[i].object as usize]);
+            let map = rows.and_then(|r| {
+                let pairs = (0..vl.vertex_count() as u32).map(|v| (vl.vertex(v), vi.vertex(v)));
+                BoxMap::fit(r, &template.bounds(), pairs)
+            });
+            (i, map.map_or_else(|| Shared::Refit(refit(template, &vi)), Shared::Map))
+        })
+        .collect();
+    let mut maps: Vec<Option<BoxMap>> = vec![None; parts.len()];
+    let mut refits: Vec<Option<Bvh>> = (0..parts.len()).map(|_| None).collect();
+    let mut users = vec![0usize; leaders.len()];
+    for (i, s) in shared {
+        match s {
+            Shared::Map(m) => {
+                maps[i] = Some(m);
+                users[plan[i].expect("planned").layout] += 1;
+            }
+            Shared::Refit(t) => refits[i] = Some(t),
+        }
+    }
+    let tree = |i: usize| {
+        let p = plan[i].expect("needed part has a plan");
+        match &refits[i] {
+            Some(t) => PartTree { bvh: t, map: None, root: parts[i].bounds },
+            None => PartTree { bvh: &own[p.layout], map: maps[i], root: parts[i].bounds },
+        }
+    };
+    // Memory: what copying each needed part into its own sub-mesh (f64 positions, triangles,
+    // object ids) with its own tree would take, against the shared layouts and trees.
+    let copied: usize = needed
+        .iter()
+        .map(|&i| {
+            let p = plan[i].expect("planned");
+            let (v, t) = (layouts[p.layout].vertices, layouts[p.layout].tris.len());
+            v * 24 + t * 16 + tree_bytes(&own[p.layout])
+        })
+        .sum();
+    let kept: usize = layouts.iter().map(Layout::bytes).sum::<usize>()
+        + own.iter().map(tree_bytes).sum::<usize>()
+        + refits.iter().flatten().map(tree_bytes).sum::<usize>()
+        + maps.iter().flatten().count() * std::mem::size_of::<BoxMap>();
+    let sharing = Sharing {
+        shared_trees: users.iter().filter(|&&u| u > 0).count(),
+        mapped_instances: users.iter().sum(),
+        memory_saved_bytes: copied.saturating_sub(kept),
+    };
     let build_ms = t0.elapsed().as_secs_f64() * 1e3;
     let t1 = Instant::now();
     let part_pairs: Vec<PartPair> = candidates
         .par_iter()
         .map(|&(a, b)| {
-            let (ma, mb) = (subs[a].as_ref().unwrap(), subs[b].as_ref().unwrap());
-            let mut r = check_built(ma, trees[a].as_ref().unwrap(), mb, trees[b].as_ref().unwrap(), settings);
+            let mut r = check_built(&view(a), &tree(a), &view(b), &tree(b), settings);
             r.timings = Default::default();
             to_input_indices(&mut r, &parts[a], &parts[b]);
             PartPair { a, b, result: r }
@@ -266,6 +487,7 @@ pub fn check_parts(
         part_pairs,
         built,
         sah_builds,
+        sharing,
         build_ms,
         query_ms: t1.elapsed().as_secs_f64() * 1e3,
     }
@@ -320,6 +542,100 @@ mod tests {
         assert!(!glob_match("a*b", "acbd"));
         assert!(glob_match("a*b*", "acbd"));
     }
+
+    /// Points on a bumpy sphere (f32 values, like a glTF accessor) and a fan of triangles.
+    fn blob() -> (Vec<DVec3>, Vec<[u32; 3]>) {
+        let (n, m) = (24u32, 16u32);
+        let mut pos = Vec::new();
+        for i in 0..n {
+            for j in 0..m {
+                let (u, v) = (i as f64 / n as f64 * 6.0, j as f64 / m as f64 * 3.0 + 0.05);
+                let r = 1.0 + 0.1 * (5.0 * u).sin();
+                let p = [r * u.cos() * v.sin(), r * u.sin() * v.sin(), r * v.cos()];
+                pos.push(DVec3::from_array(p.map(|x| x as f32 as f64)));
+            }
+        }
+        let mut tris = Vec::new();
+        for i in 0..n {
+            for j in 0..m - 1 {
+                let (a, b) = (i * m + j, ((i + 1) % n) * m + j);
+                tris.push([a, b, b + 1]);
+                tris.push([a, b + 1, a + 1]);
+            }
+        }
+        (pos, tris)
+    }
+
+    #[test]
+    fn mapped_boxes_contain_every_instance_triangle() {
+        use glam::{DMat4, DQuat};
+        let (local, tris) = blob();
+        let leaders = [
+            DMat4::IDENTITY,
+            DMat4::from_scale_rotation_translation(
+                DVec3::splat(10.0),
+                DQuat::IDENTITY,
+                DVec3::new(-3.0, 0.5, 7.0),
+            ),
+            DMat4::from_scale_rotation_translation(
+                DVec3::new(0.1, 3.0, -0.7),
+                DQuat::from_xyzw(0.3, -0.2, 0.6, 0.7).normalize(),
+                DVec3::new(1e8, -2e7, 3.0),
+            ),
+        ];
+        let instances = [
+            DMat4::from_scale_rotation_translation(
+                DVec3::new(-1.0, 1.0, 1.0),
+                DQuat::IDENTITY,
+                DVec3::new(5.0, 2.0, 2.0),
+            ),
+            DMat4::from_scale_rotation_translation(
+                DVec3::new(3.0, 0.5, 7.0),
+                DQuat::from_xyzw(-0.1, 0.8, 0.2, 0.4).normalize(),
+                DVec3::new(1.0, 1.0, 1.0),
+            ),
+            DMat4::from_scale_rotation_translation(
+                DVec3::new(1e-3, 1e3, -1.0),
+                DQuat::from_xyzw(0.5, 0.5, -0.5, 0.5),
+                DVec3::new(-1e8, 1e-9, 0.0),
+            ),
+        ];
+        for l in leaders {
+            for i in instances {
+                let world =
+                    |m: DMat4| -> Vec<DVec3> { local.iter().map(|&p| m.transform_point3(p)).collect() };
+                let (wl, wi) = (world(l), world(i));
+                let boxes: Vec<Aabb> =
+                    tris.iter().map(|t| Aabb::of_triangle(&t.map(|v| wl[v as usize]))).collect();
+                let tree = Bvh::build_from_boxes(&boxes, BuildOptions::default());
+                let (ol, oi) = (
+                    Object { world: Some(l), ..Default::default() },
+                    Object { world: Some(i), ..Default::default() },
+                );
+                let rows = relative_rows(&ol, &oi).unwrap();
+                let map = BoxMap::fit(rows, &tree.bounds(), wl.iter().copied().zip(wi.iter().copied()))
+                    .expect("an instance maps");
+                // Every node's mapped box holds the instance's triangles below it.
+                let mut below: Vec<Aabb> = vec![Aabb::EMPTY; tree.nodes.len()];
+                for k in (0..tree.nodes.len()).rev() {
+                    let n = tree.nodes[k];
+                    below[k] = if n.is_leaf() {
+                        tree.leaf_prims(&n).iter().fold(Aabb::EMPTY, |b, &t| {
+                            b.union(Aabb::of_triangle(&tris[t as usize].map(|v| wi[v as usize])))
+                        })
+                    } else {
+                        below[k + 1].union(below[n.a as usize])
+                    };
+                    assert!(map.map_box(&n.bounds).contains(&below[k]), "node {k} of {l:?} -> {i:?}");
+                }
+                // A coordinate that is not the image of its source (one vertex moved by 1e-3 of
+                // the size) is refused.
+                let mut bent = wi.clone();
+                bent[7] += DVec3::splat(below[0].extent().max_element() * 1e-3);
+                assert!(BoxMap::fit(rows, &tree.bounds(), wl.iter().copied().zip(bent)).is_none());
+            }
+        }
+    }
 }
 
 /// What to check in an assembly run.
@@ -373,6 +689,8 @@ pub struct AssemblyInfo {
     pub built_parts: Option<usize>,
     /// Distinct SAH builds (parts mode only; instances share one).
     pub sah_builds: Option<usize>,
+    /// How instances shared trees (parts mode only).
+    pub sharing: Option<Sharing>,
 }
 
 /// The whole outcome: a merged [`ClashResult`] (pairs in input triangle indices) plus the
@@ -425,6 +743,7 @@ pub fn run(a: &Mesh, b: &Mesh, sel: &Selection, settings: &Settings) -> Result<O
             candidate_part_pairs: part_pairs.len(),
             built_parts: None,
             sah_builds: None,
+            sharing: None,
         };
         return Ok(Outcome { result, parts, part_pairs, info });
     }
@@ -471,6 +790,7 @@ pub fn run(a: &Mesh, b: &Mesh, sel: &Selection, settings: &Settings) -> Result<O
         candidate_part_pairs: ar.part_pairs.len(),
         built_parts: Some(ar.built.iter().filter(|b| **b).count()),
         sah_builds: Some(ar.sah_builds),
+        sharing: Some(ar.sharing),
     };
     let result = ClashResult {
         pairs: merged,

@@ -15,10 +15,10 @@
 //! Called only when no pair of triangles meets: then each connected component of one mesh is
 //! entirely inside or entirely outside the other, so one vertex per component decides.
 
-use crate::bvh::{self, Bvh};
 use crate::geom::predicates as pr;
 use crate::geom::{Aabb, DVec3};
-use crate::mesh::Mesh;
+use crate::mesh::TriMesh;
+use crate::traverse::Tree;
 use crate::tri_tri::Shape;
 use std::collections::HashMap;
 
@@ -39,22 +39,11 @@ pub struct Topology {
 }
 
 /// Merge exactly coincident vertices (+0 and −0 are the same point) and count edge uses.
-pub fn topology(mesh: &Mesh) -> Topology {
+pub fn topology<M: TriMesh + ?Sized>(mesh: &M) -> Topology {
     use rayon::prelude::*;
     // Merge exactly coincident vertices by sorting their bit patterns (parallel; a hash map of
     // millions of keys was most of the cost of a check on large inputs).
-    let key = |p: &DVec3| [p.x + 0.0, p.y + 0.0, p.z + 0.0].map(f64::to_bits);
-    let mut order: Vec<u32> = (0..mesh.positions.len() as u32).collect();
-    order.par_sort_unstable_by_key(|&i| (key(&mesh.positions[i as usize]), i));
-    let mut merged = vec![0u32; mesh.positions.len()];
-    let mut next = 0u32;
-    for (k, &i) in order.iter().enumerate() {
-        if k > 0 && key(&mesh.positions[order[k - 1] as usize]) != key(&mesh.positions[i as usize]) {
-            next += 1;
-        }
-        merged[i as usize] = next;
-    }
-    let distinct = if order.is_empty() { 0 } else { next as usize + 1 };
+    let (merged, distinct) = crate::bodies::merge_vertices(&mesh.positions());
     let mut parent: Vec<u32> = (0..distinct as u32).collect();
     fn find(parent: &mut [u32], mut x: u32) -> u32 {
         while parent[x as usize] != x {
@@ -63,20 +52,20 @@ pub fn topology(mesh: &Mesh) -> Topology {
         }
         x
     }
-    let proper: Vec<bool> = (0..mesh.triangles.len() as u32)
+    let proper: Vec<bool> = (0..mesh.triangle_count() as u32)
         .into_par_iter()
-        .map(|t| !Shape::of(&bvh::triangle(mesh, t)).is_degenerate())
+        .map(|t| !Shape::of(&mesh.triangle(t)).is_degenerate())
         .collect();
-    let mut edges: Vec<u64> = Vec::with_capacity(mesh.triangles.len() * 3);
-    for (t, tri) in mesh.triangles.iter().enumerate() {
-        let v = tri.map(|i| merged[i as usize]);
+    let mut edges: Vec<u64> = Vec::with_capacity(mesh.triangle_count() * 3);
+    for (t, &is_proper) in proper.iter().enumerate() {
+        let v = mesh.indices(t as u32).map(|i| merged[i as usize]);
         for k in 0..3 {
             let (a, b) = (find(&mut parent, v[k]), find(&mut parent, v[(k + 1) % 3]));
             if a != b {
                 parent[a.max(b) as usize] = a.min(b);
             }
         }
-        if proper[t] {
+        if is_proper {
             for k in 0..3 {
                 let (a, b) = (v[k], v[(k + 1) % 3]);
                 edges.push((a.min(b) as u64) << 32 | a.max(b) as u64);
@@ -89,21 +78,21 @@ pub fn topology(mesh: &Mesh) -> Topology {
     // The first vertex (in triangle order) of each component.
     let mut comp_of_root = vec![u32::MAX; parent.len()];
     let mut component_seeds = Vec::new();
-    for tri in &mesh.triangles {
-        let v = tri[0];
+    for t in 0..mesh.triangle_count() as u32 {
+        let v = mesh.indices(t)[0];
         let root = find(&mut parent, merged[v as usize]) as usize;
         if comp_of_root[root] == u32::MAX {
             comp_of_root[root] = component_seeds.len() as u32;
             component_seeds.push(v);
         }
     }
-    let mut used = vec![false; mesh.positions.len()];
-    for tri in &mesh.triangles {
-        for &v in tri {
+    let mut used = vec![false; mesh.vertex_count()];
+    for t in 0..mesh.triangle_count() as u32 {
+        for v in mesh.indices(t) {
             used[v as usize] = true;
         }
     }
-    let component_of = (0..mesh.positions.len())
+    let component_of = (0..mesh.vertex_count())
         .map(|v| if used[v] { comp_of_root[find(&mut parent, merged[v]) as usize] } else { u32::MAX })
         .collect();
     Topology { closed, component_seeds, component_of, merged }
@@ -114,7 +103,7 @@ pub fn topology(mesh: &Mesh) -> Topology {
 /// edges within each component and taking the sign of each component's signed volume, so input
 /// winding does not matter. `None` for open meshes, or if some component cannot be oriented
 /// consistently. Computed only when a face-to-face contact needs it (it is the costly part).
-pub fn outward(mesh: &Mesh, topo: &Topology) -> Option<Vec<i8>> {
+pub fn outward<M: TriMesh + ?Sized>(mesh: &M, topo: &Topology) -> Option<Vec<i8>> {
     if !topo.closed {
         return None;
     }
@@ -122,15 +111,14 @@ pub fn outward(mesh: &Mesh, topo: &Topology) -> Option<Vec<i8>> {
 }
 
 /// See [`outward`].
-fn orient(mesh: &Mesh, merged: &[u32]) -> Option<Vec<i8>> {
-    let n = mesh.triangles.len();
-    let proper: Vec<bool> =
-        (0..n).map(|t| !Shape::of(&bvh::triangle(mesh, t as u32)).is_degenerate()).collect();
+fn orient<M: TriMesh + ?Sized>(mesh: &M, merged: &[u32]) -> Option<Vec<i8>> {
+    let n = mesh.triangle_count();
+    let proper: Vec<bool> = (0..n).map(|t| !Shape::of(&mesh.triangle(t as u32)).is_degenerate()).collect();
     // Undirected edge -> the (at most two, as the mesh is closed) triangles using it, with the
     // direction each traverses it in (+1 when from the lower merged id to the higher).
     let mut by_edge: HashMap<(u32, u32), Vec<(u32, i8)>> = HashMap::with_capacity(n * 3 / 2);
     for t in (0..n).filter(|&t| proper[t]) {
-        let v = mesh.triangles[t].map(|i| merged[i as usize]);
+        let v = mesh.indices(t as u32).map(|i| merged[i as usize]);
         for k in 0..3 {
             let (a, b) = (v[k], v[(k + 1) % 3]);
             by_edge.entry((a.min(b), a.max(b))).or_default().push((t as u32, if a < b { 1 } else { -1 }));
@@ -146,7 +134,7 @@ fn orient(mesh: &Mesh, merged: &[u32]) -> Option<Vec<i8>> {
         let mut comp = vec![start as u32];
         let mut queue = vec![start as u32];
         while let Some(t) = queue.pop() {
-            let v = mesh.triangles[t as usize].map(|i| merged[i as usize]);
+            let v = mesh.indices(t).map(|i| merged[i as usize]);
             for k in 0..3 {
                 let (a, b) = (v[k], v[(k + 1) % 3]);
                 let here = if a < b { 1 } else { -1 } * flip[t as usize];
@@ -175,11 +163,11 @@ fn orient(mesh: &Mesh, merged: &[u32]) -> Option<Vec<i8>> {
         // used, and a closed solid's is far from zero unless it is flat).
         // Relative to a vertex of the component: far from the origin (1e8) the plain triple
         // products cancel catastrophically.
-        let o = bvh::triangle(mesh, comp[0])[0];
+        let o = mesh.triangle(comp[0])[0];
         let vol: f64 = comp
             .iter()
             .map(|&t| {
-                let [a, b, c] = bvh::triangle(mesh, t).map(|p| p - o);
+                let [a, b, c] = mesh.triangle(t).map(|p| p - o);
                 a.dot(b.cross(c)) * flip[t as usize] as f64
             })
             .sum();
@@ -225,8 +213,8 @@ pub enum Inside {
 }
 
 /// Is `p` inside the closed mesh `m` (with tree `t`)? `p` must not lie on `m`'s surface.
-pub fn point_in_closed_mesh(p: DVec3, m: &Mesh, t: &Bvh) -> Inside {
-    let bounds = t.bounds();
+pub fn point_in_closed_mesh<M: TriMesh + ?Sized, T: Tree + ?Sized>(p: DVec3, m: &M, t: &T) -> Inside {
+    let bounds = t.root_box();
     if !bounds.contains(&Aabb { min: p, max: p }) {
         return Inside::No;
     }
@@ -237,7 +225,7 @@ pub fn point_in_closed_mesh(p: DVec3, m: &Mesh, t: &Bvh) -> Inside {
         let seg = Aabb { min: p.min(q), max: p.max(q) };
         let mut crossings = 0usize;
         let degenerate = crate::traverse::any_in_box(t, &seg, |tri| {
-            let [a, b, c] = bvh::triangle(m, tri);
+            let [a, b, c] = m.triangle(tri);
             match segment_crosses(p, q, a, b, c) {
                 Crossing::No => false,
                 Crossing::Yes => {
@@ -259,12 +247,10 @@ pub fn point_in_closed_mesh(p: DVec3, m: &Mesh, t: &Bvh) -> Inside {
 /// of the triangles' signed solid angles over 4π (Van Oosterom & Strackee 1983). 1 inside a
 /// closed outward-wound surface, 0 outside, in between for open or leaky ones. f64, used only
 /// to decide whether to call an open container's containment "undecided".
-pub fn winding_number(p: DVec3, m: &Mesh) -> f64 {
-    let total: f64 = m
-        .triangles
-        .iter()
+pub fn winding_number<M: TriMesh + ?Sized>(p: DVec3, m: &M) -> f64 {
+    let total: f64 = (0..m.triangle_count() as u32)
         .map(|t| {
-            let [a, b, c] = t.map(|i| m.positions[i as usize] - p);
+            let [a, b, c] = m.triangle(t).map(|q| q - p);
             let (la, lb, lc) = (a.length(), b.length(), c.length());
             let num = a.dot(b.cross(c));
             let den = la * lb * lc + a.dot(b) * lc + a.dot(c) * lb + b.dot(c) * la;
@@ -275,9 +261,9 @@ pub fn winding_number(p: DVec3, m: &Mesh) -> f64 {
 }
 
 /// Is `p` exactly on a triangle of `m`?
-fn on_surface(p: DVec3, m: &Mesh, t: &Bvh) -> bool {
+pub fn on_surface<M: TriMesh + ?Sized, T: Tree + ?Sized>(p: DVec3, m: &M, t: &T) -> bool {
     crate::traverse::any_in_box(t, &Aabb { min: p, max: p }, |tri| {
-        crate::tri_tri::classify(&[p, p, p], &bvh::triangle(m, tri)).is_some()
+        crate::tri_tri::classify(&[p, p, p], &m.triangle(tri)).is_some()
     })
 }
 
@@ -381,18 +367,23 @@ enum OneWay {
 }
 
 /// Which components of `inner` lie inside `outer`?
-fn one_way(inner: &Mesh, it: &Topology, outer: &Mesh, ot: &Bvh, otopo: &Topology, name: &str) -> OneWay {
+fn one_way<I, O, T>(inner: &I, it: &Topology, outer: &O, ot: &T, otopo: &Topology, name: &str) -> OneWay
+where
+    I: TriMesh + ?Sized,
+    O: TriMesh + ?Sized,
+    T: Tree + ?Sized,
+{
     let n = it.component_seeds.len();
-    let ib = Aabb::of_points(&inner.positions);
-    if !ot.bounds().overlaps(&ib) {
+    let ib = Aabb::of_points(inner.positions().iter());
+    if !ot.root_box().overlaps(&ib) {
         return OneWay::Counts(0, n);
     }
     if !otopo.closed {
         // Inside an open surface is undefined. Say so only where it could matter: the box
         // allows it and the generalized winding number (Jacobson et al. 2013) at a vertex of
         // the inner part says "mostly enclosed" (> 1/2; a lone sheet never exceeds 1/2).
-        if ot.bounds().contains(&ib) {
-            let p = inner.positions[it.component_seeds[0] as usize];
+        if ot.root_box().contains(&ib) {
+            let p = inner.vertex(it.component_seeds[0]);
             let w = winding_number(p, outer);
             if w.abs() > 0.5 {
                 return OneWay::Undecided(format!(
@@ -411,7 +402,7 @@ fn one_way(inner: &Mesh, it: &Topology, outer: &Mesh, ot: &Bvh, otopo: &Topology
         if c == u32::MAX || state[c as usize].is_some() {
             continue;
         }
-        let p = inner.positions[v];
+        let p = inner.vertex(v as u32);
         if on_surface(p, outer, ot) {
             continue;
         }
@@ -430,7 +421,20 @@ fn one_way(inner: &Mesh, it: &Topology, outer: &Mesh, ot: &Bvh, otopo: &Topology
 }
 
 /// Decide containment both ways for two meshes with no meeting triangles.
-pub fn decide(a: &Mesh, ta: &Bvh, topo_a: &Topology, b: &Mesh, tb: &Bvh, topo_b: &Topology) -> Containment {
+pub fn decide<A, TA, B, TB>(
+    a: &A,
+    ta: &TA,
+    topo_a: &Topology,
+    b: &B,
+    tb: &TB,
+    topo_b: &Topology,
+) -> Containment
+where
+    A: TriMesh + ?Sized,
+    TA: Tree + ?Sized,
+    B: TriMesh + ?Sized,
+    TB: Tree + ?Sized,
+{
     let ab = one_way(a, topo_a, b, tb, topo_b, "b");
     let ba = one_way(b, topo_b, a, ta, topo_a, "a");
     match (ab, ba) {
@@ -446,8 +450,8 @@ pub fn decide(a: &Mesh, ta: &Bvh, topo_a: &Topology, b: &Mesh, tb: &Bvh, topo_b:
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::bvh::BuildOptions;
-    use crate::mesh::Object;
+    use crate::bvh::{BuildOptions, Bvh};
+    use crate::mesh::{Mesh, Object};
 
     /// An axis-aligned box as 12 triangles, outward-facing.
     pub(crate) fn cube(min: DVec3, max: DVec3) -> Mesh {

@@ -11,8 +11,8 @@ use crate::error::{Error, Result};
 use crate::geom::predicates::{self, Tolerances};
 use crate::geom::{Aabb, DVec3};
 use crate::load::{self, Format};
-use crate::mesh::Mesh;
-use crate::traverse::{self, Candidate};
+use crate::mesh::{Mesh, TriMesh};
+use crate::traverse::{self, Candidate, Tree};
 use crate::tri_tri::{self, Contact, Shape};
 use glam::DMat4;
 use rayon::prelude::*;
@@ -342,7 +342,19 @@ pub fn check(a: &Mesh, b: &Mesh, settings: &Settings) -> ClashResult {
 
 /// The pair walk alone: every pair that meets (or comes within the tolerances), classified,
 /// sorted by (a, b); and whether `first_hit` stopped it early.
-pub fn find_pairs(a: &Mesh, ta: &Bvh, b: &Mesh, tb: &Bvh, settings: &Settings) -> (Vec<PairFinding>, bool) {
+pub fn find_pairs<A, TA, B, TB>(
+    a: &A,
+    ta: &TA,
+    b: &B,
+    tb: &TB,
+    settings: &Settings,
+) -> (Vec<PairFinding>, bool)
+where
+    A: TriMesh + ?Sized,
+    TA: Tree + ?Sized,
+    B: TriMesh + ?Sized,
+    TB: Tree + ?Sized,
+{
     let tol = settings.tolerances;
     let stop = AtomicBool::new(false);
     let mut pairs = traverse::collect_pairs(
@@ -351,10 +363,10 @@ pub fn find_pairs(a: &Mesh, ta: &Bvh, b: &Mesh, tb: &Bvh, settings: &Settings) -
         |x, y| !stop.load(Ordering::Relaxed) && tol.boxes_may_meet(x, y),
         |la, lb, out| {
             for &i in la {
-                let ti = bvh::triangle(a, i);
+                let ti = a.triangle(i);
                 let bi = Aabb::of_triangle(&ti);
                 for &j in lb {
-                    let tj = bvh::triangle(b, j);
+                    let tj = b.triangle(j);
                     if !tol.boxes_may_meet(&bi, &Aabb::of_triangle(&tj)) {
                         continue;
                     }
@@ -376,7 +388,13 @@ pub fn find_pairs(a: &Mesh, ta: &Bvh, b: &Mesh, tb: &Bvh, settings: &Settings) -
 }
 
 /// As [`check`], with both trees already built (assemblies reuse one tree for many pairs).
-pub fn check_built(a: &Mesh, ta: &Bvh, b: &Mesh, tb: &Bvh, settings: &Settings) -> ClashResult {
+pub fn check_built<A, TA, B, TB>(a: &A, ta: &TA, b: &B, tb: &TB, settings: &Settings) -> ClashResult
+where
+    A: TriMesh + ?Sized,
+    TA: Tree + ?Sized,
+    B: TriMesh + ?Sized,
+    TB: Tree + ?Sized,
+{
     let t1 = Instant::now();
     let (pairs, stopped) = find_pairs(a, ta, b, tb, settings);
     let mut counts = Counts::default();
@@ -419,10 +437,10 @@ pub fn check_built(a: &Mesh, ta: &Bvh, b: &Mesh, tb: &Bvh, settings: &Settings) 
 
 /// Face-to-face contacts between two closed, consistently oriented solids whose outward
 /// normals agree (see [`containment::coplanar_overlap`]).
-fn volumes_overlap(
-    a: &Mesh,
+fn volumes_overlap<A: TriMesh + ?Sized, B: TriMesh + ?Sized>(
+    a: &A,
     topo_a: &containment::Topology,
-    b: &Mesh,
+    b: &B,
     topo_b: &containment::Topology,
     pairs: &[PairFinding],
 ) -> bool {
@@ -432,7 +450,7 @@ fn volumes_overlap(
     let (oa, ob) = rayon::join(|| containment::outward(a, topo_a), || containment::outward(b, topo_b));
     let (Some(oa), Some(ob)) = (oa, ob) else { return false };
     pairs.iter().filter(|p| p.contact == Some(Contact::CoplanarArea)).any(|p| {
-        let (ta, tb) = (bvh::triangle(a, p.a), bvh::triangle(b, p.b));
+        let (ta, tb) = (a.triangle(p.a), b.triangle(p.b));
         containment::coplanar_overlap(&ta, oa[p.a as usize], &tb, ob[p.b as usize])
     })
 }
@@ -487,20 +505,26 @@ fn classify_pair(
 }
 
 /// Witness for an exact contact: a shared point.
-fn contact_witness(a: &Mesh, b: &Mesh, p: &PairFinding) -> Closest {
+fn contact_witness<A: TriMesh + ?Sized, B: TriMesh + ?Sized>(a: &A, b: &B, p: &PairFinding) -> Closest {
     let point = match p.segment {
         Some(s) => s[0],
         // Coplanar contacts: the closed-form distance of touching triangles is 0 (up to
         // rounding) at a shared point.
-        None => triangle_distance(&bvh::triangle(a, p.a), &bvh::triangle(b, p.b)).on_a,
+        None => triangle_distance(&a.triangle(p.a), &b.triangle(p.b)).on_a,
     };
     Closest { distance: 0.0, a: (p.a, point), b: (p.b, point) }
 }
 
 /// Branch-and-bound closest pair of two meshes known not to touch (their trees built), within
 /// the allowed distance error.
-pub fn closest_pair(a: &Mesh, ta: &Bvh, b: &Mesh, tb: &Bvh, err: DistanceError) -> Option<Closest> {
-    let scale = ta.bounds().max_abs().max(tb.bounds().max_abs());
+pub fn closest_pair<A, TA, B, TB>(a: &A, ta: &TA, b: &B, tb: &TB, err: DistanceError) -> Option<Closest>
+where
+    A: TriMesh + ?Sized,
+    TA: Tree + ?Sized,
+    B: TriMesh + ?Sized,
+    TB: Tree + ?Sized,
+{
+    let scale = ta.root_box().max_abs().max(tb.root_box().max_abs());
     let slack = predicates::distance_rounding_slack(scale);
     // With an error allowance, a node pair whose lower bound lb has (1 + rel)·lb + abs >= best
     // cannot improve on best by more than the allowance: shrink the bound accordingly.
@@ -519,10 +543,10 @@ pub fn closest_pair(a: &Mesh, ta: &Bvh, b: &Mesh, tb: &Bvh, err: DistanceError) 
         |la, lb, bound| {
             let mut best: Option<Candidate<(DVec3, DVec3)>> = None;
             for &i in la {
-                let ti = bvh::triangle(a, i);
+                let ti = a.triangle(i);
                 let bi = Aabb::of_triangle(&ti);
                 for &j in lb {
-                    let tj = bvh::triangle(b, j);
+                    let tj = b.triangle(j);
                     if bi.distance_sq(&Aabb::of_triangle(&tj)).sqrt() > bound {
                         continue;
                     }

@@ -6,6 +6,11 @@
 //! breadth-first into a fixed number of independent sub-walks, which rayon runs on any number of
 //! threads. The seeding does not depend on the thread count and results are merged in seed order,
 //! so the output is the same whatever the number of threads.
+//!
+//! The walks see a tree through [`Tree`]: its nodes and each node's box in the walk's frame. A
+//! [`Bvh`] is its own frame; an instance sharing another instance's tree maps its boxes
+//! (`crate::assembly`), and the walk carries each node's mapped box on its stack so that a box
+//! is mapped once per node pair opened.
 
 use crate::bvh::{Bvh, Node};
 use crate::geom::Aabb;
@@ -15,41 +20,96 @@ use std::sync::atomic::{AtomicU64, Ordering};
 /// How many independent sub-walks the root pair is split into (fixed, for determinism).
 const SEED_TASKS: usize = 256;
 
+/// A tree as the walks see it.
+pub trait Tree: Sync {
+    /// The nodes, depth-first (see [`Bvh`]).
+    fn nodes(&self) -> &[Node];
+    /// The box of node `i` in the walk's frame: it contains every triangle below the node (as
+    /// the leaf closures see them).
+    fn node_box(&self, i: u32) -> Aabb;
+    /// The triangles of leaf `n`.
+    fn prims_of(&self, n: &Node) -> &[u32];
+    /// Size and quality of the underlying tree.
+    fn stats(&self) -> crate::bvh::Stats;
+    /// The root box (empty for an empty tree).
+    fn root_box(&self) -> Aabb {
+        if self.nodes().is_empty() {
+            Aabb::EMPTY
+        } else {
+            self.node_box(0)
+        }
+    }
+}
+
+impl Tree for Bvh {
+    #[inline]
+    fn nodes(&self) -> &[Node] {
+        &self.nodes
+    }
+    #[inline]
+    fn node_box(&self, i: u32) -> Aabb {
+        self.nodes[i as usize].bounds
+    }
+    #[inline]
+    fn prims_of(&self, n: &Node) -> &[u32] {
+        self.leaf_prims(n)
+    }
+    fn stats(&self) -> crate::bvh::Stats {
+        Bvh::stats(self)
+    }
+}
+
+/// A node pair on a walk's stack, with both boxes.
+type Entry = (u32, u32, Aabb, Aabb);
+
 /// Which node of a pair to open: the larger, never a leaf. `None` when both are leaves.
 #[inline]
-fn open_a(a: &Node, b: &Node) -> Option<bool> {
+fn open_a(a: &Node, ba: &Aabb, b: &Node, bb: &Aabb) -> Option<bool> {
     match (a.is_leaf(), b.is_leaf()) {
         (true, true) => None,
         (true, false) => Some(false),
         (false, true) => Some(true),
-        (false, false) => Some(a.bounds.half_area() >= b.bounds.half_area()),
+        (false, false) => Some(ba.half_area() >= bb.half_area()),
     }
 }
 
-/// The two children pairs of `(i, j)` after opening one side.
+/// The two children pairs of `e` after opening one side, with their boxes.
 #[inline]
-fn children(ta: &Bvh, tb: &Bvh, i: u32, j: u32) -> Option<[(u32, u32); 2]> {
-    let (a, b) = (&ta.nodes[i as usize], &tb.nodes[j as usize]);
-    Some(if open_a(a, b)? { [(i + 1, j), (a.a, j)] } else { [(i, j + 1), (i, b.a)] })
+fn children<A: Tree + ?Sized, B: Tree + ?Sized>(ta: &A, tb: &B, e: &Entry) -> Option<[Entry; 2]> {
+    let &(i, j, ba, bb) = e;
+    let (a, b) = (&ta.nodes()[i as usize], &tb.nodes()[j as usize]);
+    Some(if open_a(a, &ba, b, &bb)? {
+        [(i + 1, j, ta.node_box(i + 1), bb), (a.a, j, ta.node_box(a.a), bb)]
+    } else {
+        [(i, j + 1, ba, tb.node_box(j + 1)), (i, b.a, ba, tb.node_box(b.a))]
+    })
 }
 
 /// Breadth-first expansion of the root pair into about `SEED_TASKS` pairs that pass `keep`.
-fn seed(ta: &Bvh, tb: &Bvh, keep: &dyn Fn(&Aabb, &Aabb) -> bool) -> Vec<(u32, u32)> {
-    if ta.nodes.is_empty() || tb.nodes.is_empty() || !keep(&ta.nodes[0].bounds, &tb.nodes[0].bounds) {
+fn seed<A: Tree + ?Sized, B: Tree + ?Sized>(
+    ta: &A,
+    tb: &B,
+    keep: &dyn Fn(&Aabb, &Aabb) -> bool,
+) -> Vec<Entry> {
+    if ta.nodes().is_empty() || tb.nodes().is_empty() {
         return Vec::new();
     }
-    let mut level = vec![(0u32, 0u32)];
+    let root = (0, 0, ta.node_box(0), tb.node_box(0));
+    if !keep(&root.2, &root.3) {
+        return Vec::new();
+    }
+    let mut level = vec![root];
     loop {
         let mut next = Vec::with_capacity(level.len() * 2);
         let mut opened = false;
-        for &(i, j) in &level {
-            match children(ta, tb, i, j) {
-                None => next.push((i, j)),
+        for e in &level {
+            match children(ta, tb, e) {
+                None => next.push(*e),
                 Some(kids) => {
                     opened = true;
-                    for (ci, cj) in kids {
-                        if keep(&ta.nodes[ci as usize].bounds, &tb.nodes[cj as usize].bounds) {
-                            next.push((ci, cj));
+                    for k in kids {
+                        if keep(&k.2, &k.3) {
+                            next.push(k);
                         }
                     }
                 }
@@ -65,29 +125,30 @@ fn seed(ta: &Bvh, tb: &Bvh, keep: &dyn Fn(&Aabb, &Aabb) -> bool) -> Vec<(u32, u3
 /// Visit every pair of leaves whose boxes pass `boxes_meet` (tested on every node pair on the
 /// way down) and let `leaf` turn the two leaves' triangle lists into results. Results come back
 /// in an order that depends only on the trees, not on the thread count.
-pub fn collect_pairs<T, M, L>(ta: &Bvh, tb: &Bvh, boxes_meet: M, leaf: L) -> Vec<T>
+pub fn collect_pairs<T, A, B, M, L>(ta: &A, tb: &B, boxes_meet: M, leaf: L) -> Vec<T>
 where
     T: Send,
+    A: Tree + ?Sized,
+    B: Tree + ?Sized,
     M: Fn(&Aabb, &Aabb) -> bool + Sync,
     L: Fn(&[u32], &[u32], &mut Vec<T>) + Sync,
 {
     let seeds = seed(ta, tb, &boxes_meet);
     let parts: Vec<Vec<T>> = seeds
         .par_iter()
-        .map(|&s| {
+        .map(|s| {
             let mut out = Vec::new();
-            let mut stack = vec![s];
-            while let Some((i, j)) = stack.pop() {
-                match children(ta, tb, i, j) {
+            let mut stack = vec![*s];
+            while let Some(e) = stack.pop() {
+                match children(ta, tb, &e) {
                     None => {
-                        let (a, b) = (&ta.nodes[i as usize], &tb.nodes[j as usize]);
-                        leaf(ta.leaf_prims(a), tb.leaf_prims(b), &mut out);
+                        let (a, b) = (&ta.nodes()[e.0 as usize], &tb.nodes()[e.1 as usize]);
+                        leaf(ta.prims_of(a), tb.prims_of(b), &mut out);
                     }
                     Some(kids) => {
-                        for &(ci, cj) in kids.iter().rev() {
-                            let (a, b) = (&ta.nodes[ci as usize], &tb.nodes[cj as usize]);
-                            if boxes_meet(&a.bounds, &b.bounds) {
-                                stack.push((ci, cj));
+                        for k in kids.iter().rev() {
+                            if boxes_meet(&k.2, &k.3) {
+                                stack.push(*k);
                             }
                         }
                     }
@@ -101,22 +162,22 @@ where
 
 /// One-tree walk: call `visit` on every triangle in a leaf whose box overlaps `query` (exact
 /// closed overlap), stopping early — and returning true — as soon as `visit` returns true.
-pub fn any_in_box(tree: &Bvh, query: &Aabb, mut visit: impl FnMut(u32) -> bool) -> bool {
-    if tree.nodes.is_empty() {
+pub fn any_in_box<T: Tree + ?Sized>(tree: &T, query: &Aabb, mut visit: impl FnMut(u32) -> bool) -> bool {
+    if tree.nodes().is_empty() {
         return false;
     }
     let mut stack = vec![0u32];
     while let Some(i) = stack.pop() {
-        let node = &tree.nodes[i as usize];
-        if !node.bounds.overlaps(query) {
+        if !tree.node_box(i).overlaps(query) {
             continue;
         }
+        let node = &tree.nodes()[i as usize];
         if !node.is_leaf() {
             stack.push(node.a);
             stack.push(i + 1);
             continue;
         }
-        if tree.leaf_prims(node).iter().any(|&t| visit(t)) {
+        if tree.prims_of(node).iter().any(|&t| visit(t)) {
             return true;
         }
     }
@@ -143,37 +204,37 @@ fn better<R>(x: &Candidate<R>, y: &Candidate<R>) -> bool {
 /// caller's bound on f64 rounding of distances, so that no pair that could tie is pruned). The
 /// winner is the minimum of (distance, key) over all candidates that could be it, so the answer
 /// does not depend on the thread count or on the order in which threads find candidates.
-pub fn min_pair<R, D, L>(ta: &Bvh, tb: &Bvh, box_distance: D, slack: f64, leaf: L) -> Option<Candidate<R>>
+pub fn min_pair<R, A, B, D, L>(ta: &A, tb: &B, box_distance: D, slack: f64, leaf: L) -> Option<Candidate<R>>
 where
     R: Send + Copy,
+    A: Tree + ?Sized,
+    B: Tree + ?Sized,
     D: Fn(&Aabb, &Aabb) -> f64 + Sync,
     L: Fn(&[u32], &[u32], f64) -> Option<Candidate<R>> + Sync,
 {
     // Best distance so far, as f64 bits (order-preserving for non-negative values).
     let best = AtomicU64::new(f64::INFINITY.to_bits());
     let bound = |best: &AtomicU64| f64::from_bits(best.load(Ordering::Relaxed)) + slack;
-    let mut seeds: Vec<(f64, u32, u32)> = seed(ta, tb, &|_, _| true)
-        .into_iter()
-        .map(|(i, j)| (box_distance(&ta.nodes[i as usize].bounds, &tb.nodes[j as usize].bounds), i, j))
-        .collect();
-    seeds.sort_by(|x, y| x.0.total_cmp(&y.0).then((x.1, x.2).cmp(&(y.1, y.2))));
+    let mut seeds: Vec<(f64, Entry)> =
+        seed(ta, tb, &|_, _| true).into_iter().map(|e| (box_distance(&e.2, &e.3), e)).collect();
+    seeds.sort_by(|x, y| x.0.total_cmp(&y.0).then((x.1 .0, x.1 .1).cmp(&(y.1 .0, y.1 .1))));
     let found: Vec<Option<Candidate<R>>> = seeds
         .par_iter()
-        .map(|&(lb, i, j)| {
+        .map(|&(lb, e)| {
             let mut mine: Option<Candidate<R>> = None;
             if lb > bound(&best) {
                 return None;
             }
-            let mut stack = vec![(lb, i, j)];
-            while let Some((lb, i, j)) = stack.pop() {
+            let mut stack = vec![(lb, e)];
+            while let Some((lb, e)) = stack.pop() {
                 if lb > bound(&best) {
                     continue;
                 }
-                match children(ta, tb, i, j) {
+                match children(ta, tb, &e) {
                     None => {
-                        let (a, b) = (&ta.nodes[i as usize], &tb.nodes[j as usize]);
+                        let (a, b) = (&ta.nodes()[e.0 as usize], &tb.nodes()[e.1 as usize]);
                         let cur = f64::from_bits(best.load(Ordering::Relaxed));
-                        if let Some(c) = leaf(ta.leaf_prims(a), tb.leaf_prims(b), cur + slack) {
+                        if let Some(c) = leaf(ta.prims_of(a), tb.prims_of(b), cur + slack) {
                             best.fetch_min(c.distance.to_bits(), Ordering::Relaxed);
                             if mine.as_ref().is_none_or(|m| better(&c, m)) {
                                 mine = Some(c);
@@ -181,14 +242,12 @@ where
                         }
                     }
                     Some(kids) => {
-                        let d = kids.map(|(ci, cj)| {
-                            box_distance(&ta.nodes[ci as usize].bounds, &tb.nodes[cj as usize].bounds)
-                        });
+                        let d = kids.map(|k| box_distance(&k.2, &k.3));
                         // Push the farther first so the nearer is opened first.
                         let order = if d[0] <= d[1] { [1, 0] } else { [0, 1] };
                         for k in order {
                             if d[k] <= bound(&best) {
-                                stack.push((d[k], kids[k].0, kids[k].1));
+                                stack.push((d[k], kids[k]));
                             }
                         }
                     }

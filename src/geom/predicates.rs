@@ -12,6 +12,13 @@
 //! triangles, and ulp-sized differences of coordinates near m are m·2^-52, hence the margins.
 //! The loader stage rejects larger coordinates and warns about smaller non-zero ones.
 //!
+//! In front of the adaptive predicates, [`orient3d`] runs cheaper stages that each answer only
+//! when they have proven the sign: a float filter with a rigorous forward error bound
+//! ([`PlaneFilter`], [`ORIENT3D_FILTER_BOUND`]; derivation in the "Filters" notes below, valid
+//! over the whole exact range, tiny inputs always falling through), a repeated point (exactly
+//! zero), and an exact integer evaluation for coordinates that are short binary fractions
+//! ([`orient3d_dyadic`]). [`orient3d_adaptive`] is the adaptive predicate alone: the reference.
+//!
 //! Nothing outside this module compares a computed geometric quantity against a threshold:
 //! verdicts are built from these signs. The only tolerances are the user's own
 //! (`--touch-tolerance`, `--clearance`), carried in [`Tolerances`].
@@ -39,10 +46,233 @@ fn sign(v: f64) -> Sign {
 
 /// Exact sign of `((b - a) × (c - a)) · (d - a)`: positive when `d` lies on the side that the
 /// normal of triangle `(a, b, c)` (right-hand rule) points to, zero when the four are coplanar.
+///
+/// Stages, each exact when it answers (see the "Filters" notes in this module): the f64 determinant with its
+/// forward error bound ([`PlaneFilter`]); a repeated point (the determinant is then exactly 0);
+/// the integer evaluation of [`orient3d_dyadic`]; Shewchuk's adaptive predicate.
 #[inline]
 pub fn orient3d(a: DVec3, b: DVec3, c: DVec3, d: DVec3) -> Sign {
+    match PlaneFilter::new(&[a, b, c]).side(d) {
+        Some(s) => s,
+        None => orient3d_undecided(a, b, c, d),
+    }
+}
+
+/// The exact sign when the f64 filter could not decide: cheap exact special cases first, then
+/// the adaptive predicate.
+#[inline(never)]
+pub fn orient3d_undecided(a: DVec3, b: DVec3, c: DVec3, d: DVec3) -> Sign {
+    if d == a || d == b || d == c || a == b || a == c || b == c {
+        return 0; // two equal rows: the determinant is exactly zero
+    }
+    match orient3d_dyadic(a, b, c, d) {
+        Some(s) => s,
+        None => orient3d_adaptive(a, b, c, d),
+    }
+}
+
+/// [`orient3d`] by Shewchuk's adaptive predicate alone (no filter of ours in front): the
+/// reference the filtered stages are tested against.
+#[inline]
+pub fn orient3d_adaptive(a: DVec3, b: DVec3, c: DVec3, d: DVec3) -> Sign {
     // robust's convention is the opposite ("positive when d is below").
     -sign(robust::orient3d(c3(a), c3(b), c3(c), c3(d)))
+}
+
+// # Filters
+//
+// A float filter evaluates a determinant in f64 and answers only when the rounded value is
+// farther from zero than a rigorous bound on its rounding error; otherwise the caller falls
+// back to exact arithmetic. Error analysis (Higham, "Accuracy and Stability of Numerical
+// Algorithms", §3.1): with round-to-nearest, unit roundoff ε = 2^-53 and no underflow or
+// overflow, a value obtained from exact inputs through k roundings is the exact value times
+// (1 + θ), |θ| <= γ_k = kε / (1 - kε).
+//
+// * orient3d as evaluated here: u = b - a, v = c - a, w = d - a (one rounding each), the normal
+//   n = u × v (a product and a subtraction: n_x = u_y·v_z - v_y·u_z), then n·w summed as
+//   (n_x w_x + n_y w_y) + n_z w_z. Each of the six monomials ±U_i·V_j·W_k of the exact
+//   determinant (U, V, W the exact differences) passes through at most 3 + 1 + 1 + 1 + 2 = 8
+//   roundings, so |det_f64 - det| <= γ_8 · P where P = Σ|U_i V_j W_k| is the permanent. The
+//   permanent is computed as P_f64 = (|n|-permanent m)·|w| with m_x = |u_y v_z| + |v_y u_z|
+//   (the same rounded products), itself at most 8 roundings from the exact one, so
+//   P <= P_f64 / (1 - γ_8). With the bound computed as fl(fl(C3·P_f64) + A) and C3 = 9ε:
+//   9ε(1 - ε)² >= 8ε(1 + 17ε) >= γ_8 / (1 - γ_8), so `|det_f64| > bound` proves the sign.
+// * orient2d (component k of u × v): 2 differences, a product, a subtraction: 4 roundings, the
+//   permanent m_k as above (4 roundings); C2 = 5ε since 5ε(1 - ε)² >= 4ε(1 + 9ε).
+// * Underflow and overflow. Inside the exact range (module doc) neither happens: differences
+//   of coordinates in [2^-250, 2^250] ∪ {0} are 0 or at least 2^-302, so every product of up
+//   to three of them is a normal number, and at most 2^756. Coordinates below the range are
+//   accepted by the loader (with a warning): gradual underflow makes additions exact and adds
+//   at most 2^-1075 absolute error to each product; through the later products (factors at
+//   most 2^251) and sums that is below 2^-820 in total. The absolute allowance
+//   A = 2^-800 ([`FILTER_UNDERFLOW_ALLOWANCE`]) covers it, so tiny inputs (whose determinants
+//   are all below A) always take the exact path. An overflow makes the bound infinite or the
+//   value NaN, and every comparison false: the exact path again.
+
+/// Unit roundoff of f64 (round to nearest): 2^-53.
+const UNIT_ROUNDOFF: f64 = f64::EPSILON / 2.0;
+
+/// Relative error constant of the orient3d filter: `|det_f64 - det| <= C3 · P_f64` (derived in
+/// the module source, "Filters": γ_8 / (1 - γ_8) rounded up to 9ε).
+pub const ORIENT3D_FILTER_BOUND: f64 = 9.0 * UNIT_ROUNDOFF;
+
+/// Relative error constant of the orient2d (normal component) filter: γ_4 / (1 - γ_4) rounded
+/// up to 5ε.
+pub const ORIENT2D_FILTER_BOUND: f64 = 5.0 * UNIT_ROUNDOFF;
+
+/// Absolute error allowance of the filters for underflow (2^-800): see "Filters" above.
+pub const FILTER_UNDERFLOW_ALLOWANCE: f64 = f64::from_bits((1023 - 800) << 52);
+
+/// Float filter data of one triangle `(a, b, c)`: its f64 normal `(b - a) × (c - a)` and the
+/// permanents of the normal's components, computed once and reused for every point tested
+/// against the triangle's plane.
+#[derive(Debug, Clone, Copy)]
+pub struct PlaneFilter {
+    origin: DVec3,
+    normal: DVec3,
+    perm: DVec3,
+}
+
+impl PlaneFilter {
+    /// The filter data of triangle `t`.
+    #[inline]
+    pub fn new(t: &[DVec3; 3]) -> PlaneFilter {
+        let (u, v) = (t[1] - t[0], t[2] - t[0]);
+        // The same expressions as glam's `cross`, so `normal` is bit-identical to
+        // `(b - a).cross(c - a)` wherever that is computed.
+        let normal = u.cross(v);
+        let perm = DVec3::new(
+            (u.y * v.z).abs() + (v.y * u.z).abs(),
+            (u.z * v.x).abs() + (v.z * u.x).abs(),
+            (u.x * v.y).abs() + (v.x * u.y).abs(),
+        );
+        PlaneFilter { origin: t[0], normal, perm }
+    }
+
+    /// The f64 normal `(b - a) × (c - a)`.
+    #[inline]
+    pub fn normal(&self) -> DVec3 {
+        self.normal
+    }
+
+    /// The exact sign of component `k` of the normal (= [`orient2d`] of the triangle in
+    /// projection `k`) if the filter proves it, else `None`.
+    #[inline]
+    pub fn normal_sign(&self, k: usize) -> Option<Sign> {
+        let e = ORIENT2D_FILTER_BOUND * self.perm[k] + FILTER_UNDERFLOW_ALLOWANCE;
+        decided(self.normal[k], e)
+    }
+
+    /// True if the filter proves the triangle proper (some normal component is non-zero, so it
+    /// is not collinear); false if it cannot tell.
+    #[inline]
+    pub fn proper(&self) -> bool {
+        let e = self.perm * ORIENT2D_FILTER_BOUND + DVec3::splat(FILTER_UNDERFLOW_ALLOWANCE);
+        let n = self.normal.abs();
+        n.x > e.x || n.y > e.y || n.z > e.z
+    }
+
+    /// The exact sign of `orient3d(a, b, c, p)` if the filter proves it, else `None`.
+    #[inline]
+    pub fn side(&self, p: DVec3) -> Option<Sign> {
+        let w = p - self.origin;
+        let d = self.normal.dot(w);
+        let e = ORIENT3D_FILTER_BOUND * self.perm.dot(w.abs()) + FILTER_UNDERFLOW_ALLOWANCE;
+        decided(d, e)
+    }
+
+    /// The exact sign of `orient3d(t[0], t[1], t[2], p)`, `t` the triangle this filter was
+    /// made from: the filter, else the exact stages of [`orient3d`].
+    #[inline]
+    pub fn side_exact(&self, t: &[DVec3; 3], p: DVec3) -> Sign {
+        match self.side(p) {
+            Some(s) => s,
+            None => orient3d_undecided(t[0], t[1], t[2], p),
+        }
+    }
+}
+
+/// `Some(sign of v)` if `|v| > e`, else `None` (also when either is NaN).
+#[inline]
+fn decided(v: f64, e: f64) -> Option<Sign> {
+    if v > e {
+        Some(1)
+    } else if -v > e {
+        Some(-1)
+    } else {
+        None
+    }
+}
+
+/// Largest magnitude (in bits) of the coordinate differences [`orient3d_dyadic`] multiplies:
+/// three factors below 2^41 keep every monomial below 2^123 and the determinant below 2^126,
+/// inside i128.
+const DYADIC_DIFF_BITS: u32 = 41;
+
+/// Exact orient3d in integer arithmetic when the inputs allow it (common for exactly coplanar
+/// input whose coordinates are short binary fractions: grids, f32 data, nearby points far from
+/// the origin). Per axis, the four coordinates scaled by one power of two `2^-L_axis` (so that
+/// the largest is below 2^62) must all be integers: then they are exact i64 values, and so are
+/// their differences. Every monomial of the determinant takes
+/// one difference from each axis, so the determinant is `2^(L_x + L_y + L_z)` times the integer
+/// determinant, computed exactly in i128 when the differences are below 2^41. `None` when the
+/// inputs do not allow it (then the adaptive predicate decides).
+pub fn orient3d_dyadic(a: DVec3, b: DVec3, c: DVec3, d: DVec3) -> Option<Sign> {
+    // Per axis: the components of u = b - a, v = c - a, w = d - a (in that axis's units).
+    let dx = axis_differences([a.x, b.x, c.x, d.x])?;
+    let dy = axis_differences([a.y, b.y, c.y, d.y])?;
+    let dz = axis_differences([a.z, b.z, c.z, d.z])?;
+    // Each below 2^41 in magnitude: the normal's components are below 2^83, the determinant
+    // below 2^126.
+    let (ux, uy, uz) = (dx[0] as i128, dy[0] as i128, dz[0] as i128);
+    let (vx, vy, vz) = (dx[1] as i128, dy[1] as i128, dz[1] as i128);
+    let (wx, wy, wz) = (dx[2] as i128, dy[2] as i128, dz[2] as i128);
+    let n = [uy * vz - uz * vy, uz * vx - ux * vz, ux * vy - uy * vx];
+    let det = n[0] * wx + n[1] * wy + n[2] * wz;
+    Some(det.signum() as Sign)
+}
+
+/// For one axis, the coordinates `[a, b, c, d]` as exact integer multiples of one power of two
+/// `2^L`, their lowest set bit (`None` if the four do not fit a 62-bit window), and their
+/// differences `[b - a, c - a, d - a]` in units of
+/// `2^L` (`None` if one is 2^41 or more).
+#[inline]
+fn axis_differences(xs: [f64; 4]) -> Option<[i64; 3]> {
+    let top = xs.iter().map(|x| (x.to_bits() >> 52) & 0x7ff).max().unwrap_or(0);
+    if top == 0 {
+        // All zero (or subnormal: left to the adaptive predicate).
+        return xs.iter().all(|&x| x == 0.0).then_some([0; 3]);
+    }
+    // |x| < 2^(top - 1022) for all four; scaling by 2^(1084 - top) (exact: a power of two)
+    // puts them below 2^62. The scale's biased exponent 2107 - top is a normal one when
+    // top >= 62 (smaller coordinates: below 2^-960, left to the adaptive predicate).
+    if top < 62 {
+        return None;
+    }
+    let scale = f64::from_bits((2107 - top) << 52);
+    let mut ints = [0i64; 4];
+    for (x, out) in xs.iter().zip(ints.iter_mut()) {
+        let t = x * scale;
+        // |t| < 2^62: the conversion truncates exactly, and converts back exactly iff `t` is an
+        // integer. A non-zero coordinate must not have been lost to underflow.
+        let i = t as i64;
+        if i as f64 != t || (t == 0.0) != (*x == 0.0) {
+            return None;
+        }
+        *out = i;
+    }
+    // Drop the trailing zero bits common to all four (exact), so that L is their lowest set bit.
+    let common = ints.iter().fold(0i64, |acc, &v| acc | v).trailing_zeros().min(62);
+    let ints = ints.map(|v| v >> common);
+    let mut diffs = [0i64; 3];
+    for (r, out) in diffs.iter_mut().enumerate() {
+        let v = ints[r + 1] - ints[0]; // below 2^63 in magnitude: no overflow
+        if v.unsigned_abs() >= 1u64 << DYADIC_DIFF_BITS {
+            return None;
+        }
+        *out = v;
+    }
+    Some(diffs)
 }
 
 /// The determinant of [`orient3d`] as a value, used only to place intersection points for the
@@ -51,7 +281,12 @@ pub fn orient3d(a: DVec3, b: DVec3, c: DVec3, d: DVec3) -> Sign {
 /// rounding of the other plane (where the f64 value has no correct digits); its sign is forced
 /// to the exact one.
 pub fn orient3d_value(a: DVec3, b: DVec3, c: DVec3, d: DVec3) -> f64 {
-    let s = orient3d(a, b, c, d);
+    orient3d_value_signed(a, b, c, d, orient3d(a, b, c, d))
+}
+
+/// [`orient3d_value`] when the exact sign `s` of the determinant is already known (it must be
+/// `orient3d(a, b, c, d)`): the same value without deciding the sign again.
+pub fn orient3d_value_signed(a: DVec3, b: DVec3, c: DVec3, d: DVec3, s: Sign) -> f64 {
     if s == 0 {
         return 0.0;
     }
@@ -71,14 +306,14 @@ mod dd {
     #[derive(Clone, Copy)]
     pub(super) struct Dd(f64, f64);
 
-    #[inline]
+    #[inline(always)]
     fn two_sum(a: f64, b: f64) -> Dd {
         let s = a + b;
         let bb = s - a;
         Dd(s, (a - (s - bb)) + (b - bb))
     }
 
-    #[inline]
+    #[inline(always)]
     fn add(x: Dd, y: Dd) -> Dd {
         let s = two_sum(x.0, y.0);
         let lo = s.1 + x.1 + y.1;
@@ -86,12 +321,12 @@ mod dd {
         Dd(h, lo - (h - s.0))
     }
 
-    #[inline]
+    #[inline(always)]
     fn neg(x: Dd) -> Dd {
         Dd(-x.0, -x.1)
     }
 
-    #[inline]
+    #[inline(always)]
     fn mul(x: Dd, y: Dd) -> Dd {
         let p = x.0 * y.0;
         let e = x.0.mul_add(y.0, -p);
@@ -101,7 +336,29 @@ mod dd {
     }
 
     /// `((b - a) × (c - a)) · (d - a)`, differences exact.
+    ///
+    /// `mul` needs a fused multiply-add; without the target feature `f64::mul_add` is a
+    /// software routine (hundreds of instructions), so on x86-64 CPUs that have FMA the same
+    /// code is run compiled for it. Both are the correctly rounded IEEE fma: the same bits.
     pub(super) fn orient3d(a: DVec3, b: DVec3, c: DVec3, d: DVec3) -> f64 {
+        #[cfg(target_arch = "x86_64")]
+        if std::arch::is_x86_feature_detected!("fma") {
+            // SAFETY: the CPU supports FMA (checked just above), the only requirement of a
+            // `target_feature(enable = "fma")` function.
+            return unsafe { orient3d_fma(a, b, c, d) };
+        }
+        orient3d_portable(a, b, c, d)
+    }
+
+    /// [`orient3d_portable`] compiled with hardware FMA.
+    #[cfg(target_arch = "x86_64")]
+    #[target_feature(enable = "fma")]
+    fn orient3d_fma(a: DVec3, b: DVec3, c: DVec3, d: DVec3) -> f64 {
+        orient3d_portable(a, b, c, d)
+    }
+
+    #[inline(always)]
+    fn orient3d_portable(a: DVec3, b: DVec3, c: DVec3, d: DVec3) -> f64 {
         let diff = |p: DVec3, k: usize| two_sum(p[k], -a[k]);
         let (u, v, w) =
             ([0, 1, 2].map(|k| diff(b, k)), [0, 1, 2].map(|k| diff(c, k)), [0, 1, 2].map(|k| diff(d, k)));
@@ -160,13 +417,19 @@ pub fn line_axis(p: DVec3, q: DVec3) -> usize {
     }
 }
 
-/// The predicates a classification is built from. [`Exact`] is the product; [`Float`] exists
-/// to measure what exactness costs and buys (`--mode fast`).
+/// The predicates a classification is built from. [`Exact`] is the product; [`Adaptive`] the
+/// same exact signs without our filters (the reference they are tested against); [`Float`]
+/// exists to measure what exactness costs and buys (`--mode fast`).
 pub trait Kernel {
     /// Sign of `((b - a) × (c - a)) · (d - a)`.
     fn orient3d(a: DVec3, b: DVec3, c: DVec3, d: DVec3) -> Sign;
     /// The determinant value (sign as `orient3d`), to place points for the report.
     fn orient3d_value(a: DVec3, b: DVec3, c: DVec3, d: DVec3) -> f64;
+    /// [`Kernel::orient3d_value`] when `s = Self::orient3d(a, b, c, d)` is already known.
+    fn orient3d_value_signed(a: DVec3, b: DVec3, c: DVec3, d: DVec3, s: Sign) -> f64 {
+        let _ = s;
+        Self::orient3d_value(a, b, c, d)
+    }
     /// Sign of component `axis` of `(b - a) × (c - a)`.
     fn orient2d(a: DVec3, b: DVec3, c: DVec3, axis: usize) -> Sign;
     /// Are the three points collinear?
@@ -182,7 +445,8 @@ pub trait Kernel {
     }
 }
 
-/// Shewchuk's adaptive exact predicates: signs exact for the f64 inputs.
+/// Exact predicates: signs exact for the f64 inputs (our filters, then Shewchuk's adaptive
+/// predicates).
 pub struct Exact;
 
 impl Kernel for Exact {
@@ -193,6 +457,30 @@ impl Kernel for Exact {
     #[inline]
     fn orient3d_value(a: DVec3, b: DVec3, c: DVec3, d: DVec3) -> f64 {
         orient3d_value(a, b, c, d)
+    }
+    #[inline]
+    fn orient3d_value_signed(a: DVec3, b: DVec3, c: DVec3, d: DVec3, s: Sign) -> f64 {
+        orient3d_value_signed(a, b, c, d, s)
+    }
+    #[inline]
+    fn orient2d(a: DVec3, b: DVec3, c: DVec3, axis: usize) -> Sign {
+        orient2d(a, b, c, axis)
+    }
+}
+
+/// Shewchuk's adaptive predicates alone, without our filters in front: the exact reference
+/// (the classification as it was before the filters) that the filtered path is tested and
+/// measured against.
+pub struct Adaptive;
+
+impl Kernel for Adaptive {
+    #[inline]
+    fn orient3d(a: DVec3, b: DVec3, c: DVec3, d: DVec3) -> Sign {
+        orient3d_adaptive(a, b, c, d)
+    }
+    #[inline]
+    fn orient3d_value(a: DVec3, b: DVec3, c: DVec3, d: DVec3) -> f64 {
+        orient3d_value_signed(a, b, c, d, orient3d_adaptive(a, b, c, d))
     }
     #[inline]
     fn orient2d(a: DVec3, b: DVec3, c: DVec3, axis: usize) -> Sign {
@@ -285,6 +573,105 @@ impl Tolerances {
     }
 }
 
+/// A box map that is wider than this many ulps of its coordinate scale (see [`BoxMap::fit`]) is
+/// refused: the instance's coordinates are then not (to rounding) an affine image of the shared
+/// tree's, and it gets its own refitted boxes instead. Only a cost threshold: any accepted map
+/// is conservative.
+pub const BOX_MAP_MAX_DEVIATION_ULPS: f64 = 1024.0;
+
+/// A conservative affine map of boxes, so that instances of one mesh can share one tree: the
+/// tree is built over one instance's coordinates `x` (the *source*), and another instance's
+/// coordinates `w` (the *target*, computed independently, e.g. by the loader from the mesh's
+/// local coordinates) are, up to rounding, `R x + t`.
+///
+/// [`BoxMap::map_box`] returns a box that contains every target vertex whose source lies in the
+/// given box, whatever the rounding of the target coordinates and of the map itself. Proof, per
+/// output axis `i`, for a box `[lo, hi]` inside the source root box: let
+/// `S_i = |t_i| + Σ_j |r_ij|·max(|root.min_j|, |root.max_j|)`.
+/// * The exact range of `(R x + t)_i` over the box is `[L_i, U_i]` with
+///   `L_i = t_i + Σ_j min(r_ij·lo_j, r_ij·hi_j)` (a corner per term by the sign of `r_ij`). Its f64
+///   evaluation (three products, three sums, in a fixed order) is within `γ_4·S_i` of it
+///   (Higham, *Accuracy and Stability of Numerical Algorithms*, §3.1; `γ_n = n·u/(1 − n·u)`,
+///   `u = 2^-53`).
+/// * Every target vertex is within `dev_i` of the exact image of its source; [`BoxMap::fit`]
+///   measures it: the largest f64 `|w_i − fl(R x + t)_i|` over all vertices, which is at least
+///   `(1 − u)·|w_i − fl(…)|`, plus `γ_4·S_i` for the rounding of `fl(R x + t)`.
+/// * The final `lo − slack` / `hi + slack` rounds by at most `u·(|L̂_i| + slack_i)`.
+///
+/// So `slack_i ≥ (2γ_4 + u(1 + γ_4))·S_i + dev/(1 − u)` over `(1 − u)` suffices; the map uses
+/// `16u·S_i + 2·dev_i + 2^-1022` (roughly twice that; the last term covers products that
+/// underflow, each off by at most 2^-1075), and `S_i`, `dev_i` are computed in f64 with a
+/// relative error far below the factor 2 of margin. A looser box only costs time; a tighter one
+/// could cull a touching pair, so the margin errs outward.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct BoxMap {
+    /// The rows `[r_i0, r_i1, r_i2, t_i]` of the affine map (source → target).
+    pub rows: [[f64; 4]; 3],
+    /// Per output axis, added outward to both sides of every mapped box.
+    pub slack: DVec3,
+}
+
+impl BoxMap {
+    /// Row `i` applied to `x`, in the fixed order the error bound assumes.
+    #[inline]
+    fn eval(r: &[f64; 4], x: [f64; 3]) -> f64 {
+        r[0] * x[0] + r[1] * x[1] + r[2] * x[2] + r[3]
+    }
+
+    /// The map `rows` from the source vertices to the target vertices (`pairs` yields each
+    /// vertex as (source, target)), with its slack measured over all of them; `source_root` is
+    /// a box containing every source vertex (the tree's root). `None` when the map is not
+    /// finite or the target is further than [`BOX_MAP_MAX_DEVIATION_ULPS`] ulps of the scale
+    /// from the image of the source (not an instance of the same geometry to rounding).
+    pub fn fit(
+        rows: [[f64; 4]; 3],
+        source_root: &Aabb,
+        pairs: impl Iterator<Item = (DVec3, DVec3)>,
+    ) -> Option<BoxMap> {
+        if rows.iter().flatten().any(|x| !x.is_finite()) {
+            return None;
+        }
+        let big = source_root.min.abs().max(source_root.max.abs()).to_array();
+        let scale = rows.map(|r| r[3].abs() + (0..3).map(|j| r[j].abs() * big[j]).sum::<f64>());
+        let mut dev = [0.0f64; 3];
+        for (x, w) in pairs {
+            let (x, w) = (x.to_array(), w.to_array());
+            for i in 0..3 {
+                let d = (w[i] - Self::eval(&rows[i], x)).abs();
+                if d.is_nan() {
+                    return None;
+                }
+                dev[i] = dev[i].max(d);
+            }
+        }
+        let u = f64::EPSILON / 2.0;
+        let mut slack = [0.0f64; 3];
+        for i in 0..3 {
+            if !scale[i].is_finite() || dev[i] > BOX_MAP_MAX_DEVIATION_ULPS * f64::EPSILON * scale[i] {
+                return None;
+            }
+            slack[i] = 16.0 * u * scale[i] + 2.0 * dev[i] + f64::MIN_POSITIVE;
+        }
+        Some(BoxMap { rows, slack: DVec3::from_array(slack) })
+    }
+
+    /// A box containing every target vertex whose source vertex lies in `b` (which must lie in
+    /// the source root given to [`BoxMap::fit`]).
+    #[inline]
+    pub fn map_box(&self, b: &Aabb) -> Aabb {
+        let (lo, hi) = (b.min.to_array(), b.max.to_array());
+        let mut min = [0.0; 3];
+        let mut max = [0.0; 3];
+        for i in 0..3 {
+            let r = &self.rows[i];
+            let pick = |j: usize, low: bool| if (r[j] >= 0.0) == low { lo[j] } else { hi[j] };
+            min[i] = Self::eval(r, [pick(0, true), pick(1, true), pick(2, true)]);
+            max[i] = Self::eval(r, [pick(0, false), pick(1, false), pick(2, false)]);
+        }
+        Aabb { min: DVec3::from_array(min) - self.slack, max: DVec3::from_array(max) + self.slack }
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -329,6 +716,62 @@ mod tests {
         let up = f64::from_bits(z.to_bits() + 1);
         assert_eq!(orient3d(a, b, c, DVec3::new(0.25, 0.75, up)), orient3d(a, b, c, a + DVec3::Z));
         assert_eq!(orient3d(a, b, c, DVec3::new(0.25, 0.75, z)), 0);
+    }
+
+    #[test]
+    fn filter_never_contradicts_the_exact_sign() {
+        // A point walked across a plane far from the origin ulp by ulp: the filter either
+        // abstains or gives the exact sign, and abstains right at the plane.
+        let z = 1.0e8;
+        let t =
+            [DVec3::new(1.0e8, 0.0, z), DVec3::new(0.0, 1.0e8 + 3.0, z), DVec3::new(-1.0e8 + 0.5, -7.0, z)];
+        let f = PlaneFilter::new(&t);
+        assert!(f.proper());
+        let mut abstained = 0;
+        for k in -40i64..=40 {
+            let p = DVec3::new(0.25, 0.75, f64::from_bits((z.to_bits() as i64 + k) as u64));
+            let exact = orient3d_adaptive(t[0], t[1], t[2], p);
+            assert_eq!(exact, k.signum() as Sign);
+            match f.side(p) {
+                Some(s) => assert_eq!(s, exact, "k = {k}"),
+                None => abstained += 1,
+            }
+            assert_eq!(f.side_exact(&t, p), exact);
+            assert_eq!(orient3d(t[0], t[1], t[2], p), exact);
+        }
+        assert!(abstained > 0 && f.side(DVec3::new(0.25, 0.75, z)).is_none());
+        // Far off the plane it decides.
+        assert_eq!(f.side(DVec3::new(0.0, 0.0, z + 1.0)), Some(1));
+        // A collinear triangle is never proven proper; tiny coordinates are left to the exact path.
+        assert!(!PlaneFilter::new(&[DVec3::ZERO, DVec3::X, DVec3::X * 3.0]).proper());
+        let tiny = 2f64.powi(-420);
+        let ft = PlaneFilter::new(&[DVec3::ZERO, DVec3::X * tiny, DVec3::Y * tiny]);
+        assert!(!ft.proper() && ft.side(DVec3::Z * tiny).is_none());
+        assert_eq!(orient3d(DVec3::ZERO, DVec3::X * tiny, DVec3::Y * tiny, DVec3::Z * tiny), 1);
+    }
+
+    #[test]
+    fn dyadic_stage_is_exact_on_short_binary_fractions() {
+        // Exactly coplanar points of x + y + z = 3e8 on a 2^-26 grid: f64 determinants round to
+        // non-zero values, the integer evaluation is exactly zero.
+        let q = 2f64.powi(-26);
+        let base = 100_000_000i64 << 26;
+        let p = |i: i64, j: i64| {
+            let (x, y) = (base + i, base + j);
+            DVec3::new(x as f64 * q, y as f64 * q, (3 * base - x - y) as f64 * q)
+            // all exact
+        };
+        let (a, b, c, d) = (p(0, 0), p(67_108_864, 5), p(3, 67_108_865), p(10_000_000, 20_000_000));
+        assert_eq!(orient3d_dyadic(a, b, c, d), Some(0));
+        assert_eq!(orient3d_adaptive(a, b, c, d), 0);
+        let up = d + DVec3::new(0.0, 0.0, q);
+        assert_eq!(orient3d_dyadic(a, b, c, up), Some(orient3d_adaptive(a, b, c, up)));
+        assert_eq!(orient3d_dyadic(a, b, c, up), Some(1));
+        // Differences spanning too many bits, or inexact: no answer.
+        assert_eq!(orient3d_dyadic(DVec3::ZERO, DVec3::X, DVec3::Y * 1e-30, DVec3::Z), None);
+        assert_eq!(orient3d_dyadic(DVec3::splat(0.1), DVec3::splat(-1e20), DVec3::Y, DVec3::Z), None);
+        // Repeated points are exactly zero.
+        assert_eq!(orient3d(a, b, c, b), 0);
     }
 
     #[test]
