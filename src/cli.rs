@@ -50,12 +50,12 @@ pub struct Args {
     /// Affine transform of B, as --transform-a.
     #[arg(long, value_name = "M", allow_hyphen_values = true)]
     pub transform_b: Option<String>,
-    /// Pairs that do not touch but are within this distance count as touching: model units, or
-    /// relative to the model size with a `rel` suffix (`1e-6rel` = 1e-6 × the diagonal of the
+    /// Pairs that do not touch but are within this distance count as touching: in the report
+    /// units (--units, else the files' own), or relative to the model size with a `rel` suffix (`1e-6rel` = 1e-6 × the diagonal of the
     /// box around both inputs).
     #[arg(long, value_name = "E", default_value = "0", allow_hyphen_values = true)]
     pub touch_tolerance: String,
-    /// Also report every pair closer than D that does not touch (model units, or `rel` suffix).
+    /// Also report every pair closer than D that does not touch (report units, or `rel` suffix).
     #[arg(long, value_name = "D", default_value = "0", allow_hyphen_values = true)]
     pub clearance: String,
     /// Exit 1 when the verdict is at or above this.
@@ -85,10 +85,20 @@ pub struct Args {
     /// no distance or containment is computed, and which pair is listed depends on timing.
     #[arg(long)]
     pub first_hit: bool,
+    /// Split every part into its connected bodies (triangles joined through edges used by
+    /// exactly two triangles), named `part/body1`, `part/body2`, …: e.g. two cubes in one STL
+    /// solid that touch along an edge become two parts.
+    #[arg(long)]
+    pub split_bodies: bool,
+    /// Estimate each clash region's penetration depth: the deepest vertex of one part inside
+    /// the other closed part, measured to its surface (a lower bound; costs a tree per part
+    /// with a region and point queries, at most 4096 per region and side).
+    #[arg(long)]
+    pub penetration: bool,
     /// Allowed relative error of the minimum distance (reported d <= (1+R)·true + A).
     #[arg(long, value_name = "R", default_value_t = 0.0)]
     pub distance_rel_err: f64,
-    /// Allowed absolute error of the minimum distance (model units).
+    /// Allowed absolute error of the minimum distance (report units).
     #[arg(long, value_name = "A", default_value_t = 0.0)]
     pub distance_abs_err: f64,
     /// Check only parts of A whose name matches GLOB (`*`, `?`; repeatable). Part names are
@@ -105,6 +115,29 @@ pub struct Args {
     /// Deterministic report: no timings, no thread count (byte-identical across runs).
     #[arg(long)]
     pub no_timings: bool,
+    /// Units of the report: every input is converted into U (multiplied in f64 after loading,
+    /// before --transform/--translate, which are therefore in U), and all coordinates,
+    /// distances and tolerances are in U. Inputs of unknown units (OBJ, STL, without
+    /// --units-a/-b) are taken to be in U, with a warning. Verdicts are exact for the converted
+    /// coordinates (a factor that is not a power of two rounds each coordinate once). Default:
+    /// --units-a, else --units-b, else none: no conversion, lengths in the files' own units.
+    #[arg(long, value_enum, value_name = "U")]
+    pub units: Option<Unit>,
+    /// Units of A's coordinates [default: m for glTF/GLB (the glTF specification), unknown for
+    /// OBJ/STL]. In scene mode, the units of the file.
+    #[arg(long, value_enum, value_name = "U")]
+    pub units_a: Option<Unit>,
+    /// Units of B's coordinates, as --units-a.
+    #[arg(long, value_enum, value_name = "U")]
+    pub units_b: Option<Unit>,
+    /// Multiply A's coordinates by F (finite, > 0) with the unit conversion, before
+    /// --transform-a/--translate-a: the coordinates are multiplied once by the f64 product of
+    /// the conversion factor and F. In scene mode, applies to the file.
+    #[arg(long, value_name = "F", allow_hyphen_values = true)]
+    pub scale_a: Option<f64>,
+    /// Multiply B's coordinates by F, as --scale-a.
+    #[arg(long, value_name = "F", allow_hyphen_values = true)]
+    pub scale_b: Option<f64>,
     /// Output flags: --format, --junit, --baseline, --export-glb.
     #[command(flatten)]
     pub outputs: crate::output::OutputArgs,
@@ -123,6 +156,9 @@ pub enum Command {
     /// Time meshclash against parry3d (f32 and f64) on generated and given meshes, compare their
     /// answers, and (--trade) tabulate every speed/accuracy option against the exact default.
     Bench(crate::bench::BenchArgs),
+    /// Run the named checks of a clash-set file (JSON) in one go: one JSON document with every
+    /// check's report, exit 1 if any check fails its --fail-on, 2 on bad input in any check.
+    ClashSet(crate::clash_set::ClashSetArgs),
 }
 
 /// `--fail-on` values.
@@ -203,6 +239,157 @@ pub struct Config {
     pub selection: crate::assembly::Selection,
     /// Output format, JUnit and GLB files, baseline.
     pub outputs: crate::output::OutputOptions,
+    /// Units and scales (`--units`, `--units-a/-b`, `--scale-a/-b`).
+    pub units: UnitsConfig,
+    /// `--split-bodies`.
+    pub split_bodies: bool,
+    /// `--penetration`.
+    pub penetration: bool,
+}
+
+/// A unit of length (`--units`, `--units-a`, `--units-b`).
+#[derive(
+    Debug, Clone, Copy, PartialEq, Eq, ValueEnum, serde::Serialize, serde::Deserialize, schemars::JsonSchema,
+)]
+pub enum Unit {
+    /// Micrometre.
+    #[value(name = "um")]
+    #[serde(rename = "um")]
+    Um,
+    /// Millimetre.
+    #[value(name = "mm")]
+    #[serde(rename = "mm")]
+    Mm,
+    /// Centimetre.
+    #[value(name = "cm")]
+    #[serde(rename = "cm")]
+    Cm,
+    /// Metre (glTF's unit by specification).
+    #[value(name = "m")]
+    #[serde(rename = "m")]
+    M,
+    /// Inch (25.4 mm exactly).
+    #[value(name = "in")]
+    #[serde(rename = "in")]
+    In,
+    /// Foot (12 in).
+    #[value(name = "ft")]
+    #[serde(rename = "ft")]
+    Ft,
+    /// Yard (3 ft).
+    #[value(name = "yd")]
+    #[serde(rename = "yd")]
+    Yd,
+}
+
+impl Unit {
+    /// Its name on the command line and in the report.
+    pub fn name(self) -> &'static str {
+        match self {
+            Unit::Um => "um",
+            Unit::Mm => "mm",
+            Unit::Cm => "cm",
+            Unit::M => "m",
+            Unit::In => "in",
+            Unit::Ft => "ft",
+            Unit::Yd => "yd",
+        }
+    }
+
+    /// Its length in micrometres: an exact integer for every unit (the inch is 25.4 mm by
+    /// definition).
+    pub fn micrometres(self) -> u32 {
+        match self {
+            Unit::Um => 1,
+            Unit::Mm => 1_000,
+            Unit::Cm => 10_000,
+            Unit::M => 1_000_000,
+            Unit::In => 25_400,
+            Unit::Ft => 304_800,
+            Unit::Yd => 914_400,
+        }
+    }
+
+    /// The factor that converts coordinates in `self` to `to`: the exact ratio of two integers,
+    /// rounded once to f64 (one IEEE division of exactly representable operands).
+    pub fn factor_to(self, to: Unit) -> f64 {
+        f64::from(self.micrometres()) / f64::from(to.micrometres())
+    }
+}
+
+/// Units and raw scales, validated. Indices follow [`Config::inputs`] (in scene mode the file is
+/// input 1, and `--units-a`/`--scale-a` are stored there).
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct UnitsConfig {
+    /// `--units`, or the default (`--units-a`, else `--units-b`); None: no conversion.
+    pub report: Option<Unit>,
+    /// Declared units of each input.
+    pub inputs: [Option<Unit>; 2],
+    /// Raw multipliers (None = 1).
+    pub scale: [Option<f64>; 2],
+}
+
+impl UnitsConfig {
+    /// True if any units or scale flag was given (otherwise inputs load exactly as before, and
+    /// the report has no `inputs.*.units` blocks).
+    pub fn active(&self) -> bool {
+        self.report.is_some()
+            || self.inputs.iter().any(Option::is_some)
+            || self.scale.iter().any(Option::is_some)
+    }
+
+    /// The report's `settings.units`: the report unit, or `model`.
+    pub fn report_name(&self) -> &'static str {
+        self.report.map_or("model", Unit::name)
+    }
+
+    /// Resolve input `i` of format `format`: the multiplier, the report block and a warning when
+    /// the units were assumed. `flag` names the units flag for the warning.
+    pub fn resolve(
+        &self,
+        i: usize,
+        format: crate::load::Format,
+        flag: &str,
+    ) -> (f64, report::InputUnitsReport, Option<String>) {
+        let scale = self.scale[i].unwrap_or(1.0);
+        let gltf = matches!(format, crate::load::Format::Gltf | crate::load::Format::Glb);
+        let (units, source, warning) = match (self.report, self.inputs[i]) {
+            (None, _) => (None, None, None),
+            (Some(_), Some(u)) => (Some(u), Some("given"), None),
+            (Some(_), None) if gltf => (Some(Unit::M), Some("gltf"), None),
+            (Some(r), None) => (
+                Some(r),
+                Some("assumed"),
+                Some(format!(
+                    "units unknown ({} files carry none): taken to be {}, the report units; give {flag} to declare them",
+                    format.name().to_uppercase(),
+                    r.name()
+                )),
+            ),
+        };
+        let factor = match (units, self.report) {
+            (Some(u), Some(r)) => u.factor_to(r),
+            _ => 1.0,
+        };
+        let multiplier = factor * scale;
+        let block = report::InputUnitsReport {
+            units: units.map(|u| u.name().to_string()),
+            source: source.map(str::to_string),
+            factor,
+            scale,
+            multiplier,
+        };
+        (multiplier, block, warning)
+    }
+}
+
+fn positive_scale(flag: &str, v: Option<f64>) -> Result<Option<f64>> {
+    match v {
+        Some(x) if !(x.is_finite() && x > 0.0) => {
+            Err(Error::Usage(format!("--{flag} must be a finite number > 0, got {x}")))
+        }
+        _ => Ok(v),
+    }
 }
 
 fn numbers(flag: &str, s: &str) -> Result<Vec<f64>> {
@@ -305,6 +492,25 @@ impl Args {
         }
         let touch = parse_tolerance("touch-tolerance", &self.touch_tolerance)?;
         let clearance = parse_tolerance("clearance", &self.clearance)?;
+        let scale = [positive_scale("scale-a", self.scale_a)?, positive_scale("scale-b", self.scale_b)?];
+        let units = if scene_mode {
+            if self.units_b.is_some() || self.scale_b.is_some() {
+                return Err(Error::Usage(
+                    "scene has one file: give its units and scale with --units-a and --scale-a".into(),
+                ));
+            }
+            UnitsConfig {
+                report: self.units.or(self.units_a),
+                inputs: [None, self.units_a],
+                scale: [None, scale[0]],
+            }
+        } else {
+            UnitsConfig {
+                report: self.units.or(self.units_a).or(self.units_b),
+                inputs: [self.units_a, self.units_b],
+                scale,
+            }
+        };
         Ok(Config {
             inputs: [
                 InputSpec {
@@ -357,6 +563,9 @@ impl Args {
                 exclude: self.exclude.clone(),
             },
             outputs: self.outputs.into_options(self.fail_on == FailOnArg::New)?,
+            units,
+            split_bodies: self.split_bodies,
+            penetration: self.penetration,
         })
     }
 }
@@ -390,16 +599,67 @@ pub fn run_with_progress(cfg: &Config, progress: &(dyn Fn(Phase) + Sync)) -> Res
 }
 
 fn run_in_pool(cfg: &Config, threads: usize, progress: &(dyn Fn(Phase) + Sync)) -> Result<Outcome> {
+    let rep = check_in_pool(cfg, threads, progress)?;
+    let json = report::to_json(&rep);
+    let warnings = rep.warnings.clone();
+    if let Some(path) = &cfg.output {
+        report::write_atomic(path, json.as_bytes())?;
+    }
+    let stdout = crate::output::stdout_for(&cfg.outputs, &rep, &json, cfg.output.is_some());
+    let exit_code = rep.failed as u8;
+    Ok(Outcome { stdout, warnings, exit_code, report: Box::new(rep) })
+}
+
+/// Load one input: exactly [`query::load_input`] when no units or scale flag was given; else
+/// load, multiply the coordinates by the input's multiplier ([`crate::mesh::Mesh::scale`]),
+/// then apply the placement and check the range, as `load_input` does. `i` indexes
+/// `cfg.inputs`; `flag` is the units flag that declares this input's units.
+fn load_with_units(
+    cfg: &Config,
+    i: usize,
+    flag: &str,
+) -> Result<(query::Input, Option<report::InputUnitsReport>)> {
+    let spec = &cfg.inputs[i];
+    if !cfg.units.active() {
+        return Ok((query::load_input(spec)?, None));
+    }
+    let (loaded, format) = crate::load::load_path(&spec.path)?;
+    let (multiplier, block, warning) = cfg.units.resolve(i, format, flag);
+    let mut mesh = loaded.mesh;
+    let mut warnings = loaded.warnings;
+    warnings.extend(warning);
+    mesh.scale(multiplier);
+    if spec.transform != DMat4::IDENTITY {
+        query::place(&mut mesh, &spec.transform, &spec.path)?;
+    }
+    warnings.extend(query::check_range(&mesh, &spec.path)?);
+    Ok((query::Input { path: spec.path.clone(), format, mesh, warnings }, Some(block)))
+}
+
+/// Check one configuration and return the finished report (with finding ids, the baseline
+/// comparison, and the JUnit and GLB files of `cfg.outputs` written), without writing the report
+/// itself: the single command and every check of a clash set go through here.
+pub fn check_in_pool(
+    cfg: &Config,
+    threads: usize,
+    progress: &(dyn Fn(Phase) + Sync),
+) -> Result<report::Report> {
     progress(Phase::Load);
     let t0 = Instant::now();
-    let (a, b) = if cfg.selection.scene {
+    let (mut a, mut b, units) = if cfg.selection.scene {
         // `meshclash scene FILE`: one file, its parts against each other.
-        let a = query::load_input(&cfg.inputs[1])?;
-        (a.clone(), a)
+        let (a, u) = load_with_units(cfg, 1, "--units-a")?;
+        (a.clone(), a, [u.clone(), u])
     } else {
-        let (a, b) = rayon::join(|| query::load_input(&cfg.inputs[0]), || query::load_input(&cfg.inputs[1]));
-        (a?, b?)
+        let (a, b) =
+            rayon::join(|| load_with_units(cfg, 0, "--units-a"), || load_with_units(cfg, 1, "--units-b"));
+        let ((a, ua), (b, ub)) = (a?, b?);
+        (a, b, [ua, ub])
     };
+    if cfg.split_bodies {
+        crate::bodies::split_bodies(&mut a.mesh);
+        crate::bodies::split_bodies(&mut b.mesh);
+    }
     let load_ms = t0.elapsed().as_secs_f64() * 1e3;
     let size = crate::geom::Aabb::of_points(&a.mesh.positions)
         .union(crate::geom::Aabb::of_points(&b.mesh.positions))
@@ -434,11 +694,12 @@ fn run_in_pool(cfg: &Config, threads: usize, progress: &(dyn Fn(Phase) + Sync)) 
             touch_tolerance_given: cfg.touch.spec(),
             clearance_given: cfg.clearance.spec(),
             model_size: size,
-            units: "model".into(),
+            units: cfg.units.report_name().into(),
             fail_on: cfg.fail_on.name().into(),
             bvh: cfg.settings.bvh.strategy.name().into(),
             mode: cfg.settings.mode.name().into(),
             first_hit: cfg.settings.first_hit,
+            penetration: cfg.penetration,
             distance_rel_err: cfg.settings.distance_error.rel,
             distance_abs_err: cfg.settings.distance_error.abs,
             leaf_size: cfg.settings.bvh.leaf_size,
@@ -451,14 +712,10 @@ fn run_in_pool(cfg: &Config, threads: usize, progress: &(dyn Fn(Phase) + Sync)) 
         assembly,
     };
     let mut rep = report::build(&ctx, &result);
+    let [ua, ub] = units;
+    rep.inputs.a.units = ua;
+    rep.inputs.b.units = ub;
     progress(Phase::Write);
     crate::output::finish(&cfg.outputs, &mut rep, &result, [&a.mesh, &b.mesh])?;
-    let json = report::to_json(&rep);
-    let warnings = rep.warnings.clone();
-    if let Some(path) = &cfg.output {
-        report::write_atomic(path, json.as_bytes())?;
-    }
-    let stdout = crate::output::stdout_for(&cfg.outputs, &rep, &json, cfg.output.is_some());
-    let exit_code = rep.failed as u8;
-    Ok(Outcome { stdout, warnings, exit_code, report: Box::new(rep) })
+    Ok(rep)
 }

@@ -15,7 +15,9 @@
 
 pub mod assembly;
 pub mod bench;
+pub mod bodies;
 pub mod bvh;
+pub mod clash_set;
 pub mod cli;
 pub mod containment;
 pub mod cross_check;

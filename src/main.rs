@@ -22,10 +22,14 @@ fn main() -> ExitCode {
             return ExitCode::SUCCESS;
         }
     };
+    if let Some(cli::Command::ClashSet(set)) = args.command {
+        return clash_set(set);
+    }
     if let Some(cmd) = &args.command {
         // `schema`, `completions <shell>`, `man`: generated text on stdout; `bench`: its tables.
         let text = match cmd {
             cli::Command::Output(c) => c.render(),
+            cli::Command::ClashSet(_) => unreachable!("handled above"),
             cli::Command::Bench(b) => match meshclash::bench::run_command(b) {
                 Ok(t) => t,
                 Err(e) => {
@@ -83,5 +87,62 @@ fn main() -> ExitCode {
             eprintln!("meshclash: error: {e}");
             ExitCode::from(e.exit_code())
         }
+    }
+}
+
+/// `meshclash clash-set FILE`: like the main job, with one document for all checks.
+fn clash_set(set: meshclash::clash_set::ClashSetArgs) -> ExitCode {
+    use meshclash::clash_set;
+    if let Some(kind) = set.schema {
+        return print_stdout(&clash_set::schema_json(kind));
+    }
+    let quiet = set.quiet;
+    let (stdout_tty, stderr_tty) = (std::io::stdout().is_terminal(), std::io::stderr().is_terminal());
+    let spinner = (stderr_tty && !quiet)
+        .then(|| Spinner::start(indicatif::ProgressDrawTarget::stderr(), progress::DEFAULT_DELAY));
+    let on_phase = |p| {
+        if let Some(s) = &spinner {
+            s.phase(p);
+        }
+    };
+    let outcome = clash_set::run_with_progress(&set, &on_phase);
+    if let Some(s) = spinner {
+        s.finish();
+    }
+    match outcome {
+        Ok(out) => {
+            if !quiet {
+                for w in &out.warnings {
+                    eprintln!("meshclash: warning: {w}");
+                }
+            }
+            let text_on_tty = set.format == Some(clash_set::SetFormat::Text) && stdout_tty;
+            if stderr_tty && !quiet && !text_on_tty {
+                eprint!("{}", clash_set::summary(&out.report));
+            }
+            if let Some(text) = out.stdout {
+                let code = print_stdout(&text);
+                if code != ExitCode::SUCCESS {
+                    return code;
+                }
+            }
+            ExitCode::from(out.exit_code)
+        }
+        Err(e) => {
+            eprintln!("meshclash: error: {e}");
+            ExitCode::from(e.exit_code())
+        }
+    }
+}
+
+/// Write `text` to stdout; a closed pipe is not an error, any other failure is exit 2.
+fn print_stdout(text: &str) -> ExitCode {
+    let mut so = std::io::stdout().lock();
+    match so.write_all(text.as_bytes()).and_then(|_| so.flush()) {
+        Err(e) if e.kind() != std::io::ErrorKind::BrokenPipe => {
+            eprintln!("meshclash: error: cannot write to stdout: {e}");
+            ExitCode::from(2)
+        }
+        _ => ExitCode::SUCCESS,
     }
 }

@@ -19,6 +19,93 @@ pub struct Mesh {
     pub objects: Vec<Object>,
 }
 
+impl Mesh {
+    /// Multiply every coordinate by `factor` in f64, each product rounded once (a unit
+    /// conversion or `--scale`). A power-of-two factor is exact (unless a product over- or
+    /// underflows); any other factor rounds each coordinate to the nearest f64 of the exact
+    /// product. `objects[*].world` keeps the loader's matrix (the scale is applied after it).
+    /// The caller checks the result's range (an overflow gives infinite coordinates).
+    pub fn scale(&mut self, factor: f64) {
+        if factor == 1.0 {
+            return;
+        }
+        for p in &mut self.positions {
+            *p *= factor;
+        }
+    }
+
+    /// The sub-mesh of the given triangles (in that order), re-indexed: only the vertices they
+    /// use, in order of first use; every triangle assigned to object 0, a copy of the object of
+    /// the first triangle (`objects` is empty when `tris` is).
+    pub fn sub_mesh(&self, tris: &[u32]) -> Mesh {
+        let mut remap: std::collections::HashMap<u32, u32> = std::collections::HashMap::new();
+        let mut positions = Vec::new();
+        let triangles: Vec<[u32; 3]> = tris
+            .iter()
+            .map(|&t| {
+                self.triangles[t as usize].map(|v| {
+                    *remap.entry(v).or_insert_with(|| {
+                        positions.push(self.positions[v as usize]);
+                        (positions.len() - 1) as u32
+                    })
+                })
+            })
+            .collect();
+        let objects = tris.first().map(|&t| self.objects[self.tri_object[t as usize] as usize].clone());
+        Mesh {
+            positions,
+            tri_object: vec![0; triangles.len()],
+            triangles,
+            objects: objects.into_iter().collect(),
+        }
+    }
+}
+
+/// Read access to a triangle mesh in world coordinates: a whole [`Mesh`], or a view of one part
+/// of one (`crate::assembly`) that borrows the loaded coordinates instead of copying them.
+/// Vertices are numbered `0..vertex_count()` and triangles `0..triangle_count()`.
+pub trait TriMesh: Sync {
+    /// Number of vertices.
+    fn vertex_count(&self) -> usize;
+    /// Vertex `v`.
+    fn vertex(&self, v: u32) -> DVec3;
+    /// Number of triangles.
+    fn triangle_count(&self) -> usize;
+    /// The vertex indices of triangle `t`.
+    fn indices(&self, t: u32) -> [u32; 3];
+    /// Triangle `t` as three points.
+    #[inline]
+    fn triangle(&self, t: u32) -> [DVec3; 3] {
+        self.indices(t).map(|v| self.vertex(v))
+    }
+    /// All vertices in order (borrowed when they are stored contiguously).
+    fn positions(&self) -> std::borrow::Cow<'_, [DVec3]> {
+        (0..self.vertex_count() as u32).map(|v| self.vertex(v)).collect::<Vec<_>>().into()
+    }
+}
+
+impl TriMesh for Mesh {
+    #[inline]
+    fn vertex_count(&self) -> usize {
+        self.positions.len()
+    }
+    #[inline]
+    fn vertex(&self, v: u32) -> DVec3 {
+        self.positions[v as usize]
+    }
+    #[inline]
+    fn triangle_count(&self) -> usize {
+        self.triangles.len()
+    }
+    #[inline]
+    fn indices(&self, t: u32) -> [u32; 3] {
+        self.triangles[t as usize]
+    }
+    fn positions(&self) -> std::borrow::Cow<'_, [DVec3]> {
+        std::borrow::Cow::Borrowed(&self.positions)
+    }
+}
+
 /// One object of a file: an OBJ `o`/`g` group, an STL `solid`, or a glTF mesh instance
 /// (node × mesh).
 #[derive(Debug, Clone, Default, PartialEq)]
@@ -40,4 +127,40 @@ pub struct Loaded {
     pub mesh: Mesh,
     /// Human-readable warnings, one line each.
     pub warnings: Vec<String>,
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn tri() -> Mesh {
+        Mesh {
+            positions: vec![
+                DVec3::new(1.0, -2.0, 0.1),
+                DVec3::new(3.0, 0.0, -0.0),
+                DVec3::new(0.3, 5.0, 7.0),
+            ],
+            triangles: vec![[0, 1, 2]],
+            tri_object: vec![0],
+            objects: vec![Object { name: "o".into(), ..Object::default() }],
+        }
+    }
+
+    #[test]
+    fn scale_multiplies_each_coordinate_once() {
+        let mut m = tri();
+        m.scale(0.25);
+        assert_eq!(m.positions[0], DVec3::new(0.25, -0.5, 0.025));
+        assert_eq!(m.positions[2], DVec3::new(0.075, 1.25, 1.75));
+        // Not a power of two: each coordinate is the rounded product, nothing else changes.
+        let mut m = tri();
+        m.scale(25.4);
+        assert_eq!(m.positions[0].z, 0.1 * 25.4);
+        assert_eq!(m.positions[2].x, 0.3 * 25.4);
+        assert_eq!((m.triangles.clone(), m.tri_object.clone()), (tri().triangles, tri().tri_object));
+        let mut m = tri();
+        m.scale(1.0);
+        assert_eq!(m, tri());
+        assert!(m.positions[1].z.is_sign_negative());
+    }
 }

@@ -14,7 +14,9 @@
 //!   "inputs": {
 //!     "a": {"path", "format": "obj|stl|gltf|glb", "vertices", "triangles", "degenerate_triangles", "closed",
 //!           "objects": [{"name", "triangles"}], "bounds": {"min": [x,y,z], "max": [x,y,z]},
-//!           "transform": [16 numbers, row-major] | null},
+//!           "transform": [16 numbers, row-major] | null,
+//!           "units"?: {"units": "mm" | null, "source": "given|gltf|assumed" | null, "factor",
+//!                      "scale", "multiplier"}},   // only with --units/--units-a/-b/--scale-a/-b
 //!     "b": { ...same... }
 //!   },
 //!   "settings": {"touch_tolerance", "clearance", "touch_tolerance_given", "clearance_given",
@@ -34,7 +36,8 @@
 //!   "pairs_truncated": bool,
 //!   "bvh": {"a": {"nodes", "leaves", "depth", "sah_cost", "bytes"}, "b": {...}},
 //!   "assembly": {"mode": "files|parts", "selected": [a, b], "candidate_part_pairs",
-//!                "built_parts": n | null, "sah_builds": n | null},
+//!                "built_parts": n | null, "sah_builds": n | null,
+//!                "shared_trees"?: n, "memory_saved_bytes"?: n},
 //!   "parts": [{"input": "a|b", "object", "name", "triangles", "bounds"}],
 //!   "part_pairs": [{"a", "b", "a_name", "b_name", "verdict", "crossing_pairs", "touching_pairs",
 //!                   "clearance_pairs", "min_distance": number | null, "contained": string | null}],
@@ -107,6 +110,23 @@ pub struct Report {
     pub baseline: Option<crate::output::baseline::BaselineReport>,
 }
 
+/// How deep one part reaches into the other at a region.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, schemars::JsonSchema)]
+#[serde(deny_unknown_fields)]
+pub struct PenetrationReport {
+    /// Largest distance from a sampled point of one part's surface (vertices near the region,
+    /// the region's triangles' centroids and edge midpoints), inside the other (closed) part,
+    /// to the other's surface: a lower bound on the local interpenetration; 0 when none is.
+    pub depth: f64,
+    /// That point (the region's centre when `depth` is 0).
+    pub point: [f64; 3],
+    /// `a_in_b` (a point of A's surface inside B) or `b_in_a`.
+    pub side: String,
+    /// Points found inside the other part and measured (sampled: at most about 8192 per
+    /// region and side).
+    pub samples: usize,
+}
+
 /// A clash region (v2), see [`crate::regions`].
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize, schemars::JsonSchema)]
 #[serde(deny_unknown_fields)]
@@ -131,6 +151,10 @@ pub struct RegionReport {
     pub bounds: Bounds,
     /// Diagonal of that box (size of the interference; not a penetration depth).
     pub extent: f64,
+    /// Penetration estimate (with `--penetration`; null otherwise, or when neither part is
+    /// closed): see [`crate::regions::estimate_penetration`].
+    #[serde(default)]
+    pub penetration: Option<PenetrationReport>,
 }
 
 /// The `assembly` block (v2).
@@ -149,6 +173,14 @@ pub struct AssemblyReport {
     pub built_parts: Option<usize>,
     /// Distinct SAH builds: instances of one glTF mesh share one (parts mode only).
     pub sah_builds: Option<usize>,
+    /// Trees walked by more than one part: an instance walks its mesh's shared tree through
+    /// the relative transform instead of a copy (parts mode only; absent otherwise).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub shared_trees: Option<usize>,
+    /// Bytes not allocated compared with copying every checked part (positions, triangles, tree)
+    /// per instance (parts mode only; absent otherwise).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub memory_saved_bytes: Option<u64>,
 }
 
 /// A part (v2): an OBJ `o`/`g`, an STL `solid`, or a glTF mesh instance.
@@ -229,6 +261,8 @@ pub fn assembly_view(o: &crate::assembly::Outcome) -> (AssemblyReport, Vec<PartR
         candidate_part_pairs: i.candidate_part_pairs,
         built_parts: i.built_parts,
         sah_builds: i.sah_builds,
+        shared_trees: i.sharing.map(|s| s.shared_trees),
+        memory_saved_bytes: i.sharing.map(|s| s.memory_saved_bytes as u64),
     };
     (a, parts, pairs)
 }
@@ -330,6 +364,30 @@ pub struct InputReport {
     pub bounds: Bounds,
     /// The placement applied, row-major 4×4, or null for none.
     pub transform: Option<Vec<f64>>,
+    /// With `--units`, `--units-a/-b` or `--scale-a/-b`: how this input was converted to the
+    /// report units; absent otherwise.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub units: Option<InputUnitsReport>,
+}
+
+/// How one input's coordinates were converted (`inputs.*.units`).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, schemars::JsonSchema)]
+#[serde(deny_unknown_fields)]
+pub struct InputUnitsReport {
+    /// The units the file's coordinates were taken to be in (`um`, `mm`, `cm`, `m`, `in`, `ft`,
+    /// `yd`), or null when the report has no units (only a `--scale` was given).
+    pub units: Option<String>,
+    /// Where `units` comes from: `given` (`--units-a`/`--units-b`), `gltf` (glTF is metres by
+    /// specification), `assumed` (OBJ and STL carry no units: taken to be the report units, and
+    /// a warning says so), or null with `units`.
+    pub source: Option<String>,
+    /// Unit conversion factor into the report units: the exact ratio rounded once to f64.
+    pub factor: f64,
+    /// The raw `--scale-a`/`--scale-b` multiplier (1 when not given).
+    pub scale: f64,
+    /// `factor × scale` rounded once: every coordinate was multiplied by this number (each
+    /// product rounded once) before `--transform`/`--translate`.
+    pub multiplier: f64,
 }
 
 /// An object (OBJ `o`/`g`, STL solid, glTF mesh instance).
@@ -366,7 +424,8 @@ pub struct SettingsReport {
     pub clearance_given: String,
     /// Diagonal of the box around both inputs (the base of relative tolerances).
     pub model_size: f64,
-    /// Units of every length in the report: "model" (the files' own units).
+    /// Units of every length in the report: "model" (the files' own units), or the `--units`
+    /// value (`um`, `mm`, `cm`, `m`, `in`, `ft`, `yd`) the inputs were converted to.
     pub units: String,
     /// `clash`, `touching`, `clearance` or `never`.
     pub fail_on: String,
@@ -376,6 +435,9 @@ pub struct SettingsReport {
     pub mode: String,
     /// Stopped at the first crossing pair: counts are lower bounds.
     pub first_hit: bool,
+    /// `--penetration`: regions carry a penetration estimate.
+    #[serde(default)]
+    pub penetration: bool,
     /// Allowed relative error of `min_distance`.
     pub distance_rel_err: f64,
     /// Allowed absolute error of `min_distance`.
@@ -536,6 +598,7 @@ fn input_report(input: &Input, m: &DMat4, info: &crate::query::MeshInfo, closed:
         objects: info.objects.iter().map(|(n, t)| ObjectReport { name: n.clone(), triangles: *t }).collect(),
         bounds: Bounds { min: v3(min), max: v3(max) },
         transform: (*m != DMat4::IDENTITY).then(|| m.transpose().to_cols_array().to_vec()),
+        units: None,
     }
 }
 
@@ -607,8 +670,15 @@ pub fn build(ctx: &Context, r: &ClashResult) -> Report {
         assembly: ctx.assembly.0.clone(),
         parts: ctx.assembly.1.clone(),
         part_pairs: ctx.assembly.2.clone(),
-        regions: crate::regions::regions(&r.pairs, &ia.mesh, &ib.mesh)
-            .into_iter()
+        regions: {
+            let mut regs = crate::regions::regions(&r.pairs, &ia.mesh, &ib.mesh);
+            if ctx.settings.penetration && !ctx.settings.first_hit {
+                let opts = crate::bvh::BuildOptions::default();
+                crate::regions::estimate_penetration(&mut regs, &r.pairs, &ia.mesh, &ib.mesh, opts);
+            }
+            regs
+        }
+        .into_iter()
             .map(|g| RegionReport {
                 a_name: ia.mesh.objects[g.objects.0 as usize].name.clone(),
                 b_name: ib.mesh.objects[g.objects.1 as usize].name.clone(),
@@ -620,6 +690,12 @@ pub fn build(ctx: &Context, r: &ClashResult) -> Report {
                 center: v3(g.center),
                 bounds: Bounds { min: v3(g.bounds.min), max: v3(g.bounds.max) },
                 extent: g.extent,
+                penetration: g.penetration.map(|p| PenetrationReport {
+                    depth: p.depth,
+                    point: v3(p.point),
+                    side: if p.side == 0 { "a_in_b" } else { "b_in_a" }.to_string(),
+                    samples: p.samples,
+                }),
             })
             .collect(),
         warnings,

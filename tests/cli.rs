@@ -394,3 +394,167 @@ fn two_files_report_part_pairs_by_object() {
     assert_eq!(pairs.len(), 2);
     assert!(pairs.iter().all(|(a, b)| a == b));
 }
+
+// ---- Units and scale (`--units`, `--units-a/-b`, `--scale-a/-b`) ----
+
+fn run_json(args: &[&str]) -> (Option<i32>, Report, String) {
+    let out = bin().args(args).output().unwrap();
+    let err = String::from_utf8(out.stderr).unwrap();
+    assert!(matches!(out.status.code(), Some(0 | 1)), "{args:?}: {err}");
+    (out.status.code(), parse(&out.stdout), err)
+}
+
+fn halved(p: [f64; 3]) -> [f64; 3] {
+    p.map(|c| c * 0.5)
+}
+
+#[test]
+fn a_power_of_two_scale_scales_every_length_exactly() {
+    // Halving every coordinate (and the translation, which is in the scaled units) is exact in
+    // binary floating point, and every operation of the check commutes with it: verdicts and
+    // pair sets are identical, and every length is exactly half.
+    let (a, b) = (shipped("fcl_env.obj"), shipped("fcl_rob.obj"));
+    for (tb, tb_half) in [("0,0,0", "0,0,0"), ("0,0,300", "0,0,150")] {
+        let (code, r, _) =
+            run_json(&[&a, &b, "-q", "--no-timings", "--clearance", "40", "--translate-b", tb]);
+        let (code2, h, _) = run_json(&[
+            &a,
+            &b,
+            "-q",
+            "--no-timings",
+            "--clearance",
+            "20",
+            "--translate-b",
+            tb_half,
+            "--scale-a",
+            "0.5",
+            "--scale-b",
+            "0.5",
+        ]);
+        assert_eq!(code, code2);
+        assert_eq!(h.settings.units, "model");
+        let u = h.inputs.a.units.as_ref().expect("scale recorded");
+        assert_eq!(
+            (u.units.as_deref(), u.source.as_deref(), u.factor, u.scale, u.multiplier),
+            (None, None, 1.0, 0.5, 0.5)
+        );
+        assert_eq!(h.verdict, r.verdict);
+        assert_eq!(h.summary.crossing_pairs, r.summary.crossing_pairs);
+        assert_eq!(h.summary.clearance_pairs, r.summary.clearance_pairs);
+        assert_eq!(h.summary.min_distance, r.summary.min_distance.map(|d| d * 0.5));
+        assert_eq!(h.inputs.b.bounds.min, halved(r.inputs.b.bounds.min));
+        assert_eq!(h.inputs.a.bounds.max, halved(r.inputs.a.bounds.max));
+        let (c, ch) = (r.closest.unwrap(), h.closest.unwrap());
+        assert_eq!(ch.a.point, halved(c.a.point));
+        assert_eq!(ch.b.point, halved(c.b.point));
+        assert_eq!(r.pairs.len(), h.pairs.len());
+        assert!(!r.pairs.is_empty());
+        for (p, q) in r.pairs.iter().zip(&h.pairs) {
+            assert_eq!((p.a, p.b, &p.kind, &p.contact), (q.a, q.b, &q.kind, &q.contact));
+            assert_eq!(q.distance, p.distance * 0.5);
+            assert_eq!(q.segment, p.segment.map(|[s, t]| [halved(s), halved(t)]));
+        }
+    }
+}
+
+#[test]
+fn metres_to_millimetres_on_a_known_pair() {
+    // Two unit cubes (metres) 2 m apart along x: 2000 mm apart; integer coordinates times 1000
+    // are exact, so the distance is exactly 2000. --translate-b is in report units (mm):
+    // moving B by -1000 mm leaves 1000 mm, and moving by -1000 m would have crossed.
+    let dir = tempfile::tempdir().unwrap();
+    let a = cube_obj(dir.path(), "a.obj", [0.0; 3], [1.0; 3]);
+    let b = cube_obj(dir.path(), "b.obj", [3.0, 0.0, 0.0], [4.0, 1.0, 1.0]);
+    let (code, plain, _) = run_json(&[&a, &b, "--no-timings"]);
+    assert_eq!(code, Some(0));
+    assert_eq!(plain.summary.min_distance, Some(2.0));
+    assert!(plain.inputs.a.units.is_none() && plain.inputs.b.units.is_none());
+    assert_eq!(plain.settings.units, "model");
+    let (_, mm, err) =
+        run_json(&[&a, &b, "--no-timings", "--units", "mm", "--units-a", "m", "--units-b", "m"]);
+    assert_eq!(mm.settings.units, "mm");
+    assert_eq!(mm.summary.min_distance, Some(2000.0));
+    assert_eq!(mm.inputs.b.bounds.max, [4000.0, 1000.0, 1000.0]);
+    let u = mm.inputs.a.units.as_ref().unwrap();
+    assert_eq!(
+        (u.units.as_deref(), u.source.as_deref(), u.factor, u.scale, u.multiplier),
+        (Some("m"), Some("given"), 1000.0, 1.0, 1000.0)
+    );
+    assert!(mm.warnings.is_empty(), "{:?}", mm.warnings);
+    assert!(!err.contains("warning"), "{err}");
+    let (_, moved, _) = run_json(&[
+        &a,
+        &b,
+        "-q",
+        "--no-timings",
+        "--units",
+        "mm",
+        "--units-a",
+        "m",
+        "--units-b",
+        "m",
+        "--translate-b",
+        "-1000,0,0",
+    ]);
+    assert_eq!(moved.summary.min_distance, Some(1000.0));
+    // --units defaults to --units-a: the same run without --units.
+    let (_, dflt, _) = run_json(&[&a, &b, "-q", "--no-timings", "--units-a", "m", "--units-b", "m"]);
+    assert_eq!(dflt.settings.units, "m");
+    assert_eq!(dflt.summary.min_distance, Some(2.0));
+    // Inches to millimetres: 25.4 exactly per inch; a 2-inch gap is 50.8 mm (the nearest f64).
+    let (_, inch, _) =
+        run_json(&[&a, &b, "-q", "--no-timings", "--units", "mm", "--units-a", "in", "--units-b", "in"]);
+    assert_eq!(inch.inputs.a.units.as_ref().unwrap().factor, 25.4);
+    let d = inch.summary.min_distance.unwrap();
+    assert!((d - 50.8).abs() <= 4.0 * f64::EPSILON * 101.6, "{d}");
+}
+
+#[test]
+fn unknown_units_are_assumed_and_gltf_is_metres() {
+    let (obj, glb) = (shipped("fcl_rob.obj"), shipped("pins.glb"));
+    let (_, plain, _) = run_json(&[&obj, &glb, "-q", "--no-timings", "--fail-on", "never"]);
+    let (_, mm, err) = run_json(&[&obj, &glb, "--no-timings", "--fail-on", "never", "--units", "mm"]);
+    let (ua, ub) = (mm.inputs.a.units.as_ref().unwrap(), mm.inputs.b.units.as_ref().unwrap());
+    assert_eq!(
+        (ua.units.as_deref(), ua.source.as_deref(), ua.multiplier),
+        (Some("mm"), Some("assumed"), 1.0)
+    );
+    assert_eq!((ub.units.as_deref(), ub.source.as_deref(), ub.multiplier), (Some("m"), Some("gltf"), 1000.0));
+    // The assumption is a warning, in the report and on stderr, naming the file and the flag.
+    let w: Vec<&String> = mm.warnings.iter().filter(|w| w.contains("units unknown")).collect();
+    assert_eq!(w.len(), 1, "{:?}", mm.warnings);
+    assert!(w[0].contains("fcl_rob.obj") && w[0].contains("--units-a") && w[0].contains("mm"), "{}", w[0]);
+    assert!(err.contains("units unknown"), "{err}");
+    // Unchanged A; B's coordinates each multiplied by 1000 and rounded once, so the bounds
+    // (min/max, which rounding preserves) are the plain ones times 1000.
+    assert_eq!(mm.inputs.a.bounds, plain.inputs.a.bounds);
+    assert_eq!(mm.inputs.b.bounds.min, plain.inputs.b.bounds.min.map(|c| c * 1000.0));
+    assert_eq!(mm.inputs.b.bounds.max, plain.inputs.b.bounds.max.map(|c| c * 1000.0));
+    // Scene mode: --units-a is the file's.
+    let (_, scene, _) = run_json(&["scene", &glb, "-q", "--no-timings", "--units", "mm", "--units-a", "cm"]);
+    assert_eq!(scene.settings.units, "mm");
+    for u in [&scene.inputs.a.units, &scene.inputs.b.units] {
+        let u = u.as_ref().unwrap();
+        assert_eq!((u.units.as_deref(), u.source.as_deref(), u.factor), (Some("cm"), Some("given"), 10.0));
+    }
+    assert_eq!(scene.inputs.a.bounds.min, plain.inputs.b.bounds.min.map(|c| c * 10.0));
+}
+
+#[test]
+fn bad_units_and_scales_exit_2() {
+    let ok = shipped("fcl_rob.obj");
+    assert!(error_line(&[&ok, &ok, "--units", "furlong"]).contains("--units"));
+    assert!(error_line(&[&ok, &ok, "--units-b", "MM"]).contains("--units-b"));
+    for bad in ["0", "-2", "nan", "inf", "-0"] {
+        assert!(
+            error_line(&[&ok, &ok, "--scale-a", bad]).contains("--scale-a must be a finite number > 0"),
+            "{bad}"
+        );
+    }
+    assert!(error_line(&[&ok, &ok, "--scale-b", "1e400"]).contains("--scale-b"));
+    let scene = error_line(&["scene", &shipped("pins.glb"), "--units-b", "mm"]);
+    assert!(scene.contains("--units-a"), "{scene}");
+    // A scale that overflows the coordinates is bad input naming the file.
+    let big = error_line(&[&ok, &ok, "--scale-a", "1e300"]);
+    assert!(big.contains("fcl_rob.obj") && big.contains("2^250"), "{big}");
+}

@@ -110,6 +110,40 @@ pub fn pair_line(r: &Report, p: &PairReport) -> String {
     s
 }
 
+/// A length with the report's unit (`12.5 mm`), or bare in model units.
+fn with_units(r: &Report, x: f64) -> String {
+    match r.settings.units.as_str() {
+        "model" => num(x),
+        u => format!("{} {u}", num(x)),
+    }
+}
+
+/// `units: mm (A: m given, x1000; B: mm assumed)`, when units or a scale were given.
+fn units_line(r: &Report) -> Option<String> {
+    let (ua, ub) = (r.inputs.a.units.as_ref(), r.inputs.b.units.as_ref());
+    if ua.is_none() && ub.is_none() {
+        return None;
+    }
+    let side = |name: &str, u: Option<&crate::report::InputUnitsReport>| {
+        let Some(u) = u else { return format!("{name}: as given") };
+        let mut t = format!("{name}:");
+        if let (Some(unit), Some(src)) = (&u.units, &u.source) {
+            let _ = write!(t, " {unit} {src}");
+        }
+        if u.scale != 1.0 {
+            let _ = write!(t, " scale {}", num(u.scale));
+        }
+        if u.multiplier != 1.0 {
+            let _ = write!(t, ", x{}", num(u.multiplier));
+        }
+        if t.len() == name.len() + 1 {
+            t.push_str(" as given");
+        }
+        t
+    };
+    Some(format!("units: {} ({}; {})", r.settings.units, side("A", ua), side("B", ub)))
+}
+
 /// The summary, several lines ending in a newline; coloured with ANSI escapes if `color`.
 pub fn render(r: &Report, color: bool) -> String {
     let c = Paint(color);
@@ -139,6 +173,9 @@ pub fn render(r: &Report, color: bool) -> String {
             if i.closed { ", closed" } else { "" }
         );
     }
+    if let Some(line) = units_line(r) {
+        let _ = writeln!(s, "  {line}");
+    }
     let m = &r.summary;
     let _ = writeln!(
         s,
@@ -154,7 +191,7 @@ pub fn render(r: &Report, color: bool) -> String {
             let _ = writeln!(
                 s,
                 "  closest: {} between A#{} ({}) at {} and B#{} ({}) at {}",
-                c.p(BOLD, &num(cl.distance)),
+                c.p(BOLD, &with_units(r, cl.distance)),
                 cl.a.triangle,
                 object(r, 'a', cl.a.object),
                 point(&cl.a.point),
