@@ -611,9 +611,8 @@ fn run_in_pool(cfg: &Config, threads: usize, progress: &(dyn Fn(Phase) + Sync)) 
 }
 
 /// Load one input: exactly [`query::load_input`] when no units or scale flag was given; else
-/// load, multiply the coordinates by the input's multiplier ([`crate::mesh::Mesh::scale`]),
-/// then apply the placement and check the range, as `load_input` does. `i` indexes
-/// `cfg.inputs`; `flag` is the units flag that declares this input's units.
+/// [`query::prepare_input`] with the input's multiplier. `i` indexes `cfg.inputs`; `flag` is the
+/// units flag that declares this input's units.
 fn load_with_units(
     cfg: &Config,
     i: usize,
@@ -625,15 +624,7 @@ fn load_with_units(
     }
     let (loaded, format) = crate::load::load_path(&spec.path)?;
     let (multiplier, block, warning) = cfg.units.resolve(i, format, flag);
-    let mut mesh = loaded.mesh;
-    let mut warnings = loaded.warnings;
-    warnings.extend(warning);
-    mesh.scale(multiplier);
-    if spec.transform != DMat4::IDENTITY {
-        query::place(&mut mesh, &spec.transform, &spec.path)?;
-    }
-    warnings.extend(query::check_range(&mesh, &spec.path)?);
-    Ok((query::Input { path: spec.path.clone(), format, mesh, warnings }, Some(block)))
+    Ok((query::prepare_input(spec, loaded, format, multiplier, warning)?, Some(block)))
 }
 
 /// Check one configuration and return the finished report (with finding ids, the baseline

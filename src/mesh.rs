@@ -115,7 +115,8 @@ pub struct Object {
     pub name: String,
     /// glTF only: the index of the glTF mesh this instance draws (instances of one mesh share it).
     pub gltf_mesh: Option<u32>,
-    /// glTF only: the node's world matrix (column-major, as glam stores it) that was applied.
+    /// glTF only: the world matrix (column-major, as glam stores it) that was applied: the
+    /// node's, or for an `EXT_mesh_gpu_instancing` instance the node's times the instance's.
     pub world: Option<glam::DMat4>,
 }
 

@@ -91,8 +91,23 @@ pub struct Input {
 /// Load `spec.path` and apply `spec.transform`.
 pub fn load_input(spec: &InputSpec) -> Result<Input> {
     let (loaded, format) = load::load_path(&spec.path)?;
+    prepare_input(spec, loaded, format, 1.0, None)
+}
+
+/// Turn a loaded file into an input: multiply its coordinates by `multiplier` (a unit
+/// conversion; 1 = none), apply the placement, check the range. `note` is a warning placed after
+/// the loader's (e.g. that the units were assumed).
+pub fn prepare_input(
+    spec: &InputSpec,
+    loaded: crate::mesh::Loaded,
+    format: load::Format,
+    multiplier: f64,
+    note: Option<String>,
+) -> Result<Input> {
     let mut mesh = loaded.mesh;
     let mut warnings = loaded.warnings;
+    warnings.extend(note);
+    mesh.scale(multiplier);
     if spec.transform != DMat4::IDENTITY {
         place(&mut mesh, &spec.transform, &spec.path)?;
     }
