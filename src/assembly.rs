@@ -673,6 +673,11 @@ pub struct PartPairSummary {
     pub min_distance: Option<f64>,
     /// Containment between the two parts.
     pub containment: Containment,
+    /// The witness of `min_distance`: triangles (input indices) and points, when known.
+    pub closest: Option<crate::query::Closest>,
+    /// The pair's triangle pairs (input triangle indices), sorted; the report lists a capped
+    /// number of them.
+    pub pairs: Vec<(u32, u32)>,
 }
 
 /// Facts about the assembly run.
@@ -779,6 +784,8 @@ pub fn run(a: &Mesh, b: &Mesh, sel: &Selection, settings: &Settings) -> Result<O
                 counts: r.counts,
                 min_distance: r.closest.map(|c| c.distance),
                 containment: r.containment.clone(),
+                closest: r.closest,
+                pairs: r.pairs.iter().map(|p| (p.a, p.b)).collect(),
             });
         }
     }
@@ -820,10 +827,17 @@ fn group_by_part(parts: &[Part], a: &Mesh, b: &Mesh, r: &ClashResult) -> Vec<Par
             counts: Default::default(),
             min_distance: None,
             containment: Containment::None,
+            closest: None,
+            pairs: Vec::new(),
         });
         let v = e.counts.record(p);
         e.verdict = e.verdict.max(v);
-        e.min_distance = Some(e.min_distance.map_or(p.distance, |d: f64| d.min(p.distance)));
+        e.pairs.push((p.a, p.b));
+        // Pairs come sorted by (a, b): the first of the smallest distance is the witness.
+        if e.closest.is_none_or(|c| p.distance < c.distance) {
+            e.closest = Some(crate::query::pair_witness(a, b, p));
+        }
+        e.min_distance = e.closest.map(|c| c.distance);
     }
     by.into_values().collect()
 }

@@ -665,7 +665,7 @@ pub fn check_in_pool(
     progress(Phase::Check);
     let outcome = crate::assembly::run(&a.mesh, &b.mesh, &cfg.selection, &settings)
         .map_err(|e| Error::input(&cfg.inputs[1].path, e))?;
-    let assembly = report::assembly_view(&outcome);
+    let assembly = report::assembly_view(&outcome, cfg.max_pairs);
     let result = outcome.result;
     let failed = cfg.fail_on.fails(result.verdict);
     let cross_check = if cfg.cross_check {

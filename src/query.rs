@@ -519,6 +519,15 @@ fn classify_pair(
     })
 }
 
+/// The closest points a listed pair shows: a shared point for an exact contact, else the two
+/// closest points its `segment` carries (tolerance and clearance pairs).
+pub fn pair_witness<A: TriMesh + ?Sized, B: TriMesh + ?Sized>(a: &A, b: &B, p: &PairFinding) -> Closest {
+    match (p.contact, p.segment) {
+        (None, Some([s, t])) => Closest { distance: p.distance, a: (p.a, s), b: (p.b, t) },
+        _ => contact_witness(a, b, p),
+    }
+}
+
 /// Witness for an exact contact: a shared point.
 fn contact_witness<A: TriMesh + ?Sized, B: TriMesh + ?Sized>(a: &A, b: &B, p: &PairFinding) -> Closest {
     let point = match p.segment {

@@ -223,10 +223,23 @@ pub struct PartPairReport {
     pub min_distance: Option<f64>,
     /// Containment between the two parts (a clash), or null.
     pub contained: Option<String>,
+    /// The witness of `min_distance` (triangles are input indices, objects those of the parts).
+    #[serde(default)]
+    pub closest: Option<ClosestReport>,
+    /// The part pair's triangle pairs as `[a, b]` input triangle indices, sorted by (a, b); at
+    /// most `settings.max_pairs` of them.
+    #[serde(default)]
+    pub pairs: Vec<[u32; 2]>,
+    /// More triangle pairs than listed (the counts stay complete).
+    #[serde(default)]
+    pub pairs_truncated: bool,
 }
 
 /// Build the v2 part view from an assembly outcome.
-pub fn assembly_view(o: &crate::assembly::Outcome) -> (AssemblyReport, Vec<PartReport>, Vec<PartPairReport>) {
+pub fn assembly_view(
+    o: &crate::assembly::Outcome,
+    max_pairs: usize,
+) -> (AssemblyReport, Vec<PartReport>, Vec<PartPairReport>) {
     let parts = o
         .parts
         .iter()
@@ -252,6 +265,16 @@ pub fn assembly_view(o: &crate::assembly::Outcome) -> (AssemblyReport, Vec<PartR
             clearance_pairs: pp.counts.clearance,
             min_distance: pp.min_distance,
             contained: pp.containment.name().map(str::to_string),
+            closest: pp.closest.map(|c| {
+                let (pa, pb) = (&o.parts[pp.a], &o.parts[pp.b]);
+                ClosestReport {
+                    distance: c.distance,
+                    a: Witness { triangle: c.a.0, object: pa.object, point: v3(c.a.1) },
+                    b: Witness { triangle: c.b.0, object: pb.object, point: v3(c.b.1) },
+                }
+            }),
+            pairs: pp.pairs.iter().take(max_pairs).map(|&(x, y)| [x, y]).collect(),
+            pairs_truncated: pp.pairs.len() > max_pairs,
         })
         .collect();
     let i = &o.info;
