@@ -18,7 +18,7 @@
 //! anything, or cross a proper triangle when a segment pierces its interior transversally.
 
 pub use crate::geom::predicates::Float;
-use crate::geom::predicates::{self as pr, Exact, Kernel, Sign};
+use crate::geom::predicates::{self as pr, Adaptive, Exact, Kernel, PlaneFilter, Sign};
 use crate::geom::DVec3;
 
 /// How two triangles meet.
@@ -102,13 +102,47 @@ impl Shape {
 }
 
 /// Classify the pair `(a, b)` exactly. `None` if they share no point.
+///
+/// Float-filtered: each triangle's f64 normal and its error-bound data are computed once
+/// ([`PlaneFilter`]); when they prove both triangles proper, the other triangle's vertices are
+/// placed against each plane by the filter, and only the signs it cannot prove are computed
+/// exactly. Every sign used is exact, so the answer is the one of [`classify_unfiltered`], bit
+/// for bit (points included).
 pub fn classify(a: &[DVec3; 3], b: &[DVec3; 3]) -> Option<Hit> {
+    let fb = PlaneFilter::new(b);
+    // A proper `b` with all of `a` strictly on one side of its plane: apart, whatever shape `a`
+    // has (a segment or point of `a` is then strictly on that side too).
+    if fb.proper() && apart(&fb, a) {
+        return None;
+    }
+    let fa = PlaneFilter::new(a);
+    if fa.proper() && fb.proper() {
+        // Both proven non-collinear: `Shape::of` would return `Tri` for both.
+        return Classifier::<Exact>::tri_tri_filtered(a, &fa, b, &fb);
+    }
     Classifier::<Exact>::classify_shapes(&Shape::of(a), &Shape::of(b))
+}
+
+/// True if the filter proves all of `pts` strictly on one side of its plane.
+#[inline]
+fn apart(f: &PlaneFilter, pts: &[DVec3; 3]) -> bool {
+    let s = pts.map(|p| f.side(p));
+    s == [Some(1); 3] || s == [Some(-1); 3]
 }
 
 /// As [`classify`], for already classified shapes.
 pub fn classify_shapes(a: &Shape, b: &Shape) -> Option<Hit> {
+    if let (Shape::Tri(a), Shape::Tri(b)) = (a, b) {
+        return Classifier::<Exact>::tri_tri_filtered(a, &PlaneFilter::new(a), b, &PlaneFilter::new(b));
+    }
     Classifier::<Exact>::classify_shapes(a, b)
+}
+
+/// [`classify`] without the float filters of [`crate::geom::predicates`]: every sign from
+/// Shewchuk's adaptive predicates, each decided on its own (the classifier as it was before
+/// the filters). The reference that tests and benchmarks compare [`classify`] with.
+pub fn classify_unfiltered(a: &[DVec3; 3], b: &[DVec3; 3]) -> Option<Hit> {
+    Classifier::<Adaptive>::classify_shapes(&Shape::of(a), &Shape::of(b))
 }
 
 /// As [`classify`], with the predicates of kernel `K`: [`Exact`] (the default everywhere), or
@@ -182,10 +216,11 @@ impl<K: Kernel> Classifier<K> {
         -o * sa.sigma * sb.sigma
     }
 
-    /// The f64 position of an end, for the report only.
-    fn end_point(t: &[DVec3; 3], d: &[f64; 3], e: End) -> DVec3 {
+    /// The f64 position of an end, for the report only. `d(i)`: the determinant value of
+    /// vertex `i` of `t` with respect to the other plane.
+    fn end_point(t: &[DVec3; 3], d: impl Fn(usize) -> f64, e: End) -> DVec3 {
         let (p, q) = (t[e.apex], t[e.other]);
-        let (dp, dq) = (d[e.apex], d[e.other]);
+        let (dp, dq) = (d(e.apex), d(e.other));
         if dq == 0.0 {
             return q;
         }
@@ -195,13 +230,48 @@ impl<K: Kernel> Classifier<K> {
 
     fn tri_tri(a: &[DVec3; 3], b: &[DVec3; 3]) -> Option<Hit> {
         let sa = a.map(|p| K::orient3d(b[0], b[1], b[2], p));
+        Self::tri_tri_from(a, b, sa, || b.map(|p| K::orient3d(a[0], a[1], a[2], p)))
+    }
+
+    /// [`Self::tri_tri`] with the plane sides from the float filters of both triangles: the
+    /// filter's sign where it proves one, the exact stages where it cannot.
+    fn tri_tri_filtered(a: &[DVec3; 3], fa: &PlaneFilter, b: &[DVec3; 3], fb: &PlaneFilter) -> Option<Hit> {
+        let sa = Self::sides(fb, b, a)?;
+        Self::tri_tri_from(a, b, sa, || Self::sides_all(fa, a, b))
+    }
+
+    /// Exact signs of `pts` against the plane of `t` (filter `f`), or `None` when all three are
+    /// proven strictly on one side (the pair is apart; nothing exact is computed).
+    #[inline]
+    fn sides(f: &PlaneFilter, t: &[DVec3; 3], pts: &[DVec3; 3]) -> Option<[Sign; 3]> {
+        let s = pts.map(|p| f.side(p));
+        if s == [Some(1); 3] || s == [Some(-1); 3] {
+            return None;
+        }
+        Some([0, 1, 2].map(|i| s[i].unwrap_or_else(|| pr::orient3d_undecided(t[0], t[1], t[2], pts[i]))))
+    }
+
+    /// As [`Self::sides`], always returning the signs.
+    #[inline]
+    fn sides_all(f: &PlaneFilter, t: &[DVec3; 3], pts: &[DVec3; 3]) -> [Sign; 3] {
+        pts.map(|p| f.side_exact(t, p))
+    }
+
+    /// The classification from `sa` (the exact sides of `a`'s vertices against `b`'s plane) and
+    /// `sb` (those of `b` against `a`'s plane, asked for only when needed).
+    fn tri_tri_from(
+        a: &[DVec3; 3],
+        b: &[DVec3; 3],
+        sa: [Sign; 3],
+        sb: impl FnOnce() -> [Sign; 3],
+    ) -> Option<Hit> {
         if sa.iter().all(|&s| s > 0) || sa.iter().all(|&s| s < 0) {
             return None;
         }
         if sa.iter().all(|&s| s == 0) {
             return Self::coplanar(a, b);
         }
-        let sb = b.map(|p| K::orient3d(a[0], a[1], a[2], p));
+        let sb = sb();
         if sb.iter().all(|&s| s > 0) || sb.iter().all(|&s| s < 0) {
             return None;
         }
@@ -214,14 +284,19 @@ impl<K: Kernel> Classifier<K> {
             return None;
         }
         let positive = lo_a_hi_b < 0 && hi_a_lo_b > 0 && !ia.single && !ib.single;
-        // The shared interval: max of the lows, min of the highs.
-        let da = a.map(|p| K::orient3d_value(b[0], b[1], b[2], p));
-        let db = b.map(|p| K::orient3d_value(a[0], a[1], a[2], p));
+        // The shared interval: max of the lows, min of the highs. The determinant values (for
+        // placing the ends) only of the vertices used, with their exact signs already known.
+        let da = |i: usize| K::orient3d_value_signed(b[0], b[1], b[2], a[i], sa[i]);
+        let db = |i: usize| K::orient3d_value_signed(a[0], a[1], a[2], b[i], sb[i]);
         let lo_cmp = Self::cmp_ends(a, &ia, ia.lo, b, &ib, ib.lo);
-        let lo = if lo_cmp >= 0 { Self::end_point(a, &da, ia.lo) } else { Self::end_point(b, &db, ib.lo) };
-        let hi_cmp = Self::cmp_ends(a, &ia, ia.hi, b, &ib, ib.hi);
-        let hi = if hi_cmp <= 0 { Self::end_point(a, &da, ia.hi) } else { Self::end_point(b, &db, ib.hi) };
-        let segment = Some(if positive { [lo, hi] } else { [lo, lo] });
+        let lo = if lo_cmp >= 0 { Self::end_point(a, da, ia.lo) } else { Self::end_point(b, db, ib.lo) };
+        let segment = Some(if positive {
+            let hi_cmp = Self::cmp_ends(a, &ia, ia.hi, b, &ib, ib.hi);
+            let hi = if hi_cmp <= 0 { Self::end_point(a, da, ia.hi) } else { Self::end_point(b, db, ib.hi) };
+            [lo, hi]
+        } else {
+            [lo, lo]
+        });
         Some(Hit {
             crossing: positive && ia.split && ib.split,
             contact: if positive { Contact::Segment } else { Contact::Point },
@@ -243,9 +318,14 @@ impl<K: Kernel> Classifier<K> {
         let (mut strict, mut weak) = (false, false);
         for i in 0..3 {
             let (e0, e1) = (t[i], t[(i + 1) % 3]);
-            let s: Vec<Sign> = pts.iter().map(|&p| K::orient2d(e0, e1, p, k)).collect();
-            strict |= s.iter().all(|&v| v < 0);
-            weak |= s.iter().all(|&v| v <= 0);
+            let (mut all_neg, mut all_nonpos) = (true, true);
+            for &p in pts {
+                let v = K::orient2d(e0, e1, p, k);
+                all_neg &= v < 0;
+                all_nonpos &= v <= 0;
+            }
+            strict |= all_neg;
+            weak |= all_nonpos;
         }
         (strict, weak)
     }

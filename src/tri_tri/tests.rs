@@ -183,3 +183,223 @@ fn float_kernel_agrees_on_generic_input_and_errs_near_degeneracy() {
     assert_eq!(e, classify(&b, &a).map(|h| (h.crossing, h.contact)));
     let _ = f;
 }
+
+// ---------------------------------------------------------------------------------------------
+// The float filters may only skip work whose answer they have proven: the filtered classifier
+// must agree bit for bit (kind, contact, segment points) with the unfiltered one (every sign
+// from the adaptive predicates) on random and on adversarial near-degenerate input.
+// ---------------------------------------------------------------------------------------------
+
+mod filtered_vs_unfiltered {
+    use super::*;
+    use crate::geom::predicates as pr;
+    use proptest::prelude::*;
+
+    /// A hit as (crossing, contact, segment end points' coordinate bits).
+    type HitBits = (bool, Contact, Option<[[u64; 3]; 2]>);
+
+    /// A hit as bits, so that equal means bit-identical (and -0.0 differs from 0.0).
+    fn bits(h: Option<Hit>) -> Option<HitBits> {
+        h.map(|h| {
+            let seg = h.segment.map(|s| s.map(|p| [p.x.to_bits(), p.y.to_bits(), p.z.to_bits()]));
+            (h.crossing, h.contact, seg)
+        })
+    }
+
+    /// Both classifiers, both orders; also every orient3d of the pair's vertex sets against the
+    /// adaptive predicate (which covers the exact stages: repeated points, integers, adaptive).
+    fn agree(a: &[DVec3; 3], b: &[DVec3; 3]) -> Result<(), TestCaseError> {
+        for (x, y) in [(a, b), (b, a)] {
+            let f = bits(classify(x, y));
+            let u = bits(classify_unfiltered(x, y));
+            prop_assert_eq!(f, u, "a = {:?}, b = {:?}", x, y);
+            let shapes = bits(classify_shapes(&Shape::of(x), &Shape::of(y)));
+            prop_assert_eq!(shapes, u);
+            for p in y {
+                let (s, r) =
+                    (pr::orient3d(x[0], x[1], x[2], *p), pr::orient3d_adaptive(x[0], x[1], x[2], *p));
+                prop_assert_eq!(s, r, "orient3d {:?} {:?}", x, p);
+                if let Some(d) = pr::orient3d_dyadic(x[0], x[1], x[2], *p) {
+                    prop_assert_eq!(d, r, "dyadic {:?} {:?}", x, p);
+                }
+            }
+        }
+        Ok(())
+    }
+
+    fn coord() -> impl Strategy<Value = f64> {
+        -1.0f64..1.0
+    }
+
+    fn point() -> impl Strategy<Value = DVec3> {
+        (coord(), coord(), coord()).prop_map(|(x, y, z)| DVec3::new(x, y, z))
+    }
+
+    fn triangle() -> impl Strategy<Value = [DVec3; 3]> {
+        [point(), point(), point()]
+    }
+
+    /// Move `x` by `k` ulps (k in -2..=2).
+    fn ulps(x: f64, k: i64) -> f64 {
+        if x == 0.0 {
+            return k as f64 * f64::from_bits(1);
+        }
+        let b = x.to_bits() as i64;
+        let moved = if x > 0.0 { b + k } else { b - k };
+        f64::from_bits(moved as u64)
+    }
+
+    /// `b` derived from `a` in a way that makes the pair nearly or exactly degenerate.
+    fn adversarial(
+        a: [DVec3; 3],
+        b: [DVec3; 3],
+        how: u8,
+        w: [f64; 3],
+        k: [i64; 3],
+    ) -> ([DVec3; 3], [DVec3; 3]) {
+        let in_plane = |s: f64, t: f64| a[0] + (a[1] - a[0]) * s + (a[2] - a[0]) * t; // rounded: near the plane
+        match how % 8 {
+            // Vertices on a's plane (rounded), one pushed by a few ulps.
+            0 => {
+                let mut c = [in_plane(w[0], w[1]), in_plane(w[1], w[2]), in_plane(w[2], w[0])];
+                c[0].z = ulps(c[0].z, k[0]);
+                (a, c)
+            }
+            // One shared vertex, one vertex on the plane.
+            1 => (a, [a[0], in_plane(w[0], w[1]), b[2]]),
+            // A shared edge, the third vertex anywhere or near the plane.
+            2 => (a, [a[1], a[0], if k[1] > 0 { b[2] } else { in_plane(w[1], -w[2]) }]),
+            // The same triangle, with coordinates moved by ulps.
+            3 => (a, a.map(|p| DVec3::new(ulps(p.x, k[0]), ulps(p.y, k[1]), ulps(p.z, k[2])))),
+            // Far from the origin (1e8): both moved, b through a point of a's plane.
+            4 => {
+                let off = DVec3::new(1.0e8, -1.0e8, 1.0e8);
+                let c = [in_plane(w[0], w[1]), b[1], b[2]];
+                (a.map(|p| p + off), c.map(|p| p + off))
+            }
+            // Exactly coplanar dyadic grid points on x + y + z = 3e8 (multiples of 2^-26).
+            5 => {
+                let q = 2f64.powi(-26);
+                let base = 100_000_000i64 << 26;
+                let grid = |s: f64, t: f64| {
+                    let x = base + (s * 4.0 / q).round() as i64;
+                    let y = base + (t * 4.0 / q).round() as i64;
+                    DVec3::new(x as f64 * q, y as f64 * q, (3 * base - x - y) as f64 * q)
+                    // exact
+                };
+                let ga = [grid(a[0].x, a[0].y), grid(a[1].x, a[1].y), grid(a[2].x, a[2].y)];
+                let gb = [
+                    grid(b[0].x, b[0].y),
+                    if k[0] > 0 { ga[1] } else { grid(b[1].x, b[1].y) },
+                    grid(w[0], w[1]),
+                ];
+                (ga, gb)
+            }
+            // Axis-aligned coplanar (z = 0.5), possibly sharing a vertex.
+            6 => {
+                let flat = |p: DVec3| DVec3::new(p.x, p.y, 0.5);
+                let fa = a.map(flat);
+                (fa, [if k[2] > 0 { fa[2] } else { flat(b[0]) }, flat(b[1]), flat(b[2])])
+            }
+            // Tiny (2^-260, below the exact range) or huge (2^240) scale.
+            _ => {
+                let s = if k[0] > 0 { 2f64.powi(-260) } else { 2f64.powi(240) };
+                let c = [in_plane(w[0], w[1]), b[1], b[2]];
+                (a.map(|p| p * s), c.map(|p| p * s))
+            }
+        }
+    }
+
+    proptest! {
+        #![proptest_config(ProptestConfig::with_cases(3000))]
+
+        #[test]
+        fn random_pairs(a in triangle(), b in triangle()) {
+            agree(&a, &b)?;
+        }
+
+        #[test]
+        fn near_degenerate_pairs(
+            a in triangle(),
+            b in triangle(),
+            how in 0u8..8,
+            w in [-0.5f64..1.5, -0.5f64..1.5, -0.5f64..1.5],
+            k in [-2i64..=2, -2i64..=2, -2i64..=2],
+        ) {
+            let (a, b) = adversarial(a, b, how, w, k);
+            agree(&a, &b)?;
+        }
+    }
+
+    #[test]
+    fn hand_made_degenerate_pairs_agree() {
+        let u = unit();
+        let p = v(0.25, 0.25, 0.0);
+        let cases = [
+            (u, u),
+            (u, [p, p, p]),
+            (u, [v(0.25, 0.25, -1.0), v(0.25, 0.25, 1.0), v(0.25, 0.25, 0.5)]),
+            (u, [v(-1.0, 0.5, 0.0), v(2.0, 0.2, 0.0), v(2.0, 0.2, 0.0)]),
+            (u, tri([1.0, 0.0, 0.0], [1.0, 1.0, 0.0], [0.0, 1.0, 0.0])),
+            (u, tri([0.2, 0.2, 0.0], [0.3, 0.2, 1.0], [0.2, 0.6, 1.0])),
+            (u, tri([0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.5, -0.5, 1.0])),
+        ];
+        for (a, b) in cases {
+            agree(&a, &b).unwrap();
+        }
+    }
+}
+
+/// A driver for instruction counts (`valgrind --tool=callgrind`), not a check: replays the
+/// candidate pairs (triangle boxes overlap) of a real mesh pair through one classifier.
+/// `MESHCLASH_REPLAY` = `tori` (crossing tori, 100k triangles each), `grid` (coplanar grids at
+/// 1e8, 20k) or `bunny` (vs its rotated copy; needs ../shared/meshes);
+/// `MESHCLASH_CLASSIFIER` = `filtered`, `unfiltered` or `none` (everything but the classifier,
+/// to subtract). Prints the candidate count and hits to stderr.
+#[test]
+#[ignore]
+fn replay_candidates_for_profiling() {
+    use crate::bench::gen;
+    use crate::bvh::{self, BuildOptions, Bvh};
+    use crate::geom::Aabb;
+    let which = std::env::var("MESHCLASH_REPLAY").unwrap_or_else(|_| "tori".into());
+    let (a, b) = match which.as_str() {
+        "grid" => gen::coplanar_grids(20_000),
+        "bunny" => {
+            let path = std::path::PathBuf::from(env!("CARGO_MANIFEST_DIR"))
+                .join("../shared/meshes/stanford-bunny.obj");
+            let spec = crate::query::InputSpec { path, transform: glam::DMat4::IDENTITY };
+            let m = crate::query::load_input(&spec).unwrap().mesh;
+            (gen::rotated_copy(&m), m)
+        }
+        _ => gen::crossing_tori(100_000),
+    };
+    let opts = BuildOptions::default();
+    let (ta, tb) = (Bvh::build(&a, opts), Bvh::build(&b, opts));
+    let cands: Vec<(u32, u32)> = crate::traverse::collect_pairs(
+        &ta,
+        &tb,
+        |x, y| x.overlaps(y),
+        |la, lb, out| {
+            for &i in la {
+                let bi = Aabb::of_triangle(&bvh::triangle(&a, i));
+                for &j in lb {
+                    if bi.overlaps(&Aabb::of_triangle(&bvh::triangle(&b, j))) {
+                        out.push((i, j));
+                    }
+                }
+            }
+        },
+    );
+    let f: fn(&[DVec3; 3], &[DVec3; 3]) -> Option<Hit> =
+        match std::env::var("MESHCLASH_CLASSIFIER").as_deref().unwrap_or("filtered") {
+            "unfiltered" => classify_unfiltered,
+            "none" => |_, _| None,
+            _ => classify,
+        };
+    let hits = cands
+        .iter()
+        .filter(|&&(i, j)| std::hint::black_box(f)(&bvh::triangle(&a, i), &bvh::triangle(&b, j)).is_some())
+        .count();
+    eprintln!("{which}: {} candidates, {hits} meet", cands.len());
+}
