@@ -56,25 +56,48 @@ pub fn topology<M: TriMesh + ?Sized>(mesh: &M) -> Topology {
         .into_par_iter()
         .map(|t| !Shape::of(&mesh.triangle(t)).is_degenerate())
         .collect();
-    let mut edges: Vec<u64> = Vec::with_capacity(mesh.triangle_count() * 3);
+    // Undirected edges (lo, hi) of the proper triangles, bucketed by lo (a counting sort: two
+    // passes over the triangles, 4 bytes per edge; a comparison sort of 64-bit edge keys was
+    // most of this function's time on large meshes).
+    let ids = |t: usize| mesh.indices(t as u32).map(|i| merged[i as usize]);
+    let lo_hi = |v: [u32; 3], k: usize| (v[k].min(v[(k + 1) % 3]), v[k].max(v[(k + 1) % 3]));
+    let mut start = vec![0u32; distinct + 1];
     for (t, &is_proper) in proper.iter().enumerate() {
-        let v = mesh.indices(t as u32).map(|i| merged[i as usize]);
-        for k in 0..3 {
-            let (a, b) = (find(&mut parent, v[k]), find(&mut parent, v[(k + 1) % 3]));
+        let v = ids(t);
+        // Two unions join all three vertices.
+        for k in 0..2 {
+            let (a, b) = (find(&mut parent, v[k]), find(&mut parent, v[k + 1]));
             if a != b {
                 parent[a.max(b) as usize] = a.min(b);
             }
         }
         if is_proper {
             for k in 0..3 {
-                let (a, b) = (v[k], v[(k + 1) % 3]);
-                edges.push((a.min(b) as u64) << 32 | a.max(b) as u64);
+                start[lo_hi(v, k).0 as usize + 1] += 1;
             }
         }
     }
+    for i in 0..distinct {
+        start[i + 1] += start[i];
+    }
+    let mut fill = start.clone();
+    let mut hi = vec![0u32; start[distinct] as usize];
+    for (t, _) in proper.iter().enumerate().filter(|x| *x.1) {
+        let v = ids(t);
+        for k in 0..3 {
+            let (a, b) = lo_hi(v, k);
+            hi[fill[a as usize] as usize] = b;
+            fill[a as usize] += 1;
+        }
+    }
+    drop(fill);
     // Closed: every undirected edge of the proper triangles used exactly twice.
-    edges.par_sort_unstable();
-    let closed = !edges.is_empty() && edges.chunk_by(|x, y| x == y).all(|run| run.len() == 2);
+    let closed = !hi.is_empty()
+        && (0..distinct).all(|a| {
+            let bucket = &mut hi[start[a] as usize..start[a + 1] as usize];
+            bucket.sort_unstable();
+            bucket.chunk_by(|x, y| x == y).all(|run| run.len() == 2)
+        });
     // The first vertex (in triangle order) of each component.
     let mut comp_of_root = vec![u32::MAX; parent.len()];
     let mut component_seeds = Vec::new();
