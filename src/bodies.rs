@@ -140,7 +140,11 @@ pub fn split_bodies(mesh: &mut Mesh) -> usize {
         } else {
             split += 1;
             for k in 0..per_object[o] {
-                objects.push(Object { name: format!("{}/body{}", obj.name, k + 1), gltf_mesh: None, ..obj.clone() });
+                objects.push(Object {
+                    name: format!("{}/body{}", obj.name, k + 1),
+                    gltf_mesh: None,
+                    ..obj.clone()
+                });
             }
         }
     }

@@ -185,7 +185,13 @@ struct Solid {
 ///
 /// Needs the complete pair list (not `--first-hit`). Parts are copied and a tree built only
 /// for parts that have a region.
-pub fn estimate_penetration(regs: &mut [Region], pairs: &[PairFinding], a: &Mesh, b: &Mesh, opts: BuildOptions) {
+pub fn estimate_penetration(
+    regs: &mut [Region],
+    pairs: &[PairFinding],
+    a: &Mesh,
+    b: &Mesh,
+    opts: BuildOptions,
+) {
     if regs.is_empty() {
         return;
     }
@@ -199,7 +205,8 @@ pub fn estimate_penetration(regs: &mut [Region], pairs: &[PairFinding], a: &Mesh
         .par_iter()
         .map(|&(side, o)| {
             let m = meshes[side as usize];
-            let tris: Vec<u32> = (0..m.triangles.len() as u32).filter(|&t| m.tri_object[t as usize] == o).collect();
+            let tris: Vec<u32> =
+                (0..m.triangles.len() as u32).filter(|&t| m.tri_object[t as usize] == o).collect();
             let mesh = m.sub_mesh(&tris);
             let solid = containment::topology(&mesh).closed.then(|| {
                 let tree = Bvh::build(&mesh, opts);
@@ -208,7 +215,8 @@ pub fn estimate_penetration(regs: &mut [Region], pairs: &[PairFinding], a: &Mesh
             ((side, o), solid)
         })
         .collect();
-    let merged = [crate::bodies::merge_vertices(&a.positions).0, crate::bodies::merge_vertices(&b.positions).0];
+    let merged =
+        [crate::bodies::merge_vertices(&a.positions).0, crate::bodies::merge_vertices(&b.positions).0];
     // Per part pair: which triangles of each side meet the other part.
     let mut cut: HashMap<(u32, u32), [Vec<u32>; 2]> = HashMap::new();
     for p in pairs {
@@ -429,7 +437,8 @@ mod tests {
         // Stable: the same regions from the pairs in another order.
         let mut rev = r.pairs.clone();
         rev.reverse();
-        let strip = |v: Vec<Region>| v.into_iter().map(|g| Region { members: vec![], ..g }).collect::<Vec<_>>();
+        let strip =
+            |v: Vec<Region>| v.into_iter().map(|g| Region { members: vec![], ..g }).collect::<Vec<_>>();
         assert_eq!(strip(regions(&rev, &a, &b)), strip(regs));
     }
 
@@ -455,7 +464,9 @@ mod tests {
             for side in [0.0, 1.0] {
                 for x in 0..n {
                     for y in 0..n {
-                        let f = |dx: usize, dy: usize| at(axis, side, (x + dx) as f64 / n as f64, (y + dy) as f64 / n as f64);
+                        let f = |dx: usize, dy: usize| {
+                            at(axis, side, (x + dx) as f64 / n as f64, (y + dy) as f64 / n as f64)
+                        };
                         let q = [f(0, 0), f(1, 0), f(1, 1), f(0, 1)].map(|p| vid(&mut m, p));
                         m.triangles.push([q[0], q[1], q[2]]);
                         m.triangles.push([q[0], q[2], q[3]]);

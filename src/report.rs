@@ -702,25 +702,25 @@ pub fn build(ctx: &Context, r: &ClashResult) -> Report {
             regs
         }
         .into_iter()
-            .map(|g| RegionReport {
-                a_name: ia.mesh.objects[g.objects.0 as usize].name.clone(),
-                b_name: ib.mesh.objects[g.objects.1 as usize].name.clone(),
-                id: g.id,
-                a_object: g.objects.0,
-                b_object: g.objects.1,
-                pairs: g.pairs,
-                crossing_pairs: g.crossing,
-                center: v3(g.center),
-                bounds: Bounds { min: v3(g.bounds.min), max: v3(g.bounds.max) },
-                extent: g.extent,
-                penetration: g.penetration.map(|p| PenetrationReport {
-                    depth: p.depth,
-                    point: v3(p.point),
-                    side: if p.side == 0 { "a_in_b" } else { "b_in_a" }.to_string(),
-                    samples: p.samples,
-                }),
-            })
-            .collect(),
+        .map(|g| RegionReport {
+            a_name: ia.mesh.objects[g.objects.0 as usize].name.clone(),
+            b_name: ib.mesh.objects[g.objects.1 as usize].name.clone(),
+            id: g.id,
+            a_object: g.objects.0,
+            b_object: g.objects.1,
+            pairs: g.pairs,
+            crossing_pairs: g.crossing,
+            center: v3(g.center),
+            bounds: Bounds { min: v3(g.bounds.min), max: v3(g.bounds.max) },
+            extent: g.extent,
+            penetration: g.penetration.map(|p| PenetrationReport {
+                depth: p.depth,
+                point: v3(p.point),
+                side: if p.side == 0 { "a_in_b" } else { "b_in_a" }.to_string(),
+                samples: p.samples,
+            }),
+        })
+        .collect(),
         warnings,
         timings_ms: ctx.times.map(|(load, total)| TimingsReport {
             load,

@@ -40,7 +40,8 @@ fn shared_stl_splits_into_two_cubes_that_touch_along_an_edge() {
     let boxes: Vec<(Vec<f64>, Vec<f64>)> = parts
         .iter()
         .map(|x| {
-            let f = |k: &str| x["bounds"][k].as_array().unwrap().iter().map(|v| v.as_f64().unwrap()).collect();
+            let f =
+                |k: &str| x["bounds"][k].as_array().unwrap().iter().map(|v| v.as_f64().unwrap()).collect();
             (f("min"), f("max"))
         })
         .collect();

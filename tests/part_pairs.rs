@@ -65,7 +65,8 @@ fn scene_part_pairs_carry_witnesses_and_capped_pairs() {
     assert!(total > 3, "B's four side faces each cross A's face x = 1");
     assert_eq!((listed.len(), ab["pairs_truncated"].as_bool().unwrap()), (3, true));
     // Listed pairs: sorted, A's triangles 0..12 against B's 12..24 (file order).
-    let idx: Vec<(u64, u64)> = listed.iter().map(|x| (x[0].as_u64().unwrap(), x[1].as_u64().unwrap())).collect();
+    let idx: Vec<(u64, u64)> =
+        listed.iter().map(|x| (x[0].as_u64().unwrap(), x[1].as_u64().unwrap())).collect();
     assert!(idx.windows(2).all(|w| w[0] < w[1]));
     assert!(idx.iter().all(|&(a, b)| a < 12 && (12..24).contains(&b)), "{idx:?}");
     // B and C: clearance, exactly 1.5 (B's face x = 1.5 against C's face x = 3).
@@ -85,7 +86,10 @@ fn scene_part_pairs_carry_witnesses_and_capped_pairs() {
     // Uncapped, every part pair lists all its pairs.
     let (_, full) = run(&["scene", p, "--clearance", "2.5"]);
     for pp in full["part_pairs"].as_array().unwrap() {
-        let n = ["crossing_pairs", "touching_pairs", "clearance_pairs"].map(|k| pp[k].as_u64().unwrap()).iter().sum::<u64>();
+        let n = ["crossing_pairs", "touching_pairs", "clearance_pairs"]
+            .map(|k| pp[k].as_u64().unwrap())
+            .iter()
+            .sum::<u64>();
         assert_eq!(pp["pairs"].as_array().unwrap().len() as u64, n);
         assert_eq!(pp["pairs_truncated"], false);
     }
