@@ -92,7 +92,7 @@ pub struct Args {
     pub split_bodies: bool,
     /// Estimate each clash region's penetration depth: the deepest vertex of one part inside
     /// the other closed part, measured to its surface (a lower bound; costs a tree per part
-    /// with a region and point queries, at most 4096 per region and side).
+    /// with a region and point queries, at most about 2048 per region and side).
     #[arg(long)]
     pub penetration: bool,
     /// Allowed relative error of the minimum distance (reported d <= (1+R)·true + A).

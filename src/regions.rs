@@ -18,7 +18,7 @@ use std::collections::HashMap;
 
 /// At most this many vertices (taken at an even stride in a fixed order) are measured per
 /// region and side, so the estimate costs a bounded number of point queries.
-pub const PENETRATION_SAMPLES: usize = 4096;
+pub const PENETRATION_SAMPLES: usize = 1024;
 
 /// One connected interference.
 #[derive(Debug, Clone, PartialEq)]
@@ -215,8 +215,7 @@ pub fn estimate_penetration(
             ((side, o), solid)
         })
         .collect();
-    let merged =
-        [crate::bodies::merge_vertices(&a.positions).0, crate::bodies::merge_vertices(&b.positions).0];
+    let merged = [crate::bodies::merge_vertices(&a.positions), crate::bodies::merge_vertices(&b.positions)];
     // Per part pair: which triangles of each side meet the other part.
     let mut cut: HashMap<(u32, u32), [Vec<u32>; 2]> = HashMap::new();
     for p in pairs {
@@ -230,73 +229,94 @@ pub fn estimate_penetration(
             v.dedup();
         }
     }
-    let estimates: Vec<Option<Penetration>> = regs
+    // Regions grouped by part pair: the free pieces of a part pair are found once for all its
+    // regions (in parallel over part pairs).
+    let mut groups: std::collections::BTreeMap<(u32, u32), Vec<usize>> = Default::default();
+    for (i, r) in regs.iter().enumerate() {
+        groups.entry(r.objects).or_default().push(i);
+    }
+    let regs_ro: &[Region] = regs;
+    let estimates: Vec<(usize, Option<Penetration>)> = groups
         .par_iter()
-        .map(|r| {
-            let mut best: Option<Penetration> = None;
+        .flat_map_iter(|(objects, members)| {
+            let mut best: Vec<Option<Penetration>> = vec![None; members.len()];
             for side in 0..2u8 {
                 let (inner, outer_obj, inner_obj) = match side {
-                    0 => (a, (1u8, r.objects.1), r.objects.0),
-                    _ => (b, (0u8, r.objects.0), r.objects.1),
+                    0 => (a, (1u8, objects.1), objects.0),
+                    _ => (b, (0u8, objects.0), objects.1),
                 };
                 let Some(Some(outer)) = solids.get(&outer_obj) else { continue };
-                let cuts = &cut[&r.objects][side as usize];
-                let found = side_depth(r, pairs, side, inner, inner_obj, &merged[side as usize], cuts, outer);
-                let replace = match (&best, &found) {
-                    (_, None) => false,
-                    (None, Some(_)) => true,
-                    (Some(x), Some(y)) => y.depth > x.depth,
-                };
-                if replace {
-                    best = found;
+                let (ids, distinct) = &merged[side as usize];
+                let pieces = Pieces::new(inner, inner_obj, ids, *distinct, &cut[objects][side as usize]);
+                for (k, &ri) in members.iter().enumerate() {
+                    let found = side_depth(&regs_ro[ri], pairs, side, inner, ids, &pieces, outer);
+                    if best[k].is_none_or(|x| found.depth > x.depth) {
+                        best[k] = Some(found);
+                    }
                 }
             }
-            best
+            members.iter().copied().zip(best).collect::<Vec<_>>()
         })
         .collect();
-    for (r, e) in regs.iter_mut().zip(estimates) {
-        r.penetration = e;
+    for (i, e) in estimates {
+        regs[i].penetration = e;
     }
 }
 
-#[allow(clippy::too_many_arguments)]
+/// The inner part's triangles that meet no triangle of the other part ("free"), joined into
+/// pieces through shared (merged) vertices: for each merged vertex id, the root of its piece
+/// and one vertex index, or `u32::MAX` for ids on no free triangle.
+struct Pieces {
+    root: Vec<u32>,
+    vertex: Vec<u32>,
+}
+
+impl Pieces {
+    fn new(inner: &Mesh, inner_obj: u32, merged: &[u32], distinct: usize, cuts: &[u32]) -> Pieces {
+        let mut parent: Vec<u32> = (0..distinct as u32).collect();
+        fn find(parent: &mut [u32], mut x: u32) -> u32 {
+            while parent[x as usize] != x {
+                parent[x as usize] = parent[parent[x as usize] as usize];
+                x = parent[x as usize];
+            }
+            x
+        }
+        let mut vertex = vec![u32::MAX; distinct];
+        for (t, tri) in inner.triangles.iter().enumerate() {
+            if inner.tri_object[t] != inner_obj || cuts.binary_search(&(t as u32)).is_ok() {
+                continue;
+            }
+            let v = tri.map(|i| merged[i as usize]);
+            for k in 0..3 {
+                if vertex[v[k] as usize] == u32::MAX {
+                    vertex[v[k] as usize] = tri[k];
+                }
+            }
+            for k in 1..3 {
+                let (x, y) = (find(&mut parent, v[0]), find(&mut parent, v[k]));
+                if x != y {
+                    parent[x.max(y) as usize] = x.min(y);
+                }
+            }
+        }
+        let root = (0..distinct as u32)
+            .map(|m| if vertex[m as usize] == u32::MAX { u32::MAX } else { find(&mut parent, m) })
+            .collect();
+        Pieces { root, vertex }
+    }
+}
+
 fn side_depth(
     r: &Region,
     pairs: &[PairFinding],
     side: u8,
     inner: &Mesh,
-    inner_obj: u32,
     merged: &[u32],
-    cuts: &[u32],
+    free: &Pieces,
     outer: &Solid,
-) -> Option<Penetration> {
+) -> Penetration {
     let tri_of = |p: &PairFinding| if side == 0 { p.a } else { p.b };
-    // Free triangles of the inner part, joined into pieces through shared (merged) vertices.
-    let mut parent: HashMap<u32, u32> = HashMap::new();
-    fn find(parent: &mut HashMap<u32, u32>, mut x: u32) -> u32 {
-        loop {
-            let p = *parent.entry(x).or_insert(x);
-            if p == x {
-                return x;
-            }
-            let g = *parent.entry(p).or_insert(p);
-            parent.insert(x, g);
-            x = g;
-        }
-    }
-    let free: Vec<u32> = (0..inner.triangles.len() as u32)
-        .filter(|&t| inner.tri_object[t as usize] == inner_obj && cuts.binary_search(&t).is_err())
-        .collect();
-    for &t in &free {
-        let v = inner.triangles[t as usize].map(|i| merged[i as usize]);
-        for k in 1..3 {
-            let (x, y) = (find(&mut parent, v[0]), find(&mut parent, v[k]));
-            if x != y {
-                parent.insert(x.max(y), x.min(y));
-            }
-        }
-    }
-    // The region's vertices (one position per merged id, in a fixed order).
+    // The region's vertices (one per merged id, in a fixed order).
     let mut region_vertices: Vec<(u32, u32)> = r
         .members
         .iter()
@@ -309,40 +329,27 @@ fn side_depth(
     let mut pieces: Vec<u32> = Vec::new();
     let mut loose: Vec<u32> = Vec::new();
     for &(m, v) in &region_vertices {
-        if parent.contains_key(&m) {
-            pieces.push(find(&mut parent, m));
-        } else {
-            loose.push(v);
+        match free.root[m as usize] {
+            u32::MAX => loose.push(v),
+            root => pieces.push(root),
         }
     }
     pieces.sort_unstable();
     pieces.dedup();
-    // Vertices of the inside pieces (one per merged id), then loose points.
-    let mut candidates: Vec<DVec3> = Vec::new();
-    if !pieces.is_empty() {
-        let mut seen: HashMap<u32, u32> = HashMap::new(); // merged id -> vertex
-        for &t in &free {
-            for v in inner.triangles[t as usize] {
-                seen.entry(merged[v as usize]).or_insert(v);
-            }
-        }
-        let mut by_piece: HashMap<u32, Vec<(u32, u32)>> = HashMap::new();
-        for (&m, &v) in &seen {
-            let root = find(&mut parent, m);
-            if pieces.binary_search(&root).is_ok() {
-                by_piece.entry(root).or_default().push((m, v));
-            }
-        }
-        for root in &pieces {
-            let mut verts = by_piece.remove(root).unwrap_or_default();
-            verts.sort_unstable();
-            // A free vertex is off the other surface, so the parity test applies.
-            let probe = inner.positions[verts[0].1 as usize];
-            if containment::point_in_closed_mesh(probe, &outer.mesh, &outer.tree) == Inside::Yes {
-                candidates.extend(verts.iter().map(|x| inner.positions[x.1 as usize]));
-            }
-        }
-    }
+    // A free vertex is off the other surface, so the parity test applies to a piece's root.
+    pieces.retain(|&root| {
+        let probe = inner.positions[free.vertex[root as usize] as usize];
+        containment::point_in_closed_mesh(probe, &outer.mesh, &outer.tree) == Inside::Yes
+    });
+    // Vertices of the inside pieces, in merged-id order.
+    let candidates: Vec<DVec3> = if pieces.is_empty() {
+        Vec::new()
+    } else {
+        (0..free.root.len())
+            .filter(|&m| free.root[m] != u32::MAX && pieces.binary_search(&free.root[m]).is_ok())
+            .map(|m| inner.positions[free.vertex[m] as usize])
+            .collect()
+    };
     // Loose points: the region's vertices on no free triangle, and the centroid and edge
     // midpoints of the region's triangles (a long triangle crossing a thin wall has its
     // deepest points between its vertices), sampled.
@@ -365,15 +372,15 @@ fn side_depth(
     }
     let stride = candidates.len().div_ceil(PENETRATION_SAMPLES).max(1);
     let mut best = Penetration { depth: 0.0, point: r.center, side, samples: 0 };
-    let pieces = candidates.iter().step_by(stride).map(|&p| (p, point_distance(p, &outer.mesh, &outer.tree)));
-    for (p, d) in pieces.chain(measured) {
+    let inside = candidates.iter().step_by(stride).map(|&p| (p, point_distance(p, &outer.mesh, &outer.tree)));
+    for (p, d) in inside.chain(measured) {
         best.samples += 1;
         if d > best.depth {
             best.depth = d;
             best.point = p;
         }
     }
-    Some(best)
+    best
 }
 
 #[cfg(test)]

@@ -122,7 +122,7 @@ pub struct PenetrationReport {
     pub point: [f64; 3],
     /// `a_in_b` (a point of A's surface inside B) or `b_in_a`.
     pub side: String,
-    /// Points found inside the other part and measured (sampled: at most about 8192 per
+    /// Points found inside the other part and measured (sampled: at most about 2048 per
     /// region and side).
     pub samples: usize,
 }
