@@ -44,14 +44,8 @@ pub fn topology<M: TriMesh + ?Sized>(mesh: &M) -> Topology {
     // Merge exactly coincident vertices by sorting their bit patterns (parallel; a hash map of
     // millions of keys was most of the cost of a check on large inputs).
     let (merged, distinct) = crate::bodies::merge_vertices(&mesh.positions());
+    use crate::bodies::{find, union};
     let mut parent: Vec<u32> = (0..distinct as u32).collect();
-    fn find(parent: &mut [u32], mut x: u32) -> u32 {
-        while parent[x as usize] != x {
-            parent[x as usize] = parent[parent[x as usize] as usize];
-            x = parent[x as usize];
-        }
-        x
-    }
     let proper: Vec<bool> = (0..mesh.triangle_count() as u32)
         .into_par_iter()
         .map(|t| !Shape::of(&mesh.triangle(t)).is_degenerate())
@@ -66,10 +60,7 @@ pub fn topology<M: TriMesh + ?Sized>(mesh: &M) -> Topology {
         let v = ids(t);
         // Two unions join all three vertices.
         for k in 0..2 {
-            let (a, b) = (find(&mut parent, v[k]), find(&mut parent, v[k + 1]));
-            if a != b {
-                parent[a.max(b) as usize] = a.min(b);
-            }
+            union(&mut parent, v[k], v[k + 1]);
         }
         if is_proper {
             for k in 0..3 {

@@ -8,6 +8,7 @@
 //! ([`crate::output::baseline::finding_id`], derived from geometry and part names) among its
 //! pairs, so ids do not depend on thread timing or file order.
 
+use crate::bodies::{find, union, vertex_key};
 use crate::bvh::{self, BuildOptions, Bvh};
 use crate::containment::{self, Inside};
 use crate::geom::{Aabb, DVec3};
@@ -59,40 +60,25 @@ pub struct Penetration {
     pub samples: usize,
 }
 
-fn key(p: DVec3) -> [u64; 3] {
-    [p.x + 0.0, p.y + 0.0, p.z + 0.0].map(f64::to_bits)
-}
-
-fn find(parent: &mut [usize], mut x: usize) -> usize {
-    while parent[x] != x {
-        parent[x] = parent[parent[x]];
-        x = parent[x];
-    }
-    x
-}
-
 /// Group `pairs` (triangle indices into `a` and `b`) into regions, sorted by id.
 pub fn regions(pairs: &[PairFinding], a: &Mesh, b: &Mesh) -> Vec<Region> {
     let n = pairs.len();
-    let mut parent: Vec<usize> = (0..n).collect();
-    let mut first: HashMap<(u8, u32, u32, [u64; 3]), usize> = HashMap::new();
+    let mut parent: Vec<u32> = (0..n as u32).collect();
+    let mut first: HashMap<(u8, u32, u32, [u64; 3]), u32> = HashMap::new();
     for (i, p) in pairs.iter().enumerate() {
         let objs = (a.tri_object[p.a as usize], b.tri_object[p.b as usize]);
         let verts = [(0u8, a, p.a), (1u8, b, p.b)];
         for (side, m, t) in verts {
             for v in m.triangles[t as usize] {
-                let k = (side, objs.0, objs.1, key(m.positions[v as usize]));
-                let j = *first.entry(k).or_insert(i);
-                let (ri, rj) = (find(&mut parent, i), find(&mut parent, j));
-                if ri != rj {
-                    parent[ri.max(rj)] = ri.min(rj);
-                }
+                let k = (side, objs.0, objs.1, vertex_key(&m.positions[v as usize]));
+                let j = *first.entry(k).or_insert(i as u32);
+                union(&mut parent, i as u32, j);
             }
         }
     }
-    let mut groups: HashMap<usize, Vec<usize>> = HashMap::new();
+    let mut groups: HashMap<u32, Vec<usize>> = HashMap::new();
     for i in 0..n {
-        let r = find(&mut parent, i);
+        let r = find(&mut parent, i as u32);
         groups.entry(r).or_default().push(i);
     }
     let mut out: Vec<Region> = groups
@@ -274,13 +260,6 @@ struct Pieces {
 impl Pieces {
     fn new(inner: &Mesh, inner_obj: u32, merged: &[u32], distinct: usize, cuts: &[u32]) -> Pieces {
         let mut parent: Vec<u32> = (0..distinct as u32).collect();
-        fn find(parent: &mut [u32], mut x: u32) -> u32 {
-            while parent[x as usize] != x {
-                parent[x as usize] = parent[parent[x as usize] as usize];
-                x = parent[x as usize];
-            }
-            x
-        }
         let mut vertex = vec![u32::MAX; distinct];
         for (t, tri) in inner.triangles.iter().enumerate() {
             if inner.tri_object[t] != inner_obj || cuts.binary_search(&(t as u32)).is_ok() {
@@ -293,10 +272,7 @@ impl Pieces {
                 }
             }
             for k in 1..3 {
-                let (x, y) = (find(&mut parent, v[0]), find(&mut parent, v[k]));
-                if x != y {
-                    parent[x.max(y) as usize] = x.min(y);
-                }
+                union(&mut parent, v[0], v[k]);
             }
         }
         let root = (0..distinct as u32)
@@ -454,7 +430,7 @@ mod tests {
         let mut index: HashMap<[u64; 3], u32> = HashMap::new();
         let mut m = mesh(&[]);
         let mut vid = |m: &mut Mesh, p: DVec3| {
-            *index.entry(key(p)).or_insert_with(|| {
+            *index.entry(vertex_key(&p)).or_insert_with(|| {
                 m.positions.push(p);
                 (m.positions.len() - 1) as u32
             })
