@@ -118,20 +118,7 @@ struct Layout {
 
 impl Layout {
     fn of(mesh: &Mesh, part: &Part) -> Layout {
-        let mut remap: HashMap<u32, u32> = HashMap::new();
-        let mut vmap = Vec::new();
-        let tris = part
-            .triangles
-            .iter()
-            .map(|&t| {
-                mesh.triangles[t as usize].map(|v| {
-                    *remap.entry(v).or_insert_with(|| {
-                        vmap.push(v);
-                        (vmap.len() - 1) as u32
-                    })
-                })
-            })
-            .collect();
+        let (tris, mut vmap) = mesh.reindex(&part.triangles);
         let run = vmap.first().copied().filter(|&s| vmap.iter().zip(s..).all(|(&v, w)| v == w));
         let vertices = vmap.len();
         if run.is_some() {

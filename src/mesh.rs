@@ -34,23 +34,31 @@ impl Mesh {
         }
     }
 
-    /// The sub-mesh of the given triangles (in that order), re-indexed: only the vertices they
-    /// use, in order of first use; every triangle assigned to object 0, a copy of the object of
-    /// the first triangle (`objects` is empty when `tris` is).
-    pub fn sub_mesh(&self, tris: &[u32]) -> Mesh {
+    /// The given triangles (in that order) re-indexed to the vertices they use, numbered in
+    /// order of first use, and for each new index the vertex it stands for.
+    pub fn reindex(&self, tris: &[u32]) -> (Vec<[u32; 3]>, Vec<u32>) {
         let mut remap: std::collections::HashMap<u32, u32> = std::collections::HashMap::new();
-        let mut positions = Vec::new();
-        let triangles: Vec<[u32; 3]> = tris
+        let mut vmap = Vec::new();
+        let triangles = tris
             .iter()
             .map(|&t| {
                 self.triangles[t as usize].map(|v| {
                     *remap.entry(v).or_insert_with(|| {
-                        positions.push(self.positions[v as usize]);
-                        (positions.len() - 1) as u32
+                        vmap.push(v);
+                        (vmap.len() - 1) as u32
                     })
                 })
             })
             .collect();
+        (triangles, vmap)
+    }
+
+    /// The sub-mesh of the given triangles (in that order), re-indexed: only the vertices they
+    /// use, in order of first use; every triangle assigned to object 0, a copy of the object of
+    /// the first triangle (`objects` is empty when `tris` is).
+    pub fn sub_mesh(&self, tris: &[u32]) -> Mesh {
+        let (triangles, vmap) = self.reindex(tris);
+        let positions = vmap.iter().map(|&v| self.positions[v as usize]).collect();
         let objects = tris.first().map(|&t| self.objects[self.tri_object[t as usize] as usize].clone());
         Mesh {
             positions,
