@@ -531,21 +531,19 @@ pub fn schema_json(kind: SchemaKind) -> String {
 pub fn run_with_progress(args: &ClashSetArgs, progress: &(dyn Fn(Phase) + Sync)) -> Result<SetOutcome> {
     let file = args.file.as_deref().ok_or_else(|| Error::Usage("missing clash-set FILE".into()))?;
     let checks = load(file, args)?;
-    let pool = rayon::ThreadPoolBuilder::new()
-        .num_threads(args.threads)
-        .build()
-        .map_err(|e| Error::Usage(format!("--threads: {e}")))?;
-    let threads = pool.current_num_threads();
-    let mut entries = Vec::with_capacity(checks.len());
-    for c in &checks {
-        let rep = pool
-            .install(|| cli::check_in_pool(&c.config, threads, progress))
-            .map_err(|e| err(file, format!("check '{}': {}", c.name, inner(e))))?;
-        entries.push(CheckReport { name: c.name.clone(), report: rep });
-    }
+    let entries = cli::in_pool(args.threads, |threads| {
+        checks
+            .iter()
+            .map(|c| {
+                let rep = cli::check_in_pool(&c.config, threads, progress)
+                    .map_err(|e| err(file, format!("check '{}': {}", c.name, inner(e))))?;
+                Ok(CheckReport { name: c.name.clone(), report: rep })
+            })
+            .collect::<Result<Vec<_>>>()
+    })?;
     let doc = ClashSetReport {
         schema: SCHEMA.into(),
-        tool: report::Tool { name: "meshclash".into(), version: env!("CARGO_PKG_VERSION").into() },
+        tool: report::Tool::this(),
         file: file.display().to_string(),
         failed: entries.iter().any(|c| c.report.failed),
         checks: entries,

@@ -591,11 +591,17 @@ pub fn run(cfg: &Config) -> Result<Outcome> {
 
 /// [`run`], calling `progress` as each phase starts (the binary drives a spinner with it).
 pub fn run_with_progress(cfg: &Config, progress: &(dyn Fn(Phase) + Sync)) -> Result<Outcome> {
+    in_pool(cfg.threads, |threads| run_in_pool(cfg, threads, progress))
+}
+
+/// Run `f` in a pool of `threads` workers (`--threads`; 0 = one per core), giving it the pool's
+/// size (the single command and the clash-set runner share this).
+pub fn in_pool<T: Send>(threads: usize, f: impl FnOnce(usize) -> Result<T> + Send) -> Result<T> {
     let pool = rayon::ThreadPoolBuilder::new()
-        .num_threads(cfg.threads)
+        .num_threads(threads)
         .build()
         .map_err(|e| Error::Usage(format!("--threads: {e}")))?;
-    pool.install(|| run_in_pool(cfg, pool.current_num_threads(), progress))
+    pool.install(|| f(pool.current_num_threads()))
 }
 
 fn run_in_pool(cfg: &Config, threads: usize, progress: &(dyn Fn(Phase) + Sync)) -> Result<Outcome> {

@@ -354,6 +354,13 @@ pub struct Tool {
     pub version: String,
 }
 
+impl Tool {
+    /// This build of meshclash.
+    pub fn this() -> Tool {
+        Tool { name: "meshclash".into(), version: env!("CARGO_PKG_VERSION").into() }
+    }
+}
+
 /// Inputs A and B.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize, schemars::JsonSchema)]
 #[serde(deny_unknown_fields)]
@@ -661,7 +668,7 @@ pub fn build(ctx: &Context, r: &ClashResult) -> Report {
         .collect();
     Report {
         schema: SCHEMA.to_string(),
-        tool: Tool { name: "meshclash".into(), version: env!("CARGO_PKG_VERSION").into() },
+        tool: Tool::this(),
         inputs: Inputs {
             a: input_report(ia, &ctx.transforms[0], &infa, r.closed[0]),
             b: input_report(ib, &ctx.transforms[1], &infb, r.closed[1]),
