@@ -953,13 +953,7 @@ fn mutated_extension_documents_never_panic() {
             Some((sparse, &[1], &[1, 0, 2, 0, 3, 0])),
         ),
     ];
-    let mut seed = 0x2545_F491_4F6C_DD1Du64;
-    let mut rnd = move |n: usize| {
-        seed ^= seed << 13;
-        seed ^= seed >> 7;
-        seed ^= seed << 17;
-        (seed % n.max(1) as u64) as usize
-    };
+    let mut rnd = crate::load::test_rng(0x2545_F491_4F6C_DD1D);
     for orig in docs {
         assert!(load_bytes(&path(), &orig, Format::Gltf).is_ok());
         for _ in 0..3000 {

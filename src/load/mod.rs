@@ -279,6 +279,17 @@ pub(crate) fn shared(name: &str) -> Option<std::path::PathBuf> {
     None
 }
 
+/// A fixed-seed xorshift generator for the loaders' mutation tests: `rnd(n)` is in `0..n`.
+#[cfg(test)]
+pub(crate) fn test_rng(mut seed: u64) -> impl FnMut(usize) -> usize {
+    move |n: usize| {
+        seed ^= seed << 13;
+        seed ^= seed >> 7;
+        seed ^= seed << 17;
+        (seed % n.max(1) as u64) as usize
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -392,13 +403,7 @@ mod tests {
     /// must give `Ok` or a one-line `Err`, never a panic.
     #[test]
     fn mutated_files_never_panic() {
-        let mut seed = 0x9E37_79B9_7F4A_7C15u64;
-        let mut rnd = move |n: usize| {
-            seed ^= seed << 13;
-            seed ^= seed >> 7;
-            seed ^= seed << 17;
-            (seed % n.max(1) as u64) as usize
-        };
+        let mut rnd = test_rng(0x9E37_79B9_7F4A_7C15);
         let files = [
             ("Box.glb", Format::Glb),
             ("SimpleMeshes.gltf", Format::Gltf),
