@@ -625,12 +625,17 @@ fn load_with_units(
     flag: &str,
 ) -> Result<(query::Input, Option<report::InputUnitsReport>)> {
     let spec = &cfg.inputs[i];
-    if !cfg.units.active() {
-        return Ok((query::load_input(spec)?, None));
+    let (mut input, units) = if !cfg.units.active() {
+        (query::load_input(spec)?, None)
+    } else {
+        let (loaded, format) = crate::load::load_path(&spec.path)?;
+        let (multiplier, block, warning) = cfg.units.resolve(i, format, flag);
+        (query::prepare_input(spec, loaded, format, multiplier, warning)?, Some(block))
+    };
+    if cfg.split_bodies {
+        crate::bodies::split_bodies(&mut input.mesh);
     }
-    let (loaded, format) = crate::load::load_path(&spec.path)?;
-    let (multiplier, block, warning) = cfg.units.resolve(i, format, flag);
-    Ok((query::prepare_input(spec, loaded, format, multiplier, warning)?, Some(block)))
+    Ok((input, units))
 }
 
 /// Check one configuration and return the finished report (with finding ids, the baseline
@@ -643,20 +648,18 @@ pub fn check_in_pool(
 ) -> Result<report::Report> {
     progress(Phase::Load);
     let t0 = Instant::now();
-    let (mut a, mut b, units) = if cfg.selection.scene {
-        // `meshclash scene FILE`: one file, its parts against each other.
+    let (first, second, units) = if cfg.selection.scene {
+        // `meshclash scene FILE`: one file, its parts against each other (A and B are the same
+        // input, loaded once).
         let (a, u) = load_with_units(cfg, 1, "--units-a")?;
-        (a.clone(), a, [u.clone(), u])
+        (a, None, [u.clone(), u])
     } else {
         let (a, b) =
             rayon::join(|| load_with_units(cfg, 0, "--units-a"), || load_with_units(cfg, 1, "--units-b"));
         let ((a, ua), (b, ub)) = (a?, b?);
-        (a, b, [ua, ub])
+        (a, Some(b), [ua, ub])
     };
-    if cfg.split_bodies {
-        crate::bodies::split_bodies(&mut a.mesh);
-        crate::bodies::split_bodies(&mut b.mesh);
-    }
+    let (a, b) = (&first, second.as_ref().unwrap_or(&first));
     let load_ms = t0.elapsed().as_secs_f64() * 1e3;
     let size = crate::geom::Aabb::of_points(&a.mesh.positions)
         .union(crate::geom::Aabb::of_points(&b.mesh.positions))
@@ -683,7 +686,7 @@ pub fn check_in_pool(
         None
     };
     let ctx = report::Context {
-        inputs: [&a, &b],
+        inputs: [a, b],
         transforms: [cfg.inputs[0].transform, cfg.inputs[1].transform],
         settings: SettingsReport {
             touch_tolerance: settings.tolerances.touch,
