@@ -6,11 +6,11 @@ use criterion::{black_box, criterion_group, criterion_main, Criterion, Throughpu
 use glam::{DMat4, DVec3};
 use meshclash::bench::gen;
 use meshclash::bvh::{BuildOptions, Bvh, Strategy};
-use meshclash::distance::triangle_distance;
+use meshclash::narrow::distance::triangle_distance;
 use meshclash::geom::Aabb;
-use meshclash::mesh::Mesh;
-use meshclash::query::{check, load_input, InputSpec, Settings};
-use meshclash::tri_tri::{classify, classify_unfiltered, Hit};
+use meshclash::scene::mesh::Mesh;
+use meshclash::check::query::{check, load_input, InputSpec, Settings};
+use meshclash::narrow::tri_tri::{classify, classify_unfiltered, Hit};
 
 /// Deterministic pseudo-random triangle pairs near each other (a mix of crossing and apart).
 fn pairs(n: usize) -> Vec<([DVec3; 3], [DVec3; 3])> {
@@ -44,7 +44,7 @@ fn kernels(c: &mut Criterion) {
     });
 }
 
-fn shared(name: &str) -> Option<meshclash::mesh::Mesh> {
+fn shared(name: &str) -> Option<meshclash::scene::mesh::Mesh> {
     let path = std::path::PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../shared/meshes").join(name);
     load_input(&InputSpec { path, transform: DMat4::IDENTITY }).ok().map(|i| i.mesh)
 }
@@ -61,7 +61,7 @@ fn phases(c: &mut Criterion) {
     let m = DMat4::from_cols_array(&[
         0.8, 0.6, 0.0, 0.0, -0.6, 0.8, 0.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.01, 0.005, 0.002, 1.0,
     ]);
-    meshclash::query::place(&mut moved, &m, std::path::Path::new("bunny")).unwrap();
+    meshclash::check::query::place(&mut moved, &m, std::path::Path::new("bunny")).unwrap();
     g.bench_function("check vs rotated copy", |b| b.iter(|| check(&bunny, &moved, &Settings::default())));
     g.finish();
 }
@@ -74,7 +74,7 @@ type Pair = (u32, u32);
 fn candidates(a: &Mesh, b: &Mesh) -> (Vec<Pair>, Vec<Pair>) {
     let opts = BuildOptions::default();
     let (ta, tb) = (Bvh::build(a, opts), Bvh::build(b, opts));
-    let all: Vec<Pair> = meshclash::traverse::collect_pairs(
+    let all: Vec<Pair> = meshclash::bvh::traverse::collect_pairs(
         &ta,
         &tb,
         |x, y| x.overlaps(y),

@@ -6,8 +6,8 @@
 use criterion::{black_box, criterion_group, criterion_main, BenchmarkId, Criterion};
 use meshclash::bench::{exact_pairs, gen};
 use meshclash::bvh::{BuildOptions, Bvh};
-use meshclash::cross_check::{parry_f32, parry_f64};
-use meshclash::query::{check, Settings};
+use meshclash::check::cross_check::{parry_f32, parry_f64};
+use meshclash::check::query::{check, Settings};
 use std::time::Duration;
 
 fn vs_parry(c: &mut Criterion) {

@@ -6,7 +6,7 @@ use crate::bvh::{BuildOptions, Strategy};
 use crate::error::{Error, Result};
 use crate::geom::predicates::Tolerances;
 use crate::output::progress::Phase;
-use crate::query::{self, DistanceError, FailOn, InputSpec, Mode, Settings};
+use crate::check::query::{self, DistanceError, FailOn, InputSpec, Mode, Settings};
 use crate::report::{self, SettingsReport};
 use clap::{Parser, ValueEnum};
 use glam::{DMat4, DVec3, DVec4};
@@ -236,7 +236,7 @@ pub struct Config {
     /// Run parry3d-f64 too.
     pub cross_check: bool,
     /// Scene mode and part selections.
-    pub selection: crate::assembly::Selection,
+    pub selection: crate::scene::assembly::Selection,
     /// Output format, JUnit and GLB files, baseline.
     pub outputs: crate::output::OutputOptions,
     /// Units and scales (`--units`, `--units-a/-b`, `--scale-a/-b`).
@@ -556,7 +556,7 @@ impl Args {
             max_pairs: self.max_pairs,
             deterministic: self.no_timings,
             cross_check: self.cross_check.is_some(),
-            selection: crate::assembly::Selection {
+            selection: crate::scene::assembly::Selection {
                 scene: scene_mode,
                 select_a: self.select_a.clone(),
                 select_b: self.select_b.clone(),
@@ -633,7 +633,7 @@ fn load_with_units(
         (query::prepare_input(spec, loaded, format, multiplier, warning)?, Some(block))
     };
     if cfg.split_bodies {
-        crate::bodies::split_bodies(&mut input.mesh);
+        crate::scene::bodies::split_bodies(&mut input.mesh);
     }
     Ok((input, units))
 }
@@ -672,14 +672,14 @@ pub fn check_in_pool(
         return Err(Error::Usage("relative tolerance overflows for this model size".into()));
     }
     progress(Phase::Check);
-    let outcome = crate::assembly::run(&a.mesh, &b.mesh, &cfg.selection, &settings)
+    let outcome = crate::scene::assembly::run(&a.mesh, &b.mesh, &cfg.selection, &settings)
         .map_err(|e| Error::input(&cfg.inputs[1].path, e))?;
     let assembly = report::assembly_view(&outcome, cfg.max_pairs);
     let result = outcome.result;
     let failed = cfg.fail_on.fails(result.verdict);
     let cross_check = if cfg.cross_check {
         progress(Phase::CrossCheck);
-        let p = crate::cross_check::parry_f64(&a.mesh, &b.mesh, true)
+        let p = crate::check::cross_check::parry_f64(&a.mesh, &b.mesh, true)
             .map_err(|e| Error::Usage(format!("--cross-check parry: {e}")))?;
         Some(report::cross_check_report(&result, &p, cfg.max_pairs, cfg.deterministic))
     } else {

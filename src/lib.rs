@@ -13,24 +13,17 @@
 //! format. The library never prints.
 #![deny(missing_docs)]
 
-pub mod assembly;
 pub mod bench;
-pub mod bodies;
 pub mod bvh;
+pub mod check;
 pub mod clash_set;
 pub mod cli;
-pub mod containment;
-pub mod cross_check;
-pub mod distance;
 pub mod error;
 pub mod geom;
 pub mod load;
-pub mod mesh;
+pub mod narrow;
 pub mod output;
-pub mod query;
-pub mod regions;
 pub mod report;
-pub mod traverse;
-pub mod tri_tri;
+pub mod scene;
 
 pub use error::{Error, Result};

@@ -4,8 +4,8 @@
 #![allow(clippy::doc_lazy_continuation)] // test helpers: tuple rows and long case docs read better as they are
 
 use glam::DMat4;
-use meshclash::assembly::{check_parts, parts_of, Pairing};
-use meshclash::query::{check, load_input, InputSpec, PairKind, Settings, Verdict};
+use meshclash::scene::assembly::{check_parts, parts_of, Pairing};
+use meshclash::check::query::{check, load_input, InputSpec, PairKind, Settings, Verdict};
 use std::collections::BTreeMap;
 use std::path::PathBuf;
 
@@ -13,12 +13,12 @@ fn shared(name: &str) -> PathBuf {
     PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../shared/meshes").join(name)
 }
 
-fn load(path: PathBuf) -> meshclash::mesh::Mesh {
+fn load(path: PathBuf) -> meshclash::scene::mesh::Mesh {
     load_input(&InputSpec { path, transform: DMat4::IDENTITY }).unwrap().mesh
 }
 
 /// (object a, object b) -> (crossing, touching) from the whole mesh against itself.
-fn by_object(mesh: &meshclash::mesh::Mesh) -> BTreeMap<(u32, u32), (u64, u64)> {
+fn by_object(mesh: &meshclash::scene::mesh::Mesh) -> BTreeMap<(u32, u32), (u64, u64)> {
     let r = check(mesh, mesh, &Settings::default());
     let mut m = BTreeMap::new();
     for p in &r.pairs {
@@ -35,7 +35,7 @@ fn by_object(mesh: &meshclash::mesh::Mesh) -> BTreeMap<(u32, u32), (u64, u64)> {
 }
 
 fn scene_findings(
-    mesh: &meshclash::mesh::Mesh,
+    mesh: &meshclash::scene::mesh::Mesh,
     threads: usize,
 ) -> (BTreeMap<(u32, u32), (u64, u64)>, usize, usize) {
     let parts = parts_of(mesh, 0);
@@ -155,7 +155,7 @@ fn gltf(meshes: &[Vec<([f32; 3], [f32; 3])>], nodes: &[(&str, usize, [f32; 3], [
     .into_bytes()
 }
 
-fn load_gltf(bytes: &[u8]) -> meshclash::mesh::Mesh {
+fn load_gltf(bytes: &[u8]) -> meshclash::scene::mesh::Mesh {
     meshclash::load::load_bytes(std::path::Path::new("scene.gltf"), bytes, meshclash::load::Format::Gltf)
         .unwrap()
         .mesh
@@ -163,9 +163,9 @@ fn load_gltf(bytes: &[u8]) -> meshclash::mesh::Mesh {
 
 /// Every candidate part pair of a scene, by part names, with 1 and 2 threads (which must agree).
 fn scene_pairs(
-    mesh: &meshclash::mesh::Mesh,
+    mesh: &meshclash::scene::mesh::Mesh,
     settings: &Settings,
-) -> (BTreeMap<(String, String), meshclash::query::ClashResult>, meshclash::assembly::AssemblyResult) {
+) -> (BTreeMap<(String, String), meshclash::check::query::ClashResult>, meshclash::scene::assembly::AssemblyResult) {
     let run = |threads: usize| {
         let parts = parts_of(mesh, 0);
         let all: Vec<usize> = (0..parts.len()).collect();
@@ -186,7 +186,7 @@ fn scene_pairs(
 /// The whole-mesh check (no parts, no instancing) grouped by object names: (crossing, touching,
 /// clearance) per pair of objects that has any.
 fn whole_by_name(
-    mesh: &meshclash::mesh::Mesh,
+    mesh: &meshclash::scene::mesh::Mesh,
     settings: &Settings,
 ) -> BTreeMap<(String, String), (u64, u64, u64)> {
     let r = check(mesh, mesh, settings);
@@ -207,7 +207,7 @@ fn whole_by_name(
 }
 
 fn counted(
-    pairs: &BTreeMap<(String, String), meshclash::query::ClashResult>,
+    pairs: &BTreeMap<(String, String), meshclash::check::query::ClashResult>,
 ) -> BTreeMap<(String, String), (u64, u64, u64)> {
     pairs
         .iter()
@@ -258,7 +258,7 @@ fn mirrored_instances_keep_containment_and_face_contacts() {
 
     let inner = &pairs[&key("big", "inner")];
     assert!(inner.pairs.is_empty());
-    assert_eq!(inner.containment, meshclash::containment::Containment::BInA);
+    assert_eq!(inner.containment, meshclash::check::containment::Containment::BInA);
     assert_eq!(inner.verdict, Verdict::Clash);
     // Nearest: inner's face x = 4 and big's x = 0 are 4 apart, its face y = 2 is 2 from y = 0,
     // z likewise; the closest is 2 (faces y = 2 / y = 0 or z = 2 / z = 0).
@@ -267,13 +267,13 @@ fn mirrored_instances_keep_containment_and_face_contacts() {
     let outside = &pairs[&key("big", "outside")];
     assert_eq!(outside.counts.crossing, 0);
     assert!(outside.counts.touching > 0);
-    assert_eq!(outside.containment, meshclash::containment::Containment::None);
+    assert_eq!(outside.containment, meshclash::check::containment::Containment::None);
     assert_eq!(outside.verdict, Verdict::Touching);
 
     let flush = &pairs[&key("big", "flush")];
     assert_eq!(flush.counts.crossing, 0);
     assert!(flush.counts.touching > 0);
-    assert_eq!(flush.containment, meshclash::containment::Containment::VolumesOverlap);
+    assert_eq!(flush.containment, meshclash::check::containment::Containment::VolumesOverlap);
     assert_eq!(flush.verdict, Verdict::Clash);
 
     // The triangle pairs are those of the whole-mesh check, which copies and shares nothing.
@@ -324,12 +324,12 @@ fn non_uniform_scaled_instance_touches_exactly_and_misses_by_one_ulp() {
     assert!(t.counts.touching > 0, "the exact face contact was culled");
     assert_eq!(t.verdict, Verdict::Touching);
     // Opposite outward normals (n is mirrored: its listed winding faces inward): contact only.
-    assert_eq!(t.containment, meshclash::containment::Containment::None);
+    assert_eq!(t.containment, meshclash::check::containment::Containment::None);
 
     let m = &pairs[&key("n", "miss")];
     assert!(m.pairs.is_empty());
     assert_eq!(m.verdict, Verdict::Clear);
-    assert_eq!(m.containment, meshclash::containment::Containment::None);
+    assert_eq!(m.containment, meshclash::check::containment::Containment::None);
     assert_eq!(m.closest.unwrap().distance, ulp);
 
     let p = &pairs[&key("lead", "partner")];

@@ -2,12 +2,12 @@
 //! against brute force over every triangle pair, on random small meshes rich in exact contacts.
 
 use meshclash::bvh::{BuildOptions, Strategy as Split};
-use meshclash::distance::triangle_distance;
+use meshclash::narrow::distance::triangle_distance;
 use meshclash::geom::predicates::Tolerances;
 use meshclash::geom::DVec3;
-use meshclash::mesh::{Mesh, Object};
-use meshclash::query::{check, PairKind, Settings};
-use meshclash::tri_tri::classify;
+use meshclash::scene::mesh::{Mesh, Object};
+use meshclash::check::query::{check, PairKind, Settings};
+use meshclash::narrow::tri_tri::classify;
 use proptest::prelude::*;
 
 fn mesh(tris: &[[DVec3; 3]]) -> Mesh {

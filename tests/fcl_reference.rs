@@ -2,9 +2,9 @@
 //! (`fcl_env_rob_reference.json`, python-fcl 0.7 OBBRSS): env moved, rob fixed.
 
 use glam::{DMat4, DVec4};
-use meshclash::distance::triangle_distance;
-use meshclash::query::{check, load_input, place, InputSpec, Settings, Verdict};
-use meshclash::tri_tri::classify;
+use meshclash::narrow::distance::triangle_distance;
+use meshclash::check::query::{check, load_input, place, InputSpec, Settings, Verdict};
+use meshclash::narrow::tri_tri::classify;
 use serde_json::Value;
 use std::path::PathBuf;
 
@@ -12,7 +12,7 @@ fn shared(name: &str) -> PathBuf {
     PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../shared/meshes").join(name)
 }
 
-fn load(name: &str) -> meshclash::mesh::Mesh {
+fn load(name: &str) -> meshclash::scene::mesh::Mesh {
     load_input(&InputSpec { path: shared(name), transform: DMat4::IDENTITY }).unwrap().mesh
 }
 
@@ -67,7 +67,7 @@ fn identity_pose_clashes_and_matches_exhaustive_search() {
     let r = check(&env, &rob, &Settings::default());
     assert_eq!(r.verdict, Verdict::Clash);
     // Every one of the 2180 × 216 pairs, classified exactly, with no tree in between.
-    let tri = |m: &meshclash::mesh::Mesh, t: usize| m.triangles[t].map(|i| m.positions[i as usize]);
+    let tri = |m: &meshclash::scene::mesh::Mesh, t: usize| m.triangles[t].map(|i| m.positions[i as usize]);
     let mut want = Vec::new();
     let mut nearest_other = f64::INFINITY;
     for i in 0..env.triangles.len() {

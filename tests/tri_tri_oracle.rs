@@ -1,4 +1,4 @@
-//! Independent exact oracle for `meshclash::tri_tri::classify`.
+//! Independent exact oracle for `meshclash::narrow::tri_tri::classify`.
 //!
 //! The f64 coordinates of both triangles are converted exactly to integers (all f64 are dyadic
 //! rationals: multiply by one common power of two, which changes no verdict), and the
@@ -17,7 +17,7 @@
 #![allow(clippy::doc_lazy_continuation)] // test helpers: tuple rows and long case docs read better as they are
 
 use meshclash::geom::DVec3;
-use meshclash::tri_tri::{classify, Contact, Hit};
+use meshclash::narrow::tri_tri::{classify, Contact, Hit};
 use num_bigint::BigInt;
 use num_rational::BigRational;
 use num_traits::{One, Signed, ToPrimitive, Zero};

@@ -3,7 +3,7 @@
 //! near-degenerate inputs on which plain f64 predicates change answers.
 
 use crate::geom::{Aabb, DVec3};
-use crate::mesh::{Mesh, Object};
+use crate::scene::mesh::{Mesh, Object};
 use glam::DMat4;
 
 /// A torus around the z axis (major radius 1, minor 0.35) with `2·u·v ≈ n` triangles, u = 2v.

@@ -9,7 +9,7 @@
 //!   bits of the skip word, so a node is 56 bytes like [`crate::bvh::Node`].
 //!
 //! The workload: for each leaf of tree A, find every leaf of tree B whose box overlaps it (the
-//! "one-tree" alternative to the dual walk of [`crate::traverse`]).
+//! "one-tree" alternative to the dual walk of [`crate::bvh::traverse`]).
 
 use crate::bvh::Bvh;
 use crate::geom::Aabb;

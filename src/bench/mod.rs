@@ -27,14 +27,14 @@ pub mod svg;
 pub mod sweep;
 
 use crate::bvh::{self, BuildOptions, Bvh, Strategy};
-use crate::cross_check::{self, ParryResult};
+use crate::check::cross_check::{self, ParryResult};
 use crate::error::{Error, Result};
 use crate::geom::predicates;
 use crate::geom::Aabb;
-use crate::mesh::Mesh;
-use crate::query::{self, ClashResult, DistanceError, Mode, Settings};
-use crate::traverse;
-use crate::tri_tri;
+use crate::scene::mesh::Mesh;
+use crate::check::query::{self, ClashResult, DistanceError, Mode, Settings};
+use crate::bvh::traverse;
+use crate::narrow::tri_tri;
 use serde::Serialize;
 use std::path::PathBuf;
 use std::sync::atomic::{AtomicBool, Ordering};
@@ -375,8 +375,8 @@ type ExactPair = (u32, u32, bool);
 
 /// The pairs phase: dual walk, exact classification of every candidate (zero tolerances).
 pub fn exact_pairs(a: &Mesh, ta: &Bvh, b: &Mesh, tb: &Bvh) -> Vec<ExactPair> {
-    let (pairs, _) = crate::query::find_pairs(a, ta, b, tb, &Settings::default());
-    pairs.iter().map(|p| (p.a, p.b, p.kind == crate::query::PairKind::Crossing)).collect()
+    let (pairs, _) = crate::check::query::find_pairs(a, ta, b, tb, &Settings::default());
+    pairs.iter().map(|p| (p.a, p.b, p.kind == crate::check::query::PairKind::Crossing)).collect()
 }
 
 /// The distance a standalone distance query needs: 0 at the first contact found, else the
@@ -414,7 +414,7 @@ pub fn distance_within(a: &Mesh, ta: &Bvh, b: &Mesh, tb: &Bvh, err: DistanceErro
     if !hit.is_empty() {
         return Some(0.0);
     }
-    crate::query::closest_pair(a, ta, b, tb, err).map(|c| c.distance)
+    crate::check::query::closest_pair(a, ta, b, tb, err).map(|c| c.distance)
 }
 
 /// Candidate triangle pairs (boxes overlap), at most `cap`.

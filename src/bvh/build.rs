@@ -480,7 +480,7 @@ fn partition(items: &mut [Item], left: impl Fn(&Item) -> bool) -> (usize, Box32,
 mod tests {
     use super::*;
     use crate::bench::gen;
-    use crate::mesh::Mesh;
+    use crate::scene::mesh::Mesh;
 
     fn boxes(m: &Mesh) -> Vec<Aabb> {
         (0..m.triangles.len() as u32).map(|t| Aabb::of_triangle(&super::super::triangle(m, t))).collect()

@@ -10,9 +10,10 @@
 
 mod build;
 mod validate;
+pub mod traverse;
 
 use crate::geom::{Aabb, DVec3};
-use crate::mesh::Mesh;
+use crate::scene::mesh::Mesh;
 
 /// A BVH node: 56 bytes (two f64 corners = 48, two u32 = 8), checked at compile time.
 #[derive(Debug, Clone, Copy, PartialEq)]

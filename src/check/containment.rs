@@ -17,9 +17,9 @@
 
 use crate::geom::predicates as pr;
 use crate::geom::{Aabb, DVec3};
-use crate::mesh::TriMesh;
-use crate::traverse::Tree;
-use crate::tri_tri::Shape;
+use crate::scene::mesh::TriMesh;
+use crate::bvh::traverse::Tree;
+use crate::narrow::tri_tri::Shape;
 use std::collections::HashMap;
 
 /// Closedness and components of one mesh.
@@ -43,8 +43,8 @@ pub fn topology<M: TriMesh + ?Sized>(mesh: &M) -> Topology {
     use rayon::prelude::*;
     // Merge exactly coincident vertices by sorting their bit patterns (parallel; a hash map of
     // millions of keys was most of the cost of a check on large inputs).
-    let (merged, distinct) = crate::bodies::merge_vertices(&mesh.positions());
-    use crate::bodies::{find, union};
+    let (merged, distinct) = crate::scene::bodies::merge_vertices(&mesh.positions());
+    use crate::scene::bodies::{find, union};
     let mut parent: Vec<u32> = (0..distinct as u32).collect();
     let proper: Vec<bool> = (0..mesh.triangle_count() as u32)
         .into_par_iter()
@@ -238,7 +238,7 @@ pub fn point_in_closed_mesh<M: TriMesh + ?Sized, T: Tree + ?Sized>(p: DVec3, m: 
         let q = p + DVec3::from(d) * reach;
         let seg = Aabb { min: p.min(q), max: p.max(q) };
         let mut crossings = 0usize;
-        let degenerate = crate::traverse::any_in_box(t, &seg, |tri| {
+        let degenerate = crate::bvh::traverse::any_in_box(t, &seg, |tri| {
             let [a, b, c] = m.triangle(tri);
             match segment_crosses(p, q, a, b, c) {
                 Crossing::No => false,
@@ -276,8 +276,8 @@ pub fn winding_number<M: TriMesh + ?Sized>(p: DVec3, m: &M) -> f64 {
 
 /// Is `p` exactly on a triangle of `m`?
 pub fn on_surface<M: TriMesh + ?Sized, T: Tree + ?Sized>(p: DVec3, m: &M, t: &T) -> bool {
-    crate::traverse::any_in_box(t, &Aabb { min: p, max: p }, |tri| {
-        crate::tri_tri::classify(&[p, p, p], &m.triangle(tri)).is_some()
+    crate::bvh::traverse::any_in_box(t, &Aabb { min: p, max: p }, |tri| {
+        crate::narrow::tri_tri::classify(&[p, p, p], &m.triangle(tri)).is_some()
     })
 }
 
@@ -465,7 +465,7 @@ where
 mod tests {
     use super::*;
     use crate::bvh::{BuildOptions, Bvh};
-    use crate::mesh::{Mesh, Object};
+    use crate::scene::mesh::{Mesh, Object};
 
     /// An axis-aligned box as 12 triangles, outward-facing.
     pub(crate) fn cube(min: DVec3, max: DVec3) -> Mesh {

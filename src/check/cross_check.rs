@@ -58,7 +58,7 @@
 //! a non-finite coordinate (GJK asserts its bounds are finite) — for the f32 variant this
 //! includes f64 values that overflow f32.
 
-use crate::mesh::Mesh;
+use crate::scene::mesh::Mesh;
 
 /// What parry3d reports for the same two meshes (already in world coordinates).
 #[derive(Debug, Clone, PartialEq)]
@@ -262,7 +262,7 @@ mod tests {
     fn mesh(positions: Vec<DVec3>, triangles: Vec<[u32; 3]>) -> Mesh {
         Mesh {
             tri_object: vec![0; triangles.len()],
-            objects: vec![crate::mesh::Object { name: "o".into(), ..Default::default() }],
+            objects: vec![crate::scene::mesh::Object { name: "o".into(), ..Default::default() }],
             positions,
             triangles,
         }

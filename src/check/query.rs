@@ -1,19 +1,19 @@
 //! Orchestration: load and place both inputs, build both trees, walk them, classify, and return
 //! plain result structs ([`ClashResult`]) that [`crate::report`] turns into JSON.
 //!
-//! Every candidate pair is classified exactly ([`crate::tri_tri`]); distances (for tolerance
-//! bands, clearance and the closest pair) are f64 closed forms ([`crate::distance`]).
+//! Every candidate pair is classified exactly ([`crate::narrow::tri_tri`]); distances (for tolerance
+//! bands, clearance and the closest pair) are f64 closed forms ([`crate::narrow::distance`]).
 
 use crate::bvh::{self, BuildOptions, Bvh};
-use crate::containment::{self, Containment};
-use crate::distance::triangle_distance;
+use crate::check::containment::{self, Containment};
+use crate::narrow::distance::triangle_distance;
 use crate::error::{Error, Result};
 use crate::geom::predicates::{self, Tolerances};
 use crate::geom::{Aabb, DVec3};
 use crate::load::{self, Format};
-use crate::mesh::{Mesh, TriMesh};
-use crate::traverse::{self, Candidate, Tree};
-use crate::tri_tri::{self, Contact, Shape};
+use crate::scene::mesh::{Mesh, TriMesh};
+use crate::bvh::traverse::{self, Candidate, Tree};
+use crate::narrow::tri_tri::{self, Contact, Shape};
 use glam::DMat4;
 use rayon::prelude::*;
 use std::path::{Path, PathBuf};
@@ -99,7 +99,7 @@ pub fn load_input(spec: &InputSpec) -> Result<Input> {
 /// the loader's (e.g. that the units were assumed).
 pub fn prepare_input(
     spec: &InputSpec,
-    loaded: crate::mesh::Loaded,
+    loaded: crate::scene::mesh::Loaded,
     format: load::Format,
     multiplier: f64,
     note: Option<String>,
@@ -337,7 +337,7 @@ pub struct ClashResult {
     pub verdict: Verdict,
     /// Whether one part hides inside the other (decided only when no triangles meet).
     pub containment: Containment,
-    /// Whether each input is closed (see [`crate::containment::topology`]).
+    /// Whether each input is closed (see [`crate::check::containment::topology`]).
     pub closed: [bool; 2],
     /// The two trees.
     pub trees: [TreeStats; 2],

@@ -5,15 +5,15 @@
 //! (exactly coincident positions) or their B triangles do — which also joins pairs that share a
 //! triangle. Each region gets a centre, a box and an extent from the pairs' shared segments (or,
 //! for coplanar contacts, the triangles' boxes), and a stable id: the smallest finding id
-//! ([`crate::output::baseline::finding_id`], derived from geometry and part names) among its
+//! ([`crate::report::baseline::finding_id`], derived from geometry and part names) among its
 //! pairs, so ids do not depend on thread timing or file order.
 
-use crate::bodies::{find, union, vertex_key};
+use crate::scene::bodies::{find, union, vertex_key};
 use crate::bvh::{self, BuildOptions, Bvh};
-use crate::containment::{self, Inside};
+use crate::check::containment::{self, Inside};
 use crate::geom::{Aabb, DVec3};
-use crate::mesh::Mesh;
-use crate::query::{PairFinding, PairKind};
+use crate::scene::mesh::Mesh;
+use crate::check::query::{PairFinding, PairKind};
 use rayon::prelude::*;
 use std::collections::HashMap;
 
@@ -100,7 +100,7 @@ pub fn regions(pairs: &[PairFinding], a: &Mesh, b: &Mesh) -> Vec<Region> {
                 bounds = bounds.grow(lo).grow(hi);
                 sum += lo * 0.5 + hi * 0.5;
                 crossing += (p.kind == PairKind::Crossing) as usize;
-                let fid = crate::output::baseline::finding_id(a, p.a, b, p.b);
+                let fid = crate::report::baseline::finding_id(a, p.a, b, p.b);
                 if id.as_ref().is_none_or(|m| fid < *m) {
                     id = Some(fid);
                 }
@@ -135,7 +135,7 @@ fn point_distance(p: DVec3, m: &Mesh, t: &Bvh) -> f64 {
         if n.is_leaf() {
             for &tri in t.leaf_prims(n) {
                 let [a, b, c] = bvh::triangle(m, tri);
-                best = best.min((crate::distance::closest_point_on_triangle(p, a, b, c) - p).length());
+                best = best.min((crate::narrow::distance::closest_point_on_triangle(p, a, b, c) - p).length());
             }
         } else {
             let (l, r) = (i + 1, n.a);
@@ -201,7 +201,7 @@ pub fn estimate_penetration(
             ((side, o), solid)
         })
         .collect();
-    let merged = [crate::bodies::merge_vertices(&a.positions), crate::bodies::merge_vertices(&b.positions)];
+    let merged = [crate::scene::bodies::merge_vertices(&a.positions), crate::scene::bodies::merge_vertices(&b.positions)];
     // Per part pair: which triangles of each side meet the other part.
     let mut cut: HashMap<(u32, u32), [Vec<u32>; 2]> = HashMap::new();
     for p in pairs {
@@ -362,8 +362,8 @@ fn side_depth(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::mesh::Object;
-    use crate::query::{check, Settings};
+    use crate::scene::mesh::Object;
+    use crate::check::query::{check, Settings};
 
     fn plate(z: f64, x0: f64) -> Vec<[DVec3; 3]> {
         // A 4×1 strip of quads in the plane x = const... a vertical fin at x = x0.

@@ -68,7 +68,7 @@ use super::gltf_data::{
     load_buffers, parse_document, parse_extensions, split_glb, Extensions, GpuInstancing, Reader,
 };
 use crate::error::{Error, Result};
-use crate::mesh::{Loaded, Mesh, Object};
+use crate::scene::mesh::{Loaded, Mesh, Object};
 
 /// The deepest node hierarchy accepted.
 pub(crate) const MAX_DEPTH: usize = 1024;

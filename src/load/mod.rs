@@ -19,7 +19,7 @@
 use std::path::Path;
 
 use crate::error::{Error, Result};
-use crate::mesh::Loaded;
+use crate::scene::mesh::Loaded;
 
 mod gltf;
 mod gltf_data;
@@ -235,7 +235,7 @@ pub(crate) fn clip(s: &str, max: usize) -> String {
 }
 
 /// Drops objects without triangles and renumbers `tri_object`, keeping first-appearance order.
-pub(crate) fn drop_empty_objects(mesh: &mut crate::mesh::Mesh) {
+pub(crate) fn drop_empty_objects(mesh: &mut crate::scene::mesh::Mesh) {
     let mut used = vec![false; mesh.objects.len()];
     for &o in &mesh.tri_object {
         if let Some(u) = used.get_mut(o as usize) {
@@ -370,7 +370,7 @@ mod tests {
 
     #[test]
     fn validate_catches_bad_meshes() {
-        use crate::mesh::{Mesh, Object};
+        use crate::scene::mesh::{Mesh, Object};
         use glam::DVec3;
         let obj = || Object { name: "a".into(), ..Default::default() };
         let mut m = Loaded {
@@ -448,7 +448,7 @@ mod tests {
 
     #[test]
     fn drop_empty_objects_renumbers() {
-        use crate::mesh::{Mesh, Object};
+        use crate::scene::mesh::{Mesh, Object};
         let o = |n: &str| Object { name: n.into(), ..Default::default() };
         let mut m = Mesh {
             positions: vec![],

@@ -26,7 +26,7 @@ use glam::DVec3;
 
 use super::{clip, drop_empty_objects, non_finite};
 use crate::error::{Error, Result};
-use crate::mesh::{Loaded, Mesh, Object};
+use crate::scene::mesh::{Loaded, Mesh, Object};
 
 /// How many unrecognised lines are reported individually before summarising.
 const MAX_LINE_WARNINGS: usize = 10;

@@ -21,7 +21,7 @@ use glam::DVec3;
 
 use super::{clip, drop_empty_objects, non_finite};
 use crate::error::{Error, Result};
-use crate::mesh::{Loaded, Mesh, Object};
+use crate::scene::mesh::{Loaded, Mesh, Object};
 
 const HEADER: usize = 84;
 const FACET: u64 = 50;

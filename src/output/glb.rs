@@ -14,7 +14,7 @@
 //! Highlight and marker nodes are present only when they have something to show. Only the
 //! report's listed pairs are drawn (`--max-pairs`).
 
-use crate::mesh::Mesh;
+use crate::scene::mesh::Mesh;
 use crate::report::Report;
 use glam::DVec3;
 use serde_json::{json, Value};

@@ -6,15 +6,15 @@
 //! Everything here returns strings or bytes, or writes the files it was asked to write; the
 //! library never prints. The binary decides what goes to stdout and stderr.
 
-pub mod baseline;
 pub mod glb;
 pub mod junit;
 pub mod progress;
 pub mod text;
 
+use crate::report::baseline;
 use crate::error::{Error, Result};
-use crate::mesh::Mesh;
-use crate::query::ClashResult;
+use crate::scene::mesh::Mesh;
+use crate::check::query::ClashResult;
 use crate::report::{self, Report};
 use clap::CommandFactory;
 use std::path::PathBuf;

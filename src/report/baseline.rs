@@ -20,8 +20,8 @@
 //! New touching or clearance pairs are listed but do not fail it.
 
 use crate::error::{Error, Result};
-use crate::mesh::Mesh;
-use crate::query::{PairFinding, PairKind};
+use crate::scene::mesh::Mesh;
+use crate::check::query::{PairFinding, PairKind};
 use crate::report::Report;
 use serde::{Deserialize, Serialize};
 use std::collections::{BTreeSet, HashMap, HashSet};
@@ -205,7 +205,7 @@ pub fn fails_on_new(b: &BaselineReport) -> bool {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::mesh::Object;
+    use crate::scene::mesh::Object;
     use glam::DVec3;
 
     fn mesh(tris: &[[[f64; 3]; 3]], name: &str) -> Mesh {

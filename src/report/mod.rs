@@ -53,9 +53,11 @@
 //! Triangle indices are 0-based in file order (see [`crate::load`]); `object` / `a_object`
 //! index into `inputs.*.objects`.
 
+pub mod baseline;
+
 use crate::error::{Error, Result};
 use crate::geom::{Aabb, DVec3};
-use crate::query::{ClashResult, Input, PairFinding, TreeStats, Verdict};
+use crate::check::query::{ClashResult, Input, PairFinding, TreeStats, Verdict};
 use glam::DMat4;
 use serde::{Deserialize, Serialize};
 use std::io::Write;
@@ -107,7 +109,7 @@ pub struct Report {
     pub timings_ms: Option<TimingsReport>,
     /// With `--baseline`: the comparison with the earlier report; absent otherwise.
     #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub baseline: Option<crate::output::baseline::BaselineReport>,
+    pub baseline: Option<crate::report::baseline::BaselineReport>,
 }
 
 /// How deep one part reaches into the other at a region.
@@ -237,7 +239,7 @@ pub struct PartPairReport {
 
 /// Build the v2 part view from an assembly outcome.
 pub fn assembly_view(
-    o: &crate::assembly::Outcome,
+    o: &crate::scene::assembly::Outcome,
     max_pairs: usize,
 ) -> (AssemblyReport, Vec<PartReport>, Vec<PartPairReport>) {
     let parts = o
@@ -321,12 +323,12 @@ pub struct CrossCheckReport {
 /// Compare our result with parry's.
 pub fn cross_check_report(
     r: &ClashResult,
-    p: &crate::cross_check::ParryResult,
+    p: &crate::check::cross_check::ParryResult,
     max: usize,
     deterministic: bool,
 ) -> CrossCheckReport {
     let ours: Vec<(u32, u32)> = r.pairs.iter().filter(|f| f.contact.is_some()).map(|f| (f.a, f.b)).collect();
-    let (only_ours, only_parry) = crate::cross_check::diff_pairs(&ours, &p.intersecting_pairs);
+    let (only_ours, only_parry) = crate::check::cross_check::diff_pairs(&ours, &p.intersecting_pairs);
     let ours_min = r.closest.map_or(f64::NAN, |c| c.distance);
     let list = |v: &[(u32, u32)]| v.iter().take(max).map(|&(a, b)| [a, b]).collect();
     CrossCheckReport {
@@ -616,7 +618,7 @@ fn v3(p: DVec3) -> [f64; 3] {
     p.to_array()
 }
 
-fn input_report(input: &Input, m: &DMat4, info: &crate::query::MeshInfo, closed: bool) -> InputReport {
+fn input_report(input: &Input, m: &DMat4, info: &crate::check::query::MeshInfo, closed: bool) -> InputReport {
     let Aabb { min, max } = info.bounds;
     InputReport {
         path: input.path.display().to_string(),
@@ -645,7 +647,7 @@ fn pair_report(p: &PairFinding, ca: &[u32], cb: &[u32]) -> PairReport {
         kind: p.kind.name().to_string(),
         contact: match (p.contact, p.kind) {
             (Some(c), _) => Some(c.name().to_string()),
-            (None, crate::query::PairKind::Touching) => Some("within_tolerance".to_string()),
+            (None, crate::check::query::PairKind::Touching) => Some("within_tolerance".to_string()),
             (None, _) => None,
         },
         distance: p.distance,
@@ -658,7 +660,7 @@ fn pair_report(p: &PairFinding, ca: &[u32], cb: &[u32]) -> PairReport {
 /// Assemble the report.
 pub fn build(ctx: &Context, r: &ClashResult) -> Report {
     let [ia, ib] = ctx.inputs;
-    let (infa, infb) = (crate::query::MeshInfo::of(&ia.mesh), crate::query::MeshInfo::of(&ib.mesh));
+    let (infa, infb) = (crate::check::query::MeshInfo::of(&ia.mesh), crate::check::query::MeshInfo::of(&ib.mesh));
     let (oa, ob) = (&ia.mesh.tri_object, &ib.mesh.tri_object);
     let max = ctx.settings.max_pairs;
     let warnings = ctx
@@ -684,7 +686,7 @@ pub fn build(ctx: &Context, r: &ClashResult) -> Report {
             min_distance: r.closest.map(|c| c.distance),
             contained: r.containment.name().map(str::to_string),
             contained_reason: match &r.containment {
-                crate::containment::Containment::Undecided(why) => Some(why.clone()),
+                crate::check::containment::Containment::Undecided(why) => Some(why.clone()),
                 _ => None,
             },
         },
@@ -701,10 +703,10 @@ pub fn build(ctx: &Context, r: &ClashResult) -> Report {
         parts: ctx.assembly.1.clone(),
         part_pairs: ctx.assembly.2.clone(),
         regions: {
-            let mut regs = crate::regions::regions(&r.pairs, &ia.mesh, &ib.mesh);
+            let mut regs = crate::check::regions::regions(&r.pairs, &ia.mesh, &ib.mesh);
             if ctx.settings.penetration && !ctx.settings.first_hit {
                 let opts = crate::bvh::BuildOptions::default();
-                crate::regions::estimate_penetration(&mut regs, &r.pairs, &ia.mesh, &ib.mesh, opts);
+                crate::check::regions::estimate_penetration(&mut regs, &r.pairs, &ia.mesh, &ib.mesh, opts);
             }
             regs
         }

@@ -4,7 +4,7 @@
 //! Part pairs are found by a broad phase over the parts' world boxes (a BVH over part boxes,
 //! walked against itself or the other set with the same dual walk as triangles); only parts that
 //! take part in some candidate pair get a triangle BVH, built lazily and in parallel, and each
-//! candidate pair is checked exactly with [`crate::query::check_built`]. Parts whose boxes never
+//! candidate pair is checked exactly with [`crate::check::query::check_built`]. Parts whose boxes never
 //! come within the search margin of another cost nothing beyond their box.
 //!
 //! Nothing is copied per part: a part is a view of the loaded mesh (its world coordinates, as
@@ -23,12 +23,12 @@
 //! refitted copy of the leader's tree (exact boxes, a copy of the nodes).
 
 use crate::bvh::{BuildOptions, Bvh, Node};
-use crate::containment::Containment;
+use crate::check::containment::Containment;
 use crate::geom::predicates::BoxMap;
 use crate::geom::{Aabb, DVec3};
-use crate::mesh::{Mesh, Object, TriMesh};
-use crate::query::{check_built, ClashResult, PairFinding, Settings, Verdict};
-use crate::traverse::{self, Tree};
+use crate::scene::mesh::{Mesh, Object, TriMesh};
+use crate::check::query::{check_built, ClashResult, PairFinding, Settings, Verdict};
+use crate::bvh::traverse::{self, Tree};
 use rayon::prelude::*;
 use std::collections::HashMap;
 use std::time::Instant;
@@ -655,13 +655,13 @@ pub struct PartPairSummary {
     /// The pair's verdict.
     pub verdict: Verdict,
     /// Counts by kind.
-    pub counts: crate::query::Counts,
+    pub counts: crate::check::query::Counts,
     /// Minimum distance, when known (checked pairs; or 0 for meeting pairs in file mode).
     pub min_distance: Option<f64>,
     /// Containment between the two parts.
     pub containment: Containment,
     /// The witness of `min_distance`: triangles (input indices) and points, when known.
-    pub closest: Option<crate::query::Closest>,
+    pub closest: Option<crate::check::query::Closest>,
     /// The pair's triangle pairs (input triangle indices), sorted; the report lists a capped
     /// number of them.
     pub pairs: Vec<(u32, u32)>,
@@ -727,7 +727,7 @@ pub fn run(a: &Mesh, b: &Mesh, sel: &Selection, settings: &Settings) -> Result<O
         }
     }
     if !sel.by_parts() {
-        let result = crate::query::check(a, b, settings);
+        let result = crate::check::query::check(a, b, settings);
         let part_pairs = group_by_part(&parts, a, b, &result);
         let info = AssemblyInfo {
             mode: "files",
@@ -744,9 +744,9 @@ pub fn run(a: &Mesh, b: &Mesh, sel: &Selection, settings: &Settings) -> Result<O
     let mut pairs_seen = std::collections::HashSet::new();
     let mut merged: Vec<PairFinding> = Vec::new();
     let mut part_pairs = Vec::new();
-    let mut closest: Option<crate::query::Closest> = None;
+    let mut closest: Option<crate::check::query::Closest> = None;
     let mut containment = Containment::None;
-    let mut counts = crate::query::Counts::default();
+    let mut counts = crate::check::query::Counts::default();
     for pp in &ar.part_pairs {
         let (x, y) = (pp.a.min(pp.b), pp.a.max(pp.b));
         if x == y || !pairs_seen.insert((x, y)) {
@@ -794,7 +794,7 @@ pub fn run(a: &Mesh, b: &Mesh, sel: &Selection, settings: &Settings) -> Result<O
         containment,
         closed: [false, false],
         trees: [crate::bvh::Stats { nodes: 0, leaves: 0, depth: 0, sah_cost: 0.0, bytes: 0 }; 2],
-        timings: crate::query::Timings { build_ms: ar.build_ms, query_ms: ar.query_ms },
+        timings: crate::check::query::Timings { build_ms: ar.build_ms, query_ms: ar.query_ms },
     };
     Ok(Outcome { result, parts: ar.parts, part_pairs, info })
 }
@@ -822,7 +822,7 @@ fn group_by_part(parts: &[Part], a: &Mesh, b: &Mesh, r: &ClashResult) -> Vec<Par
         e.pairs.push((p.a, p.b));
         // Pairs come sorted by (a, b): the first of the smallest distance is the witness.
         if e.closest.is_none_or(|c| p.distance < c.distance) {
-            e.closest = Some(crate::query::pair_witness(a, b, p));
+            e.closest = Some(crate::check::query::pair_witness(a, b, p));
         }
         e.min_distance = e.closest.map(|c| c.distance);
     }

@@ -18,7 +18,7 @@
 //! only `tri_object` and `objects` are rewritten. Split glTF instances lose their `gltf_mesh`
 //! link (the bodies are no longer whole instances of that mesh).
 
-use crate::mesh::{Mesh, Object};
+use crate::scene::mesh::{Mesh, Object};
 use glam::DVec3;
 use rayon::prelude::*;
 

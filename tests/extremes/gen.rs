@@ -8,7 +8,7 @@
 //! gaps and penetrations) are applied in world coordinates with [`Frame::offset`].
 
 use meshclash::geom::DVec3;
-use meshclash::mesh::{Mesh, Object};
+use meshclash::scene::mesh::{Mesh, Object};
 
 /// How faithfully a frame carries a construction.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord)]

@@ -8,7 +8,7 @@
 //! Only `Contact` (a label) is taken from the library.
 
 use meshclash::geom::DVec3;
-use meshclash::tri_tri::Contact;
+use meshclash::narrow::tri_tri::Contact;
 use num_rational::BigRational;
 use num_traits::{Signed, ToPrimitive, Zero};
 

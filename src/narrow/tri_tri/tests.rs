@@ -368,15 +368,15 @@ fn replay_candidates_for_profiling() {
         "bunny" => {
             let path = std::path::PathBuf::from(env!("CARGO_MANIFEST_DIR"))
                 .join("../shared/meshes/stanford-bunny.obj");
-            let spec = crate::query::InputSpec { path, transform: glam::DMat4::IDENTITY };
-            let m = crate::query::load_input(&spec).unwrap().mesh;
+            let spec = crate::check::query::InputSpec { path, transform: glam::DMat4::IDENTITY };
+            let m = crate::check::query::load_input(&spec).unwrap().mesh;
             (gen::rotated_copy(&m), m)
         }
         _ => gen::crossing_tori(100_000),
     };
     let opts = BuildOptions::default();
     let (ta, tb) = (Bvh::build(&a, opts), Bvh::build(&b, opts));
-    let cands: Vec<(u32, u32)> = crate::traverse::collect_pairs(
+    let cands: Vec<(u32, u32)> = crate::bvh::traverse::collect_pairs(
         &ta,
         &tb,
         |x, y| x.overlaps(y),

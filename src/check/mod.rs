@@ -1,0 +1,8 @@
+//! The checks run over two meshes: [`query`] (candidate pairs, exact classification, closest
+//! pair), [`containment`] (closed-mesh topology and winding numbers), [`regions`] (clash regions
+//! and penetration estimates), [`cross_check`] (the parry3d reference comparison).
+
+pub mod containment;
+pub mod cross_check;
+pub mod query;
+pub mod regions;
