@@ -236,7 +236,7 @@ pub struct Config {
     /// Run parry3d-f64 too.
     pub cross_check: bool,
     /// Scene mode and part selections.
-    pub selection: crate::scene::assembly::Selection,
+    pub selection: crate::check::assembly::Selection,
     /// Output format, JUnit and GLB files, baseline.
     pub outputs: crate::output::OutputOptions,
     /// Units and scales (`--units`, `--units-a/-b`, `--scale-a/-b`).
@@ -556,7 +556,7 @@ impl Args {
             max_pairs: self.max_pairs,
             deterministic: self.no_timings,
             cross_check: self.cross_check.is_some(),
-            selection: crate::scene::assembly::Selection {
+            selection: crate::check::assembly::Selection {
                 scene: scene_mode,
                 select_a: self.select_a.clone(),
                 select_b: self.select_b.clone(),
@@ -672,7 +672,7 @@ pub fn check_in_pool(
         return Err(Error::Usage("relative tolerance overflows for this model size".into()));
     }
     progress(Phase::Check);
-    let outcome = crate::scene::assembly::run(&a.mesh, &b.mesh, &cfg.selection, &settings)
+    let outcome = crate::check::assembly::run(&a.mesh, &b.mesh, &cfg.selection, &settings)
         .map_err(|e| Error::input(&cfg.inputs[1].path, e))?;
     let assembly = report::assembly_view(&outcome, cfg.max_pairs);
     let result = outcome.result;

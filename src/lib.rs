@@ -2,15 +2,18 @@
 //!
 //! Do two triangle meshes clash, where, and how close do they come?
 //!
-//! The pipeline: [`load`] reads OBJ, STL or glTF into a [`mesh::Mesh`] (f64 positions, u32
-//! triangles, an object per triangle); [`bvh`] builds a bounding volume hierarchy per mesh (binned
-//! SAH, Wald 2007); [`traverse`] walks both trees together; each candidate triangle pair is
-//! classified exactly by [`tri_tri`] (orientation predicates in the style of Guigue & Devillers
-//! 2003, evaluated with Shewchuk's adaptive exact arithmetic from [`geom::predicates`]); when
-//! nothing touches, [`distance`] finds the closest pair by branch and bound over both trees with
-//! closed-form triangle–triangle distance (Ericson 2005; Larsen et al. 1999). [`query`]
-//! orchestrates and returns plain result structs; [`report`] turns them into the JSON wire
-//! format. The library never prints.
+//! The pipeline, one module group per step: [`load`] reads OBJ, STL or glTF into a
+//! [`scene::mesh::Mesh`] (f64 positions, u32 triangles, an object per triangle; [`scene`] also
+//! holds connected bodies); [`bvh`] builds a bounding volume hierarchy
+//! per mesh (binned SAH, Wald 2007) and [`bvh::traverse`] walks both trees together; each
+//! candidate triangle pair is classified exactly by [`narrow::tri_tri`] (orientation predicates
+//! in the style of Guigue & Devillers 2003, evaluated with Shewchuk's adaptive exact arithmetic
+//! from [`geom::predicates`]); when nothing touches, [`narrow::distance`] gives the closed-form
+//! triangle–triangle distance (Ericson 2005) for the branch and bound over both trees (Larsen et
+//! al. 1999). [`check::query`] orchestrates and returns plain result structs ([`check`] also has
+//! assemblies of parts, containment, clash regions and the parry cross-check); [`report`] turns them into the JSON
+//! wire format (with [`report::baseline`]: stable finding ids); [`output`] renders text, JUnit
+//! and GLB. The library never prints.
 #![deny(missing_docs)]
 
 pub mod bench;

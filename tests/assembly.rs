@@ -4,7 +4,7 @@
 #![allow(clippy::doc_lazy_continuation)] // test helpers: tuple rows and long case docs read better as they are
 
 use glam::DMat4;
-use meshclash::scene::assembly::{check_parts, parts_of, Pairing};
+use meshclash::check::assembly::{check_parts, parts_of, Pairing};
 use meshclash::check::query::{check, load_input, InputSpec, PairKind, Settings, Verdict};
 use std::collections::BTreeMap;
 use std::path::PathBuf;
@@ -165,7 +165,7 @@ fn load_gltf(bytes: &[u8]) -> meshclash::scene::mesh::Mesh {
 fn scene_pairs(
     mesh: &meshclash::scene::mesh::Mesh,
     settings: &Settings,
-) -> (BTreeMap<(String, String), meshclash::check::query::ClashResult>, meshclash::scene::assembly::AssemblyResult) {
+) -> (BTreeMap<(String, String), meshclash::check::query::ClashResult>, meshclash::check::assembly::AssemblyResult) {
     let run = |threads: usize| {
         let parts = parts_of(mesh, 0);
         let all: Vec<usize> = (0..parts.len()).collect();

@@ -9,7 +9,7 @@
 //!
 //! The walks see a tree through [`Tree`]: its nodes and each node's box in the walk's frame. A
 //! [`Bvh`] is its own frame; an instance sharing another instance's tree maps its boxes
-//! (`crate::scene::assembly`), and the walk carries each node's mapped box on its stack so that a box
+//! (`crate::check::assembly`), and the walk carries each node's mapped box on its stack so that a box
 //! is mapped once per node pair opened.
 
 use crate::bvh::{Bvh, Node};

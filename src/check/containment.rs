@@ -15,11 +15,11 @@
 //! Called only when no pair of triangles meets: then each connected component of one mesh is
 //! entirely inside or entirely outside the other, so one vertex per component decides.
 
+use crate::bvh::traverse::Tree;
 use crate::geom::predicates as pr;
 use crate::geom::{Aabb, DVec3};
-use crate::scene::mesh::TriMesh;
-use crate::bvh::traverse::Tree;
 use crate::narrow::tri_tri::Shape;
+use crate::scene::mesh::TriMesh;
 use std::collections::HashMap;
 
 /// Closedness and components of one mesh.

@@ -1,7 +1,9 @@
 //! The checks run over two meshes: [`query`] (candidate pairs, exact classification, closest
-//! pair), [`containment`] (closed-mesh topology and winding numbers), [`regions`] (clash regions
-//! and penetration estimates), [`cross_check`] (the parry3d reference comparison).
+//! pair), [`assembly`] (parts, placements, the part-pair run over [`query`]), [`containment`]
+//! (closed-mesh topology and winding numbers), [`regions`] (clash regions and penetration
+//! estimates), [`cross_check`] (the parry3d reference comparison).
 
+pub mod assembly;
 pub mod containment;
 pub mod cross_check;
 pub mod query;

@@ -4,16 +4,16 @@
 //! Every candidate pair is classified exactly ([`crate::narrow::tri_tri`]); distances (for tolerance
 //! bands, clearance and the closest pair) are f64 closed forms ([`crate::narrow::distance`]).
 
+use crate::bvh::traverse::{self, Candidate, Tree};
 use crate::bvh::{self, BuildOptions, Bvh};
 use crate::check::containment::{self, Containment};
-use crate::narrow::distance::triangle_distance;
 use crate::error::{Error, Result};
 use crate::geom::predicates::{self, Tolerances};
 use crate::geom::{Aabb, DVec3};
 use crate::load::{self, Format};
-use crate::scene::mesh::{Mesh, TriMesh};
-use crate::bvh::traverse::{self, Candidate, Tree};
+use crate::narrow::distance::triangle_distance;
 use crate::narrow::tri_tri::{self, Contact, Shape};
+use crate::scene::mesh::{Mesh, TriMesh};
 use glam::DMat4;
 use rayon::prelude::*;
 use std::path::{Path, PathBuf};

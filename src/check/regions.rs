@@ -8,12 +8,12 @@
 //! ([`crate::report::baseline::finding_id`], derived from geometry and part names) among its
 //! pairs, so ids do not depend on thread timing or file order.
 
-use crate::scene::bodies::{find, union, vertex_key};
 use crate::bvh::{self, BuildOptions, Bvh};
 use crate::check::containment::{self, Inside};
-use crate::geom::{Aabb, DVec3};
-use crate::scene::mesh::Mesh;
 use crate::check::query::{PairFinding, PairKind};
+use crate::geom::{Aabb, DVec3};
+use crate::scene::bodies::{find, union, vertex_key};
+use crate::scene::mesh::Mesh;
 use rayon::prelude::*;
 use std::collections::HashMap;
 
@@ -135,7 +135,8 @@ fn point_distance(p: DVec3, m: &Mesh, t: &Bvh) -> f64 {
         if n.is_leaf() {
             for &tri in t.leaf_prims(n) {
                 let [a, b, c] = bvh::triangle(m, tri);
-                best = best.min((crate::narrow::distance::closest_point_on_triangle(p, a, b, c) - p).length());
+                best =
+                    best.min((crate::narrow::distance::closest_point_on_triangle(p, a, b, c) - p).length());
             }
         } else {
             let (l, r) = (i + 1, n.a);
@@ -201,7 +202,10 @@ pub fn estimate_penetration(
             ((side, o), solid)
         })
         .collect();
-    let merged = [crate::scene::bodies::merge_vertices(&a.positions), crate::scene::bodies::merge_vertices(&b.positions)];
+    let merged = [
+        crate::scene::bodies::merge_vertices(&a.positions),
+        crate::scene::bodies::merge_vertices(&b.positions),
+    ];
     // Per part pair: which triangles of each side meet the other part.
     let mut cut: HashMap<(u32, u32), [Vec<u32>; 2]> = HashMap::new();
     for p in pairs {
@@ -362,8 +366,8 @@ fn side_depth(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::scene::mesh::Object;
     use crate::check::query::{check, Settings};
+    use crate::scene::mesh::Object;
 
     fn plate(z: f64, x0: f64) -> Vec<[DVec3; 3]> {
         // A 4×1 strip of quads in the plane x = const... a vertical fin at x = x0.

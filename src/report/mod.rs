@@ -239,7 +239,7 @@ pub struct PartPairReport {
 
 /// Build the v2 part view from an assembly outcome.
 pub fn assembly_view(
-    o: &crate::scene::assembly::Outcome,
+    o: &crate::check::assembly::Outcome,
     max_pairs: usize,
 ) -> (AssemblyReport, Vec<PartReport>, Vec<PartPairReport>) {
     let parts = o

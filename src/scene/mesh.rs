@@ -70,7 +70,7 @@ impl Mesh {
 }
 
 /// Read access to a triangle mesh in world coordinates: a whole [`Mesh`], or a view of one part
-/// of one (`crate::scene::assembly`) that borrows the loaded coordinates instead of copying them.
+/// of one (`crate::check::assembly`) that borrows the loaded coordinates instead of copying them.
 /// Vertices are numbered `0..vertex_count()` and triangles `0..triangle_count()`.
 pub trait TriMesh: Sync {
     /// Number of vertices.

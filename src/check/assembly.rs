@@ -22,13 +22,13 @@
 //! an affine image of the leader's (to rounding), or without node matrices, falls back to a
 //! refitted copy of the leader's tree (exact boxes, a copy of the nodes).
 
+use crate::bvh::traverse::{self, Tree};
 use crate::bvh::{BuildOptions, Bvh, Node};
 use crate::check::containment::Containment;
+use crate::check::query::{check_built, ClashResult, PairFinding, Settings, Verdict};
 use crate::geom::predicates::BoxMap;
 use crate::geom::{Aabb, DVec3};
 use crate::scene::mesh::{Mesh, Object, TriMesh};
-use crate::check::query::{check_built, ClashResult, PairFinding, Settings, Verdict};
-use crate::bvh::traverse::{self, Tree};
 use rayon::prelude::*;
 use std::collections::HashMap;
 use std::time::Instant;
