@@ -11,6 +11,7 @@ pub mod glb;
 pub mod junit;
 pub mod progress;
 pub mod text;
+pub mod write;
 
 use crate::error::{Error, Result};
 use crate::mesh::Mesh;
