@@ -53,12 +53,11 @@
 //! Triangle indices are 0-based in file order (see [`crate::load`]); `object` / `a_object`
 //! index into `inputs.*.objects`.
 
-use crate::error::{Error, Result};
+use crate::error::Result;
 use crate::geom::{Aabb, DVec3};
 use crate::query::{ClashResult, Input, PairFinding, TreeStats, Verdict};
 use glam::DMat4;
 use serde::{Deserialize, Serialize};
-use std::io::Write;
 use std::path::Path;
 
 /// The schema identifier written in every report.
