@@ -283,7 +283,7 @@ fn missing_and_unreadable_files() {
 
     let as_dir = dir.path().join("a_directory.stl");
     std::fs::create_dir(&as_dir).unwrap();
-    rejects_both_sides(&as_dir, &["cannot read file", "Is a directory"]);
+    rejects_both_sides(&as_dir, &["not a regular file (a directory)"]);
 
     #[cfg(unix)]
     {

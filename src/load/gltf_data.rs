@@ -395,7 +395,17 @@ fn read_external(path: &Path, i: usize, uri: &str, declared: usize) -> Result<Ve
     let cannot = |e: std::io::Error| {
         Error::input(path, format!("glTF external buffer '{shown}' cannot be read: {}", io_message(&e)))
     };
-    let f = std::fs::File::open(&file).map_err(cannot)?;
+    // The text checks above cannot see symlinks: resolve both ends and compare (issue 11 item 6).
+    let real = file.canonicalize().map_err(cannot)?;
+    let base = path.parent().filter(|d| !d.as_os_str().is_empty()).unwrap_or(Path::new("."));
+    let base = base.canonicalize().map_err(cannot)?;
+    if !real.starts_with(&base) {
+        return Err(refuse("it resolves (through a symlink) outside the glTF's directory"));
+    }
+    if !real.metadata().map_err(cannot)?.is_file() {
+        return Err(refuse("it is not a regular file"));
+    }
+    let f = std::fs::File::open(&real).map_err(cannot)?;
     let have = f.metadata().map_err(cannot)?.len();
     if have < declared as u64 {
         return Err(Error::input(

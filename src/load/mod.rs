@@ -53,13 +53,43 @@ impl Format {
 
 /// Reads `path`, detects its format, loads and validates it.
 ///
-/// A missing or unreadable file is an [`Error::Input`] naming the path.
+/// A missing or unreadable file is an [`Error::Input`] naming the path. A path that is not a
+/// regular file (a FIFO, a device such as `/dev/zero`, a socket, a directory) is refused before
+/// it is opened, so a FIFO cannot block the run and a device cannot stream without end
+/// (issue 11, item 5). Symlinks are followed: the link's target must be a regular file.
 pub fn load_path(path: &Path) -> Result<(Loaded, Format)> {
+    let meta = std::fs::metadata(path)
+        .map_err(|e| Error::input(path, format!("cannot read file: {}", io_message(&e))))?;
+    if !meta.is_file() {
+        return Err(Error::input(
+            path,
+            format!("not a regular file ({}); meshclash reads only regular files", file_kind(&meta)),
+        ));
+    }
     let bytes = std::fs::read(path)
         .map_err(|e| Error::input(path, format!("cannot read file: {}", io_message(&e))))?;
     let format = detect_format(path, &bytes)?;
     let loaded = load_bytes(path, &bytes, format)?;
     Ok((loaded, format))
+}
+
+/// A short name for the kind of a non-regular file, for error messages.
+fn file_kind(meta: &std::fs::Metadata) -> &'static str {
+    use std::os::unix::fs::FileTypeExt;
+    let t = meta.file_type();
+    if t.is_dir() {
+        "a directory"
+    } else if t.is_fifo() {
+        "a FIFO"
+    } else if t.is_char_device() {
+        "a character device"
+    } else if t.is_block_device() {
+        "a block device"
+    } else if t.is_socket() {
+        "a socket"
+    } else {
+        "not a regular file"
+    }
 }
 
 /// Loads `bytes` as `format` and validates the result.
@@ -336,6 +366,26 @@ mod tests {
         let e = load_path(Path::new("/nonexistent/dir/x.stl")).unwrap_err().to_string();
         assert!(e.starts_with("/nonexistent/dir/x.stl: cannot read file:"), "{e}");
         assert!(e.contains("No such file"), "{e}");
+    }
+
+    #[test]
+    fn fifo_input_is_refused_without_hanging() {
+        // Before issue 11 item 5 this opened the FIFO and blocked forever with no writer.
+        let dir = tempfile::tempdir().unwrap();
+        let fifo = dir.path().join("f.obj");
+        let status = std::process::Command::new("mkfifo").arg(&fifo).status().unwrap();
+        assert!(status.success());
+        let e = load_path(&fifo).unwrap_err().to_string();
+        assert!(e.contains("f.obj: not a regular file (a FIFO)"), "{e}");
+    }
+
+    #[test]
+    fn dev_zero_input_is_refused_up_front() {
+        // Before the fix /dev/zero was read until memory ran out.
+        let e = load_path(Path::new("/dev/zero")).unwrap_err().to_string();
+        assert!(e.starts_with("/dev/zero: not a regular file (a character device)"), "{e}");
+        let e = load_path(Path::new("/tmp")).unwrap_err().to_string();
+        assert!(e.contains("not a regular file (a directory)"), "{e}");
     }
 
     #[test]

@@ -10,6 +10,7 @@ pub mod glb;
 pub mod junit;
 pub mod progress;
 pub mod text;
+pub mod write;
 
 use crate::report::baseline;
 use crate::error::{Error, Result};

@@ -55,12 +55,11 @@
 
 pub mod baseline;
 
-use crate::error::{Error, Result};
+use crate::error::Result;
 use crate::geom::{Aabb, DVec3};
 use crate::check::query::{ClashResult, Input, PairFinding, TreeStats, Verdict};
 use glam::DMat4;
 use serde::{Deserialize, Serialize};
-use std::io::Write;
 use std::path::Path;
 
 /// The schema identifier written in every report.
@@ -755,21 +754,7 @@ pub fn to_json(report: &Report) -> String {
     s
 }
 
-/// Write `bytes` to `path` completely or not at all: a temporary file beside it, flushed and
-/// synced, then renamed over the target.
+/// Write `bytes` to `path` completely or not at all; see [`crate::output::write::write_file`].
 pub fn write_atomic(path: &Path, bytes: &[u8]) -> Result<()> {
-    let err = |e: std::io::Error| Error::Output { path: path.to_path_buf(), msg: e.to_string() };
-    let dir = path.parent().filter(|d| !d.as_os_str().is_empty()).unwrap_or(Path::new("."));
-    let name = path.file_name().ok_or_else(|| err(std::io::Error::other("not a file name")))?;
-    let tmp = dir.join(format!(".{}.{}.tmp", name.to_string_lossy(), std::process::id()));
-    let result = (|| {
-        let mut f = std::fs::File::create(&tmp)?;
-        f.write_all(bytes)?;
-        f.sync_all()?;
-        std::fs::rename(&tmp, path)
-    })();
-    if result.is_err() {
-        let _ = std::fs::remove_file(&tmp);
-    }
-    result.map_err(err)
+    crate::output::write::write_file(path, bytes)
 }
