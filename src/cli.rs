@@ -159,6 +159,9 @@ pub enum Command {
     /// Run the named checks of a clash-set file (JSON) in one go: one JSON document with every
     /// check's report, exit 1 if any check fails its --fail-on, 2 on bad input in any check.
     ClashSet(crate::clash_set::ClashSetArgs),
+    /// Check one mesh against itself: self-clashing triangle pairs and mesh health per part.
+    #[command(name = "self")]
+    SelfCheck(crate::self_cmd::SelfArgs),
 }
 
 /// `--fail-on` values.

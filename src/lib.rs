@@ -24,12 +24,16 @@ pub mod cross_check;
 pub mod distance;
 pub mod error;
 pub mod geom;
+pub mod health;
 pub mod load;
 pub mod mesh;
 pub mod output;
 pub mod query;
 pub mod regions;
 pub mod report;
+pub mod self_clash;
+pub mod self_cmd;
+pub mod self_report;
 pub mod traverse;
 pub mod tri_tri;
 
