@@ -83,7 +83,8 @@ const VOLUME_CHUNK: usize = 4096;
 pub fn health(mesh: &Mesh, merged: &[u32], tris: &[u32], first_n: usize) -> Health {
     let ids = |k: usize| mesh.triangles[tris[k] as usize].map(|v| merged[v as usize]);
     let pos = |k: usize| crate::bvh::triangle(mesh, tris[k]);
-    let proper: Vec<bool> = (0..tris.len()).into_par_iter().map(|k| !Shape::of(&pos(k)).is_degenerate()).collect();
+    let proper: Vec<bool> =
+        (0..tris.len()).into_par_iter().map(|k| !Shape::of(&pos(k)).is_degenerate()).collect();
     let zero: Vec<u32> = (0..tris.len()).filter(|&k| !proper[k]).map(|k| tris[k]).collect();
     let zero_area_triangles = Finding::of(zero.len() as u64, zero, first_n);
 

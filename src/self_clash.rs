@@ -261,7 +261,8 @@ where
 pub fn self_pairs(mesh: &Mesh, merged: &[u32], tris: &[u32], opts: BuildOptions) -> Vec<SelfPair> {
     let tri = |k: u32| crate::bvh::triangle(mesh, tris[k as usize]);
     let ids = |k: u32| mesh.triangles[tris[k as usize] as usize].map(|v| merged[v as usize]);
-    let boxes: Vec<Aabb> = (0..tris.len() as u32).into_par_iter().map(|k| Aabb::of_triangle(&tri(k))).collect();
+    let boxes: Vec<Aabb> =
+        (0..tris.len() as u32).into_par_iter().map(|k| Aabb::of_triangle(&tri(k))).collect();
     let tree = Bvh::build_from_boxes(&boxes, opts);
     let test = |i: u32, j: u32, out: &mut Vec<SelfPair>| {
         if !boxes[i as usize].overlaps(&boxes[j as usize]) {

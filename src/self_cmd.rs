@@ -32,6 +32,10 @@ pub struct SelfArgs {
     /// Split every part into its connected bodies first (as for a check).
     #[arg(long)]
     pub split_bodies: bool,
+    /// Check the whole file as one part (objects ignored): connectivity and health across
+    /// objects, e.g. two solids glued face to face.
+    #[arg(long, conflicts_with_all = ["select", "exclude", "split_bodies"])]
+    pub whole_file: bool,
     /// Exit 1 when any of these is found (comma-separated): `self-clash` (alias `clash`:
     /// crossing pairs), `touching` (any self-clash pair), `open`, `non-manifold` (edges or
     /// vertices), `duplicates`, `degenerate` (zero-area triangles), `winding`, `never`.
@@ -128,8 +132,8 @@ pub enum SelfFormat {
 /// The result for one part.
 #[derive(Debug, Clone, PartialEq)]
 pub struct PartResult {
-    /// Object index in the (possibly split) mesh.
-    pub object: u32,
+    /// Object index in the (possibly split) mesh; None for `--whole-file`.
+    pub object: Option<u32>,
     /// Its name.
     pub name: String,
     /// Its triangles (indices into the mesh).
@@ -157,29 +161,42 @@ pub struct SelfOutcome {
     pub report: Box<SelfReport>,
 }
 
-/// Self-clash and health of every part of `mesh` (object order) that `keep` accepts by name.
-/// `merged` is [`crate::bodies::merge_vertices`] of its positions.
+/// Which parts [`check_parts`] checks.
+pub enum PartChoice<'a> {
+    /// Every object (object order) whose name passes the filter.
+    Objects(&'a dyn Fn(&str) -> bool),
+    /// All triangles as one part with this name.
+    Whole(&'a str),
+}
+
+/// Self-clash and health of the chosen parts of `mesh`, with the milliseconds spent on health
+/// (with the vertex merge) and on the self-clash walks.
 pub fn check_parts(
     mesh: &crate::mesh::Mesh,
-    keep: &dyn Fn(&str) -> bool,
+    choice: PartChoice,
     opts: BuildOptions,
     first_n: usize,
 ) -> (Vec<PartResult>, f64, f64) {
     let t = Instant::now();
     let (merged, _) = crate::bodies::merge_vertices(&mesh.positions);
-    let parts: Vec<_> =
-        crate::assembly::parts_of(mesh, 0).into_iter().filter(|p| keep(&p.name)).collect();
-    let healths: Vec<Health> =
-        parts.iter().map(|p| health::health(mesh, &merged, &p.triangles, first_n)).collect();
+    let parts: Vec<(Option<u32>, String, Vec<u32>)> = match choice {
+        PartChoice::Objects(keep) => crate::assembly::parts_of(mesh, 0)
+            .into_iter()
+            .filter(|p| keep(&p.name))
+            .map(|p| (Some(p.object), p.name, p.triangles))
+            .collect(),
+        PartChoice::Whole(name) => vec![(None, name.to_string(), (0..mesh.triangles.len() as u32).collect())],
+    };
+    let healths: Vec<Health> = parts.iter().map(|p| health::health(mesh, &merged, &p.2, first_n)).collect();
     let health_ms = t.elapsed().as_secs_f64() * 1e3;
     let t = Instant::now();
     let results = parts
         .into_iter()
         .zip(healths)
-        .map(|(p, health)| {
-            let pairs = self_clash::self_pairs(mesh, &merged, &p.triangles, opts);
+        .map(|((object, name, tris), health)| {
+            let pairs = self_clash::self_pairs(mesh, &merged, &tris, opts);
             let crossing = pairs.iter().filter(|q| q.hit.crossing).count() as u64;
-            PartResult { object: p.object, name: p.name, triangles: p.triangles.len(), pairs, crossing, health }
+            PartResult { object, name, triangles: tris.len(), pairs, crossing, health }
         })
         .collect();
     (results, health_ms, t.elapsed().as_secs_f64() * 1e3)
@@ -193,7 +210,10 @@ pub fn run(args: &SelfArgs) -> Result<SelfOutcome> {
     if let Some(out) = &args.output {
         if let (Ok(a), Ok(b)) = (std::fs::canonicalize(out), std::fs::canonicalize(&args.file)) {
             if a == b {
-                return Err(Error::Usage(format!("-o {} is the input file; refusing to overwrite it", out.display())));
+                return Err(Error::Usage(format!(
+                    "-o {} is the input file; refusing to overwrite it",
+                    out.display()
+                )));
             }
         }
     }
@@ -212,7 +232,9 @@ fn run_in_pool(args: &SelfArgs, threads: usize) -> Result<SelfOutcome> {
             && !args.exclude.iter().any(|g| crate::assembly::glob_match(g, name))
     };
     let opts = BuildOptions { strategy: Strategy::Sah, leaf_size: args.leaf_size };
-    let (parts, health_ms, query_ms) = check_parts(&input.mesh, &keep, opts, args.first_n);
+    let whole_name = args.file.display().to_string();
+    let choice = if args.whole_file { PartChoice::Whole(&whole_name) } else { PartChoice::Objects(&keep) };
+    let (parts, health_ms, query_ms) = check_parts(&input.mesh, choice, opts, args.first_n);
     let mut warnings: Vec<String> =
         input.warnings.iter().map(|w| format!("{}: {w}", args.file.display())).collect();
     if parts.is_empty() {
@@ -230,6 +252,7 @@ fn run_in_pool(args: &SelfArgs, threads: usize) -> Result<SelfOutcome> {
         fail_on: &fail_on,
         failed_on: &failed_on,
         split_bodies: args.split_bodies,
+        whole_file: args.whole_file,
         select: &args.select,
         exclude: &args.exclude,
         leaf_size: args.leaf_size,

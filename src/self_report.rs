@@ -14,7 +14,7 @@
 //!   "tool": {"name": "meshclash", "version"},
 //!   "input": {"path", "format": "obj|stl|gltf|glb", "vertices", "triangles",
 //!             "objects": [{"name", "triangles"}]},
-//!   "settings": {"fail_on": ["self-clash", ...], "split_bodies", "select": [glob], "exclude": [glob],
+//!   "settings": {"fail_on": ["self-clash", ...], "split_bodies", "whole_file", "select": [glob], "exclude": [glob],
 //!                "bvh": "sah", "leaf_size", "max_pairs", "first_n", "threads": n | null},
 //!   "verdict": "clash" | "touching" | "clear",   // worst self-clash pair: crossing, touching, none
 //!   "failed": bool,                              // something in fail_on was found (exit code 1)
@@ -27,7 +27,7 @@
 //!              "contact": "point|segment|coplanar_area|coplanar_boundary", "distance": 0,
 //!              "segment": [[x,y,z],[x,y,z]] | null}],
 //!   "pairs_truncated": bool,
-//!   "parts": [{"object", "name", "triangles", "crossing_pairs", "touching_pairs",
+//!   "parts": [{"object": n | null, "name", "triangles", "crossing_pairs", "touching_pairs",
 //!              "health": {"closed", "volume": number | null,
 //!                         "duplicate_faces": {"count", "triangles": [ids]}, "zero_area_triangles": {..},
 //!                         "non_manifold_edges": {..}, "non_manifold_vertices": {..},
@@ -106,6 +106,8 @@ pub struct SelfSettings {
     pub fail_on: Vec<String>,
     /// `--split-bodies`.
     pub split_bodies: bool,
+    /// `--whole-file`: all triangles checked as one part.
+    pub whole_file: bool,
     /// `--select` globs.
     pub select: Vec<String>,
     /// `--exclude` globs.
@@ -156,8 +158,9 @@ pub struct SelfSummary {
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize, schemars::JsonSchema)]
 #[serde(deny_unknown_fields)]
 pub struct SelfPart {
-    /// Index into `input.objects`.
-    pub object: u32,
+    /// Index into `input.objects`, or null with `--whole-file` (the part is the whole file,
+    /// named by its path).
+    pub object: Option<u32>,
     /// Its name.
     pub name: String,
     /// Its triangle count.
@@ -231,6 +234,8 @@ pub struct Context<'a> {
     pub failed_on: &'a [SelfFailOn],
     /// `--split-bodies`.
     pub split_bodies: bool,
+    /// `--whole-file`.
+    pub whole_file: bool,
     /// `--select` globs.
     pub select: &'a [String],
     /// `--exclude` globs.
@@ -275,18 +280,17 @@ pub fn build(ctx: &Context) -> SelfReport {
     for &o in &mesh.tri_object {
         objects[o as usize].triangles += 1;
     }
-    let mut all: Vec<(u32, u32, u32, &crate::self_clash::SelfPair)> =
-        ctx.parts.iter().flat_map(|p| p.pairs.iter().map(move |q| (q.a, q.b, p.object, q))).collect();
-    all.sort_unstable_by_key(|x| (x.0, x.1));
+    let mut all: Vec<&crate::self_clash::SelfPair> = ctx.parts.iter().flat_map(|p| &p.pairs).collect();
+    all.sort_unstable_by_key(|q| (q.a, q.b));
     let pairs_truncated = all.len() > ctx.max_pairs;
     let pairs = all
         .iter()
         .take(ctx.max_pairs)
-        .map(|&(a, b, object, q)| PairReport {
-            a,
-            b,
-            a_object: object,
-            b_object: object,
+        .map(|q| PairReport {
+            a: q.a,
+            b: q.b,
+            a_object: mesh.tri_object[q.a as usize],
+            b_object: mesh.tri_object[q.b as usize],
             kind: if q.hit.crossing { "crossing" } else { "touching" }.into(),
             contact: Some(q.hit.contact.name().into()),
             distance: 0.0,
@@ -333,6 +337,7 @@ pub fn build(ctx: &Context) -> SelfReport {
         settings: SelfSettings {
             fail_on: names(ctx.fail_on),
             split_bodies: ctx.split_bodies,
+            whole_file: ctx.whole_file,
             select: ctx.select.to_vec(),
             exclude: ctx.exclude.to_vec(),
             bvh: "sah".into(),
@@ -441,14 +446,8 @@ pub fn text(r: &SelfReport) -> String {
         let _ = writeln!(out, "  … and {} more parts with findings", listed.len() - 10);
     }
     for p in r.pairs.iter().take(5) {
-        let _ = writeln!(
-            out,
-            "  pair {} × {}: {} ({})",
-            p.a,
-            p.b,
-            p.kind,
-            p.contact.as_deref().unwrap_or("-")
-        );
+        let _ =
+            writeln!(out, "  pair {} × {}: {} ({})", p.a, p.b, p.kind, p.contact.as_deref().unwrap_or("-"));
     }
     out
 }

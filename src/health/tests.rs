@@ -6,7 +6,9 @@ use crate::mesh::Object;
 fn cube(m: &mut Mesh, o: [f64; 3]) {
     let base = m.positions.len() as u32;
     for i in 0..8 {
-        m.positions.push(DVec3::from_array(o) + DVec3::new((i & 1) as f64, (i >> 1 & 1) as f64, (i >> 2 & 1) as f64));
+        m.positions.push(
+            DVec3::from_array(o) + DVec3::new((i & 1) as f64, (i >> 1 & 1) as f64, (i >> 2 & 1) as f64),
+        );
     }
     let faces = [[0, 1, 3, 2], [4, 6, 7, 5], [0, 4, 5, 1], [2, 3, 7, 6], [0, 2, 6, 4], [1, 5, 7, 3]];
     for f in faces {
@@ -17,7 +19,8 @@ fn cube(m: &mut Mesh, o: [f64; 3]) {
 }
 
 fn one(f: impl FnOnce(&mut Mesh)) -> Mesh {
-    let mut m = Mesh { objects: vec![Object { name: "m".into(), ..Default::default() }], ..Default::default() };
+    let mut m =
+        Mesh { objects: vec![Object { name: "m".into(), ..Default::default() }], ..Default::default() };
     f(&mut m);
     m
 }
@@ -115,9 +118,8 @@ fn bow_ties_are_non_manifold_vertices() {
     // Every triangle using (1, 1, 1): three corners per cube, 2 + 1 + 2 triangles each... all
     // six faces meeting there, so 2 cubes × 3 faces × (1 or 2) triangles.
     let at = DVec3::ONE;
-    let using: Vec<u32> = (0..m.triangles.len() as u32)
-        .filter(|&t| crate::bvh::triangle(&m, t).contains(&at))
-        .collect();
+    let using: Vec<u32> =
+        (0..m.triangles.len() as u32).filter(|&t| crate::bvh::triangle(&m, t).contains(&at)).collect();
     assert_eq!(h.non_manifold_vertices.triangles, using);
     // Two triangles touching at one vertex: an open bow-tie.
     let p = [[0., 0., 0.], [1., 0., 0.], [0., 1., 0.], [-1., 0., 0.], [0., -1., 0.]];

@@ -26,7 +26,8 @@ fn pairs(m: &Mesh) -> Vec<(u32, u32, bool, Contact)> {
 }
 
 fn cube() -> Mesh {
-    let p: Vec<[f64; 3]> = (0..8).map(|i| [(i & 1) as f64, (i >> 1 & 1) as f64, (i >> 2 & 1) as f64]).collect();
+    let p: Vec<[f64; 3]> =
+        (0..8).map(|i| [(i & 1) as f64, (i >> 1 & 1) as f64, (i >> 2 & 1) as f64]).collect();
     let faces = [[0, 1, 3, 2], [4, 6, 7, 5], [0, 4, 5, 1], [2, 3, 7, 6], [0, 2, 6, 4], [1, 5, 7, 3]];
     let t: Vec<[u32; 3]> = faces.iter().flat_map(|f| [[f[0], f[1], f[2]], [f[0], f[2], f[3]]]).collect();
     mesh(&p, &t)
@@ -147,7 +148,8 @@ fn a_duplicated_face_is_not_a_self_clash_pair_but_a_copy_shifted_by_a_vertex_is(
 
 #[test]
 fn zero_area_triangles_follow_the_same_rule() {
-    let p = [[0., 0., 0.], [2., 0., 0.], [1., 0., 0.], [3., 0., 0.], [0., 2., 0.], [-1., 0., 0.], [1., 0., 1.]];
+    let p =
+        [[0., 0., 0.], [2., 0., 0.], [1., 0., 0.], [3., 0., 0.], [0., 2., 0.], [-1., 0., 0.], [1., 0., 1.]];
     // A sliver 0-2-1 lying on the edge 0-1 of triangle 0-1-4: shares the edge, stays on it.
     assert!(pairs(&mesh(&p, &[[0, 1, 4], [0, 2, 1]])).is_empty());
     // A sliver 0-1-3 extending the edge beyond 1: still only the edge in common.
