@@ -163,8 +163,8 @@ pub fn health(mesh: &Mesh, merged: &[u32], tris: &[u32], first_n: usize) -> Heal
     let mut fans: Vec<(u32, u32)> = Vec::with_capacity(corner.len());
     for k in (0..tris.len()).filter(|&k| proper[k]) {
         let v = ids(k);
-        for c in 0..3 {
-            fans.push((v[c], find(&mut corner, (k * 3 + c) as u32)));
+        for (c, &vc) in v.iter().enumerate() {
+            fans.push((vc, find(&mut corner, (k * 3 + c) as u32)));
         }
     }
     drop(corner);

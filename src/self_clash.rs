@@ -45,11 +45,12 @@
 //! sorted, so the answer does not depend on the thread count.
 
 use crate::bvh::{BuildOptions, Bvh};
-use crate::geom::predicates as pr;
+use crate::geom::predicates::{self as pr, PlaneFilter};
 use crate::geom::{Aabb, DVec3};
 use crate::mesh::Mesh;
 use crate::tri_tri::{self, Hit};
 use rayon::prelude::*;
+use std::ops::Range;
 
 /// How many independent sub-walks the root is split into (fixed, for determinism).
 const SEED_TASKS: usize = 256;
@@ -139,13 +140,41 @@ fn meets_beyond_edge(u: DVec3, w: DVec3, a: DVec3, b: DVec3) -> bool {
 /// (exact-position) vertex ids of `ta`, `tb`. `None` unless they meet beyond what they share
 /// (see the module docs); then the classification of the whole pair.
 pub fn classify_adjacent(ta: &[DVec3; 3], ia: [u32; 3], tb: &[DVec3; 3], ib: [u32; 3]) -> Option<Hit> {
+    // Ids first (cheap); positions are gathered only for the pairs the filters cannot settle.
+    let distinct_count = |i: [u32; 3]| 1 + (i[1] != i[0]) as usize + (i[2] != i[0] && i[2] != i[1]) as usize;
+    let (na, nb) = (distinct_count(ia), distinct_count(ib));
+    let shared = (0..3).filter(|&k| ib.contains(&ia[k]) && !ia[..k].contains(&ia[k])).count();
+    if shared == 0 {
+        return tri_tri::classify(ta, tb);
+    }
+    if shared == 3 || (shared == 2 && (na < 3 || nb < 3)) {
+        // All three shared (a duplicate face), or two shared and one triangle is just that
+        // segment: the intersection is exactly what is shared.
+        return None;
+    }
+    // Float filters: a triangle whose unshared vertices the other's plane filter proves strictly
+    // on one side meets that plane only in what is shared, so the pair is fine. Proven signs
+    // are exact, so this only skips work, never changes an answer.
+    let off_plane = |f: &PlaneFilter, t: &[DVec3; 3], own: [u32; 3], other: [u32; 3]| {
+        let mut side = 0;
+        for k in 0..3 {
+            if !other.contains(&own[k]) {
+                match f.side(t[k]) {
+                    Some(s) if s != 0 && (side == 0 || side == s) => side = s,
+                    _ => return false,
+                }
+            }
+        }
+        side != 0
+    };
+    if off_plane(&PlaneFilter::new(ta), tb, ib, ia) || off_plane(&PlaneFilter::new(tb), ta, ia, ib) {
+        return None;
+    }
     let (da, na) = distinct(ta, ia);
     let (db, nb) = distinct(tb, ib);
     let (da, db) = (&da[..na], &db[..nb]);
     let in_b = |id: u32| db.iter().any(|&(j, _)| j == id);
-    let shared = da.iter().filter(|&&(i, _)| in_b(i)).count();
     let beyond = match shared {
-        0 => true,
         1 => {
             let v = da.iter().find(|&&(i, _)| in_b(i)).unwrap();
             let others = |d: &[(u32, DVec3)]| -> ([DVec3; 2], usize) {
@@ -162,15 +191,12 @@ pub fn classify_adjacent(ta: &[DVec3; 3], ia: [u32; 3], tb: &[DVec3; 3], ib: [u3
             let ((oa, ka), (ob, kb)) = (others(da), others(db));
             meets_beyond_vertex(v.1, &oa[..ka], &ob[..kb])
         }
-        2 if na == 3 && nb == 3 => {
+        _ => {
             let shared: Vec<DVec3> = da.iter().filter(|&&(i, _)| in_b(i)).map(|x| x.1).collect();
             let a = da.iter().find(|&&(i, _)| !in_b(i)).unwrap().1;
             let b = db.iter().find(|&&(j, _)| !da.iter().any(|&(i, _)| i == j)).unwrap().1;
             meets_beyond_edge(shared[0], shared[1], a, b)
         }
-        // Two shared vertices and one triangle is that segment, or all three shared: the
-        // intersection is exactly what is shared.
-        _ => false,
     };
     if beyond {
         tri_tri::classify(ta, tb)
@@ -180,14 +206,15 @@ pub fn classify_adjacent(ta: &[DVec3; 3], ia: [u32; 3], tb: &[DVec3; 3], ib: [u3
 }
 
 /// Walk `tree` against itself: `leaf_self` gets each leaf once, `leaf_pair` each unordered pair
-/// of different leaves whose boxes overlap (closed boxes) once. Results come back in an order
-/// that depends only on the tree.
+/// of different leaves whose boxes overlap (closed boxes) once, each leaf as its range of
+/// positions in `tree.prims`. Results come back in an order that depends only on the tree.
 pub fn self_walk<T, S, P>(tree: &Bvh, leaf_self: S, leaf_pair: P) -> Vec<T>
 where
     T: Send,
-    S: Fn(&[u32], &mut Vec<T>) + Sync,
-    P: Fn(&[u32], &[u32], &mut Vec<T>) + Sync,
+    S: Fn(Range<usize>, &mut Vec<T>) + Sync,
+    P: Fn(Range<usize>, Range<usize>, &mut Vec<T>) + Sync,
 {
+    let range = |n: &crate::bvh::Node| n.a as usize..(n.a + n.count) as usize;
     #[derive(Clone, Copy)]
     enum Job {
         Node(u32),
@@ -203,7 +230,7 @@ where
         Job::Node(i) => {
             let n = &nodes[i as usize];
             if n.is_leaf() {
-                leaf_self(tree.leaf_prims(n), out);
+                leaf_self(range(n), out);
             } else {
                 push(Job::Node(i + 1));
                 push(Job::Node(n.a));
@@ -216,7 +243,7 @@ where
             let (a, b) = (&nodes[i as usize], &nodes[j as usize]);
             let open_a = match (a.is_leaf(), b.is_leaf()) {
                 (true, true) => {
-                    leaf_pair(tree.leaf_prims(a), tree.leaf_prims(b), out);
+                    leaf_pair(range(a), range(b), out);
                     return;
                 }
                 (true, false) => false,
@@ -259,34 +286,46 @@ where
 /// `(a, b)`. `merged` gives each vertex of `mesh` its exact-position id
 /// ([`crate::bodies::merge_vertices`]).
 pub fn self_pairs(mesh: &Mesh, merged: &[u32], tris: &[u32], opts: BuildOptions) -> Vec<SelfPair> {
-    let tri = |k: u32| crate::bvh::triangle(mesh, tris[k as usize]);
-    let ids = |k: u32| mesh.triangles[tris[k as usize] as usize].map(|v| merged[v as usize]);
     let boxes: Vec<Aabb> =
-        (0..tris.len() as u32).into_par_iter().map(|k| Aabb::of_triangle(&tri(k))).collect();
+        tris.par_iter().map(|&t| Aabb::of_triangle(&crate::bvh::triangle(mesh, t))).collect();
     let tree = Bvh::build_from_boxes(&boxes, opts);
-    let test = |i: u32, j: u32, out: &mut Vec<SelfPair>| {
-        if !boxes[i as usize].overlaps(&boxes[j as usize]) {
+    drop(boxes);
+    // What a pair test reads, laid out in the tree's leaf order so that a leaf is one run of
+    // memory: (box, merged ids, triangle index in `mesh`). 64 bytes per triangle.
+    let slots: Vec<(Aabb, [u32; 3], u32)> = tree
+        .prims
+        .par_iter()
+        .map(|&k| {
+            let t = tris[k as usize];
+            let v = mesh.triangles[t as usize];
+            (Aabb::of_triangle(&crate::bvh::triangle(mesh, t)), v.map(|i| merged[i as usize]), t)
+        })
+        .collect();
+    let test = |x: &(Aabb, [u32; 3], u32), y: &(Aabb, [u32; 3], u32), out: &mut Vec<SelfPair>| {
+        if !x.0.overlaps(&y.0) {
             return;
         }
         // Lower triangle first, so the listed segment does not depend on the tree.
-        let (i, j) = if tris[i as usize] < tris[j as usize] { (i, j) } else { (j, i) };
-        if let Some(hit) = classify_adjacent(&tri(i), ids(i), &tri(j), ids(j)) {
-            out.push(SelfPair { a: tris[i as usize], b: tris[j as usize], hit });
+        let (x, y) = if x.2 < y.2 { (x, y) } else { (y, x) };
+        let (ta, tb) = (crate::bvh::triangle(mesh, x.2), crate::bvh::triangle(mesh, y.2));
+        if let Some(hit) = classify_adjacent(&ta, x.1, &tb, y.1) {
+            out.push(SelfPair { a: x.2, b: y.2, hit });
         }
     };
     let mut pairs = self_walk(
         &tree,
         |leaf, out| {
-            for (x, &i) in leaf.iter().enumerate() {
-                for &j in &leaf[x + 1..] {
-                    test(i, j, out);
+            let leaf = &slots[leaf];
+            for (k, x) in leaf.iter().enumerate() {
+                for y in &leaf[k + 1..] {
+                    test(x, y, out);
                 }
             }
         },
         |la, lb, out| {
-            for &i in la {
-                for &j in lb {
-                    test(i, j, out);
+            for x in &slots[la] {
+                for y in &slots[lb.clone()] {
+                    test(x, y, out);
                 }
             }
         },
@@ -314,3 +353,49 @@ pub fn self_pairs_brute_force(mesh: &Mesh, merged: &[u32], tris: &[u32]) -> Vec<
 
 #[cfg(test)]
 mod tests;
+
+/// Generated inputs for tests and the benchmark.
+pub mod gen {
+    use crate::geom::DVec3;
+    use crate::mesh::Mesh;
+
+    /// [`crate::bench::gen::torus`] (`≈ n` triangles, closed, major radius 1, minor 0.35) with
+    /// one fold: the vertex on the outer equator at angle 0 is pulled through the tube to
+    /// `(0.5, 0, 0)`, inside the hole, so its six triangles pierce the inner wall.
+    pub fn folded_torus(n: usize) -> Mesh {
+        let mut m = crate::bench::gen::torus(n);
+        m.positions[0] = DVec3::new(0.5, 0.0, 0.0);
+        m
+    }
+
+    /// A closed tube of radius `small` swept along the figure eight `(cos t, sin 2t / 2, 0)`:
+    /// the path crosses itself at the origin (at `t = π/2` and `t = 3π/2`, at right angles), so
+    /// the tube overlaps itself there. `u` rings of `v` vertices, two triangles per quad.
+    pub fn figure_eight_tube(u: usize, v: usize, small: f64) -> Mesh {
+        let mut positions = Vec::with_capacity(u * v);
+        for i in 0..u {
+            let t = i as f64 / u as f64 * std::f64::consts::TAU;
+            let c = DVec3::new(t.cos(), (2.0 * t).sin() / 2.0, 0.0);
+            let tangent = DVec3::new(-t.sin(), (2.0 * t).cos(), 0.0).normalize();
+            let side = tangent.cross(DVec3::Z);
+            for j in 0..v {
+                let ph = j as f64 / v as f64 * std::f64::consts::TAU;
+                positions.push(c + small * (ph.cos() * side + ph.sin() * DVec3::Z));
+            }
+        }
+        let id = |i: usize, j: usize| ((i % u) * v + (j % v)) as u32;
+        let mut triangles = Vec::with_capacity(2 * u * v);
+        for i in 0..u {
+            for j in 0..v {
+                triangles.push([id(i, j), id(i + 1, j), id(i + 1, j + 1)]);
+                triangles.push([id(i, j), id(i + 1, j + 1), id(i, j + 1)]);
+            }
+        }
+        Mesh {
+            positions,
+            tri_object: vec![0; triangles.len()],
+            triangles,
+            objects: vec![crate::mesh::Object { name: "figure8".into(), ..Default::default() }],
+        }
+    }
+}

@@ -261,3 +261,35 @@ proptest! {
         }
     }
 }
+
+#[test]
+fn a_folded_torus_crosses_only_around_the_fold() {
+    let m = gen::folded_torus(2000);
+    let got = pairs(&m);
+    assert!(got.iter().any(|p| p.2), "the pulled vertex's triangles pierce the inner wall");
+    // Every pair involves one of the six triangles around the moved vertex 0.
+    let moved = |t: u32| m.triangles[t as usize].contains(&0);
+    assert!(got.iter().all(|p| moved(p.0) || moved(p.1)), "{got:?}");
+    assert_eq!(m.triangles.iter().filter(|t| t.contains(&0)).count(), 6);
+    // The same torus unfolded: nothing.
+    assert!(pairs(&crate::bench::gen::torus(2000)).is_empty());
+}
+
+#[test]
+fn a_tube_swept_along_a_figure_eight_overlaps_itself_only_at_the_crossing() {
+    let (u, v) = (96, 12);
+    let m = gen::figure_eight_tube(u, v, 0.1);
+    let got = pairs(&m);
+    assert!(got.iter().filter(|p| p.2).count() >= 4, "{got:?}");
+    // Every pair joins the two branches through the origin: one triangle from the ring range
+    // around t = π/2, the other from around t = 3π/2 (rings are triangle / (2v)).
+    let t_of = |tri: u32| (tri as usize / (2 * v)) as f64 / u as f64 * std::f64::consts::TAU;
+    let near = |t: f64, c: f64| (t - c).abs() < 0.35;
+    for p in &got {
+        let (ta, tb) = (t_of(p.0), t_of(p.1));
+        let (h, h3) = (std::f64::consts::FRAC_PI_2, 3.0 * std::f64::consts::FRAC_PI_2);
+        assert!((near(ta, h) && near(tb, h3)) || (near(ta, h3) && near(tb, h)), "{p:?}: t = {ta}, {tb}");
+    }
+    // A thinner tube still crosses itself there.
+    assert!(pairs(&gen::figure_eight_tube(u, v, 0.02)).iter().any(|p| p.2));
+}
