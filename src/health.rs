@@ -106,18 +106,18 @@ pub fn health(mesh: &Mesh, merged: &[u32], tris: &[u32], first_n: usize) -> Heal
     let duplicate_faces = Finding::of(dup.len() as u64, dup, first_n);
 
     // Edges of the proper triangles: key (lo, hi), payload local triangle × 4 + edge number.
-    let mut edges: Vec<(u64, u32)> = (0..tris.len())
-        .into_par_iter()
-        .filter(|&k| proper[k])
-        .flat_map_iter(|k| {
-            let v = ids(k);
-            (0..3).map(move |c| {
-                let (a, b) = (v[c], v[(c + 1) % 3]);
-                ((a.min(b) as u64) << 32 | a.max(b) as u64, (k as u32) << 2 | c as u32)
-            })
-        })
-        .collect();
+    // Zero-area triangles get sentinel keys (above every real key: lo < hi <= u32::MAX), cut off
+    // after the sort; filling a preallocated array keeps the collection indexed and parallel.
+    let mut edges: Vec<(u64, u32)> = vec![(u64::MAX, 0); 3 * tris.len()];
+    edges.par_chunks_mut(3).enumerate().filter(|(k, _)| proper[*k]).for_each(|(k, out)| {
+        let v = ids(k);
+        for (c, e) in out.iter_mut().enumerate() {
+            let (a, b) = (v[c], v[(c + 1) % 3]);
+            *e = ((a.min(b) as u64) << 32 | a.max(b) as u64, (k as u32) << 2 | c as u32);
+        }
+    });
     edges.par_sort_unstable();
+    edges.truncate(edges.partition_point(|e| e.0 != u64::MAX));
     let forward = |e: &(u64, u32)| {
         let v = ids((e.1 >> 2) as usize);
         v[(e.1 & 3) as usize] < v[((e.1 & 3) as usize + 1) % 3]
@@ -159,25 +159,25 @@ pub fn health(mesh: &Mesh, merged: &[u32], tris: &[u32], first_n: usize) -> Heal
     }
     let closed = !edges.is_empty() && n_boundary == 0 && n_nm == 0;
     drop(edges);
-    // Non-manifold vertices: more than one corner set (fan) at one vertex.
-    let mut fans: Vec<(u32, u32)> = Vec::with_capacity(corner.len());
+    // Non-manifold vertices: more than one corner set (fan) at one vertex. Corners are only
+    // ever joined with corners at the same vertex, so each fan has one root corner: a vertex
+    // with two roots is non-manifold.
+    let mut roots: Vec<u32> = Vec::with_capacity(tris.len() / 2 + 1);
     for k in (0..tris.len()).filter(|&k| proper[k]) {
         let v = ids(k);
         for (c, &vc) in v.iter().enumerate() {
-            fans.push((vc, find(&mut corner, (k * 3 + c) as u32)));
+            let slot = (k * 3 + c) as u32;
+            if find(&mut corner, slot) == slot {
+                roots.push(vc);
+            }
         }
     }
     drop(corner);
-    fans.par_sort_unstable();
-    fans.dedup();
-    let (mut n_nmv, mut nmv_vertices) = (0u64, Vec::new());
-    for run in fans.chunk_by(|x, y| x.0 == y.0) {
-        if run.len() > 1 {
-            n_nmv += 1;
-            nmv_vertices.push(run[0].0);
-        }
-    }
-    drop(fans);
+    roots.par_sort_unstable();
+    let nmv_vertices: Vec<u32> =
+        roots.chunk_by(|x, y| x == y).filter(|run| run.len() > 1).map(|run| run[0]).collect();
+    let n_nmv = nmv_vertices.len() as u64;
+    drop(roots);
     let nmv_tris: Vec<u32> = if nmv_vertices.is_empty() {
         Vec::new()
     } else {
