@@ -105,29 +105,27 @@ pub fn health(mesh: &Mesh, merged: &[u32], tris: &[u32], first_n: usize) -> Heal
     drop(faces);
     let duplicate_faces = Finding::of(dup.len() as u64, dup, first_n);
 
-    // Edges of the proper triangles: key (lo, hi), payload local triangle × 4 + edge number.
-    // Zero-area triangles get sentinel keys (above every real key: lo < hi <= u32::MAX), cut off
-    // after the sort; filling a preallocated array keeps the collection indexed and parallel.
-    let mut edges: Vec<(u64, u32)> = vec![(u64::MAX, 0); 3 * tris.len()];
+    // Edges of the proper triangles: (key (lo, hi), local triangle, edge number c (from corner
+    // c to corner c + 1), whether corner c is the low end), 16 bytes. Zero-area triangles get
+    // sentinel keys (above every real key: lo < hi <= u32::MAX), cut off after the sort;
+    // filling a preallocated array keeps the collection indexed and parallel.
+    type Edge = (u64, u32, u8, bool);
+    let mut edges: Vec<Edge> = vec![(u64::MAX, 0, 0, false); 3 * tris.len()];
     edges.par_chunks_mut(3).enumerate().filter(|(k, _)| proper[*k]).for_each(|(k, out)| {
         let v = ids(k);
         for (c, e) in out.iter_mut().enumerate() {
             let (a, b) = (v[c], v[(c + 1) % 3]);
-            *e = ((a.min(b) as u64) << 32 | a.max(b) as u64, (k as u32) << 2 | c as u32);
+            *e = ((a.min(b) as u64) << 32 | a.max(b) as u64, k as u32, c as u8, a < b);
         }
     });
     edges.par_sort_unstable();
     edges.truncate(edges.partition_point(|e| e.0 != u64::MAX));
-    let forward = |e: &(u64, u32)| {
-        let v = ids((e.1 >> 2) as usize);
-        v[(e.1 & 3) as usize] < v[((e.1 & 3) as usize + 1) % 3]
-    };
-    let tri_of = |e: &(u64, u32)| tris[(e.1 >> 2) as usize];
+    let forward = |e: &Edge| e.3;
+    let tri_of = |e: &Edge| tris[e.1 as usize];
     // Corner slots (local triangle × 3 + corner) joined through the edges at their vertex.
     let mut corner: Vec<u32> = (0..tris.len() as u32 * 3).collect();
-    let corner_at = |e: &(u64, u32), lo_end: bool| {
-        let (k, c) = (e.1 >> 2, e.1 & 3);
-        // The edge runs from corner c to corner c+1; `forward` means corner c is the low end.
+    let corner_at = |e: &Edge, lo_end: bool| {
+        let (k, c) = (e.1, e.2 as u32);
         let at_c = forward(e) == lo_end;
         k * 3 + if at_c { c } else { (c + 1) % 3 }
     };
