@@ -44,6 +44,10 @@ pub struct SelfArgs {
     /// Write the report to FILE (atomically) instead of stdout.
     #[arg(short, long, value_name = "FILE")]
     pub output: Option<PathBuf>,
+    /// Also write JUnit XML to FILE (atomically): one test case per checked part, failed when
+    /// the part has something in --fail-on.
+    #[arg(long, value_name = "FILE")]
+    pub junit: Option<PathBuf>,
     /// What to print on stdout [default: json, or nothing when -o is given].
     #[arg(long, value_enum, value_name = "FORMAT")]
     pub format: Option<SelfFormat>,
@@ -282,6 +286,9 @@ fn run_in_pool(args: &SelfArgs, threads: usize) -> Result<SelfOutcome> {
         warnings: warnings.clone(),
     });
     let json = rep::to_json(&report);
+    if let Some(path) = &args.junit {
+        crate::report::write_atomic(path, junit(&parts, &fail_on).as_bytes())?;
+    }
     if let Some(path) = &args.output {
         crate::report::write_atomic(path, json.as_bytes())?;
     }
@@ -292,4 +299,63 @@ fn run_in_pool(args: &SelfArgs, threads: usize) -> Result<SelfOutcome> {
         Some(SelfFormat::Text) => Some(summary.clone()),
     };
     Ok(SelfOutcome { stdout, summary, warnings, exit_code: report.failed as u8, report: Box::new(report) })
+}
+
+/// JUnit XML: one test case per part, failed when the part meets a `fail_on` condition; the
+/// failure lists its first pairs and health findings.
+pub fn junit(parts: &[PartResult], fail_on: &[SelfFailOn]) -> String {
+    use crate::output::junit::{render, Case, FIRST};
+    let cases: Vec<Case> = parts
+        .iter()
+        .map(|p| {
+            let h = &p.health;
+            let touching = p.pairs.len() as u64 - p.crossing;
+            let mut findings: Vec<String> = p
+                .pairs
+                .iter()
+                .take(FIRST)
+                .map(|q| {
+                    let kind = if q.hit.crossing { "crossing" } else { "touching" };
+                    format!("triangles {} × {}: {kind} ({})", q.a, q.b, q.hit.contact.name())
+                })
+                .collect();
+            let health = [
+                ("boundary edges", &h.boundary_edges),
+                ("non-manifold edges", &h.non_manifold_edges),
+                ("non-manifold vertices", &h.non_manifold_vertices),
+                ("duplicate faces", &h.duplicate_faces),
+                ("zero-area triangles", &h.zero_area_triangles),
+                ("inconsistent winding edges", &h.inconsistent_winding_edges),
+            ];
+            let mut total = p.pairs.len() as u64;
+            for (what, f) in health {
+                if f.count > 0 {
+                    total += f.count;
+                    findings.push(format!("{} {what}, first triangles {:?}", f.count, f.triangles));
+                }
+            }
+            let verdict = if p.crossing > 0 {
+                "clash"
+            } else if touching > 0 {
+                "touching"
+            } else {
+                "clear"
+            };
+            Case {
+                name: p.name.clone(),
+                verdict: verdict.into(),
+                counts: format!(
+                    "{} crossing, {touching} touching self-clash pairs; {}",
+                    p.crossing,
+                    if h.closed { "closed" } else { "open" }
+                ),
+                findings,
+                total,
+                failed: fail_on.iter().any(|f| f.hit(p)),
+                time_s: 0.0,
+                output: String::new(),
+            }
+        })
+        .collect();
+    render("meshclash self", &cases)
 }

@@ -159,6 +159,33 @@ fn text_output_and_report_file() {
     assert!(out.stdout.is_empty());
     let r = parse(&std::fs::read(&report).unwrap());
     assert!(r.parts[0].health.closed);
+    // JUnit: one case per part, failed only for a part with something in --fail-on.
+    let junit = dir.path().join("j.xml");
+    let engine = shared("joined_tetrahedra.obj");
+    let out = bin()
+        .arg("self")
+        .arg(&engine)
+        .arg("--junit")
+        .arg(&junit)
+        .args(["-q", "--fail-on", "open"])
+        .output()
+        .unwrap();
+    assert_eq!(out.status.code(), Some(0));
+    let xml = std::fs::read_to_string(&junit).unwrap();
+    assert_eq!(xml.matches("<testcase").count(), 2, "{xml}");
+    assert!(!xml.contains("<failure"), "{xml}");
+    let out = bin()
+        .arg("self")
+        .arg(&engine)
+        .arg("--junit")
+        .arg(&junit)
+        .args(["-q", "--whole-file", "--fail-on", "duplicates"])
+        .output()
+        .unwrap();
+    assert_eq!(out.status.code(), Some(1));
+    let xml = std::fs::read_to_string(&junit).unwrap();
+    assert_eq!((xml.matches("<testcase").count(), xml.matches("<failure").count()), (1, 1), "{xml}");
+    assert!(xml.contains("1 duplicate faces, first triangles [7]"), "{xml}");
 }
 
 #[test]
