@@ -57,6 +57,9 @@ pub struct SelfArgs {
     /// List at most N triangle ids per health finding.
     #[arg(long, value_name = "N", default_value_t = 10)]
     pub first_n: usize,
+    /// BVH split strategy (the answer is the same with each; only the time differs).
+    #[arg(long, value_enum, default_value_t = crate::cli::BvhArg::Sah)]
+    pub bvh: crate::cli::BvhArg,
     /// Largest BVH leaf, in triangles (1..=64).
     #[arg(long, value_name = "N", default_value_t = 4)]
     pub leaf_size: u32,
@@ -249,7 +252,12 @@ fn run_in_pool(args: &SelfArgs, threads: usize) -> Result<SelfOutcome> {
         (args.select.is_empty() || args.select.iter().any(|g| crate::assembly::glob_match(g, name)))
             && !args.exclude.iter().any(|g| crate::assembly::glob_match(g, name))
     };
-    let opts = BuildOptions { strategy: Strategy::Sah, leaf_size: args.leaf_size };
+    let strategy = match args.bvh {
+        crate::cli::BvhArg::Sah => Strategy::Sah,
+        crate::cli::BvhArg::Median => Strategy::Median,
+        crate::cli::BvhArg::Equal => Strategy::Equal,
+    };
+    let opts = BuildOptions { strategy, leaf_size: args.leaf_size };
     let whole_name = args.file.display().to_string();
     let choice = if args.whole_file { PartChoice::Whole(&whole_name) } else { PartChoice::Objects(&keep) };
     let (parts, health_ms, query_ms) = check_parts(&input.mesh, choice, opts, args.first_n);
@@ -273,6 +281,7 @@ fn run_in_pool(args: &SelfArgs, threads: usize) -> Result<SelfOutcome> {
         whole_file: args.whole_file,
         select: &args.select,
         exclude: &args.exclude,
+        bvh: strategy.name(),
         leaf_size: args.leaf_size,
         max_pairs: args.max_pairs,
         first_n: args.first_n,

@@ -15,7 +15,7 @@
 //!   "input": {"path", "format": "obj|stl|gltf|glb", "vertices", "triangles",
 //!             "objects": [{"name", "triangles"}]},
 //!   "settings": {"fail_on": ["self-clash", ...], "split_bodies", "whole_file", "select": [glob], "exclude": [glob],
-//!                "bvh": "sah", "leaf_size", "max_pairs", "first_n", "threads": n | null},
+//!                "bvh": "sah|median|equal", "leaf_size", "max_pairs", "first_n", "threads": n | null},
 //!   "verdict": "clash" | "touching" | "clear",   // worst self-clash pair: crossing, touching, none
 //!   "failed": bool,                              // something in fail_on was found (exit code 1)
 //!   "failed_on": ["open", ...],                  // which fail_on conditions were met
@@ -112,7 +112,7 @@ pub struct SelfSettings {
     pub select: Vec<String>,
     /// `--exclude` globs.
     pub exclude: Vec<String>,
-    /// Always `sah`.
+    /// `sah`, `median` or `equal` (`--bvh`).
     pub bvh: String,
     /// Largest leaf.
     pub leaf_size: u32,
@@ -240,6 +240,8 @@ pub struct Context<'a> {
     pub select: &'a [String],
     /// `--exclude` globs.
     pub exclude: &'a [String],
+    /// `--bvh` (`sah`, `median` or `equal`).
+    pub bvh: &'static str,
     /// `--leaf-size`.
     pub leaf_size: u32,
     /// `--max-pairs`.
@@ -340,7 +342,7 @@ pub fn build(ctx: &Context) -> SelfReport {
             whole_file: ctx.whole_file,
             select: ctx.select.to_vec(),
             exclude: ctx.exclude.to_vec(),
-            bvh: "sah".into(),
+            bvh: ctx.bvh.into(),
             leaf_size: ctx.leaf_size,
             max_pairs: ctx.max_pairs,
             first_n: ctx.first_n,
