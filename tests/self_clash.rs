@@ -232,6 +232,10 @@ fn one_and_two_threads_give_byte_identical_reports() {
     assert_eq!(outs[0], outs[1]);
     let r = parse(&outs[0]);
     assert!(r.summary.crossing_pairs > 0 && r.summary.touching_pairs > 0);
+    // Another tree (strategy, leaf size) gives the same answer.
+    let (other, _) = run(&file, &["--bvh", "median", "--leaf-size", "1", "--fail-on", "never"]);
+    assert_eq!((&other.pairs, &other.parts, &other.summary), (&r.pairs, &r.parts, &r.summary));
+    assert_eq!(other.settings.bvh, "median");
     // Pairs sorted, a < b, both in the same part.
     assert!(r.pairs.windows(2).all(|w| (w[0].a, w[0].b) < (w[1].a, w[1].b)));
     assert!(r.pairs.iter().all(|p| p.a < p.b && p.a_object == p.b_object));
