@@ -248,6 +248,13 @@ fn run_in_pool(args: &SelfArgs, threads: usize) -> Result<SelfOutcome> {
         crate::bodies::split_bodies(&mut input.mesh);
     }
     let load_ms = t0.elapsed().as_secs_f64() * 1e3;
+    // Health numbers triangle corners in u32 (3 per triangle).
+    if input.mesh.triangles.len() > (u32::MAX / 3) as usize {
+        return Err(Error::input(
+            &args.file,
+            format!("{} triangles: `self` handles at most {}", input.mesh.triangles.len(), u32::MAX / 3),
+        ));
+    }
     let keep = |name: &str| {
         (args.select.is_empty() || args.select.iter().any(|g| crate::assembly::glob_match(g, name)))
             && !args.exclude.iter().any(|g| crate::assembly::glob_match(g, name))
