@@ -6,11 +6,11 @@ use criterion::{black_box, criterion_group, criterion_main, Criterion, Throughpu
 use glam::{DMat4, DVec3};
 use meshclash::bench::gen;
 use meshclash::bvh::{BuildOptions, Bvh, Strategy};
-use meshclash::narrow::distance::triangle_distance;
-use meshclash::geom::Aabb;
-use meshclash::scene::mesh::Mesh;
 use meshclash::check::query::{check, load_input, InputSpec, Settings};
+use meshclash::geom::Aabb;
+use meshclash::narrow::distance::triangle_distance;
 use meshclash::narrow::tri_tri::{classify, classify_unfiltered, Hit};
+use meshclash::scene::mesh::Mesh;
 
 /// Deterministic pseudo-random triangle pairs near each other (a mix of crossing and apart).
 fn pairs(n: usize) -> Vec<([DVec3; 3], [DVec3; 3])> {

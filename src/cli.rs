@@ -3,10 +3,10 @@
 //! the binary prints it.
 
 use crate::bvh::{BuildOptions, Strategy};
+use crate::check::query::{self, DistanceError, FailOn, InputSpec, Mode, Settings};
 use crate::error::{Error, Result};
 use crate::geom::predicates::Tolerances;
 use crate::output::progress::Phase;
-use crate::check::query::{self, DistanceError, FailOn, InputSpec, Mode, Settings};
 use crate::report::{self, SettingsReport};
 use clap::{Parser, ValueEnum};
 use glam::{DMat4, DVec3, DVec4};
@@ -159,6 +159,9 @@ pub enum Command {
     /// Run the named checks of a clash-set file (JSON) in one go: one JSON document with every
     /// check's report, exit 1 if any check fails its --fail-on, 2 on bad input in any check.
     ClashSet(crate::clash_set::ClashSetArgs),
+    /// Check one mesh against itself: self-clashing triangle pairs and mesh health per part.
+    #[command(name = "self")]
+    SelfCheck(crate::self_cmd::SelfArgs),
 }
 
 /// `--fail-on` values.

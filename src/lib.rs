@@ -28,5 +28,6 @@ pub mod narrow;
 pub mod output;
 pub mod report;
 pub mod scene;
+pub mod self_cmd;
 
 pub use error::{Error, Result};

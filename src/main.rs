@@ -25,11 +25,14 @@ fn main() -> ExitCode {
     if let Some(cli::Command::ClashSet(set)) = args.command {
         return clash_set(set);
     }
+    if let Some(cli::Command::SelfCheck(s)) = args.command {
+        return self_check(s);
+    }
     if let Some(cmd) = &args.command {
         // `schema`, `completions <shell>`, `man`: generated text on stdout; `bench`: its tables.
         let text = match cmd {
             cli::Command::Output(c) => c.render(),
-            cli::Command::ClashSet(_) => unreachable!("handled above"),
+            cli::Command::ClashSet(_) | cli::Command::SelfCheck(_) => unreachable!("handled above"),
             cli::Command::Bench(b) => match meshclash::bench::run_command(b) {
                 Ok(t) => t,
                 Err(e) => {
@@ -144,5 +147,31 @@ fn print_stdout(text: &str) -> ExitCode {
             ExitCode::from(2)
         }
         _ => ExitCode::SUCCESS,
+    }
+}
+
+/// `meshclash self FILE`: the report on stdout (or -o), the summary on stderr at a terminal.
+fn self_check(args: meshclash::self_cmd::SelfArgs) -> ExitCode {
+    let quiet = args.quiet;
+    match meshclash::self_cmd::run(&args) {
+        Ok(out) => {
+            if !quiet {
+                for w in &out.warnings {
+                    eprintln!("meshclash: warning: {w}");
+                }
+                let text_on_stdout = args.format == Some(meshclash::self_cmd::SelfFormat::Text);
+                if std::io::stderr().is_terminal() && !text_on_stdout {
+                    eprint!("{}", out.summary);
+                }
+            }
+            match out.stdout.map(|s| print_stdout(&s)) {
+                Some(code) if code != ExitCode::SUCCESS => code,
+                _ => ExitCode::from(out.exit_code),
+            }
+        }
+        Err(e) => {
+            eprintln!("meshclash: error: {e}");
+            ExitCode::from(e.exit_code())
+        }
     }
 }

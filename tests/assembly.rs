@@ -165,7 +165,10 @@ fn load_gltf(bytes: &[u8]) -> meshclash::scene::mesh::Mesh {
 fn scene_pairs(
     mesh: &meshclash::scene::mesh::Mesh,
     settings: &Settings,
-) -> (BTreeMap<(String, String), meshclash::check::query::ClashResult>, meshclash::check::assembly::AssemblyResult) {
+) -> (
+    BTreeMap<(String, String), meshclash::check::query::ClashResult>,
+    meshclash::check::assembly::AssemblyResult,
+) {
     let run = |threads: usize| {
         let parts = parts_of(mesh, 0);
         let all: Vec<usize> = (0..parts.len()).collect();

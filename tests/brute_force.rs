@@ -2,12 +2,12 @@
 //! against brute force over every triangle pair, on random small meshes rich in exact contacts.
 
 use meshclash::bvh::{BuildOptions, Strategy as Split};
-use meshclash::narrow::distance::triangle_distance;
+use meshclash::check::query::{check, PairKind, Settings};
 use meshclash::geom::predicates::Tolerances;
 use meshclash::geom::DVec3;
-use meshclash::scene::mesh::{Mesh, Object};
-use meshclash::check::query::{check, PairKind, Settings};
+use meshclash::narrow::distance::triangle_distance;
 use meshclash::narrow::tri_tri::classify;
+use meshclash::scene::mesh::{Mesh, Object};
 use proptest::prelude::*;
 
 fn mesh(tris: &[[DVec3; 3]]) -> Mesh {

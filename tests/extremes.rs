@@ -26,11 +26,11 @@ mod oracle;
 use gen::{all_frames, boxed, corners, plate, small_frames, Class, Frame, Mb, Off};
 use meshclash::check::containment::Containment;
 use meshclash::check::cross_check::parry_f64;
+use meshclash::check::query::{check, ClashResult, PairKind, Settings, Verdict};
 use meshclash::geom::predicates::Tolerances;
 use meshclash::geom::DVec3;
-use meshclash::scene::mesh::Mesh;
-use meshclash::check::query::{check, ClashResult, PairKind, Settings, Verdict};
 use meshclash::narrow::tri_tri::Contact;
+use meshclash::scene::mesh::Mesh;
 use std::fmt::Write as _;
 
 // ---------------------------------------------------------------------------------------------
@@ -342,7 +342,8 @@ fn oracle_containment(a: &Mesh, b: &Mesh, rows: &[Row]) -> Cont {
     // Shared volume: the outward winding comes from meshclash's own `outward` (winding
     // propagation is not what this suite checks); the coplanarity and normal directions are
     // decided here exactly.
-    let out = |m: &Mesh| meshclash::check::containment::outward(m, &meshclash::check::containment::topology(m));
+    let out =
+        |m: &Mesh| meshclash::check::containment::outward(m, &meshclash::check::containment::topology(m));
     let (oa, ob) = (out(a), out(b));
     if let (Some(oa), Some(ob)) = (oa, ob) {
         for r in rows.iter().filter(|r| r.3 == Some(Contact::CoplanarArea)) {
@@ -772,7 +773,9 @@ fn duplicate_mesh_pairs_every_triangle_with_its_twin_and_neighbours() {
             let twins = got.iter().filter(|p| p.0 == p.1 && p.3 == Some(Contact::CoplanarArea)).count();
             // A duplicated solid shares all its volume with its twin (a clash); a duplicated
             // open sheet only touches.
-            let solid = meshclash::check::containment::outward(&m, &meshclash::check::containment::topology(&m)).is_some();
+            let solid =
+                meshclash::check::containment::outward(&m, &meshclash::check::containment::topology(&m))
+                    .is_some();
             let want_verdict = if solid { Verdict::Clash } else { Verdict::Touching };
             if got != want || twins != t.len() || r.verdict != want_verdict {
                 let only_got: Vec<_> = got.iter().filter(|x| !want.contains(x)).take(6).collect();
@@ -1108,7 +1111,8 @@ fn parry_agrees_where_it_is_stable() {
             let p = parry_f64(&o.built.a, &o.built.b, true).expect("parry runs");
             let ours: Vec<(u32, u32)> =
                 o.r.pairs.iter().filter(|x| x.kind != PairKind::Clearance).map(|x| (x.a, x.b)).collect();
-            let (only_ours, only_parry) = meshclash::check::cross_check::diff_pairs(&ours, &p.intersecting_pairs);
+            let (only_ours, only_parry) =
+                meshclash::check::cross_check::diff_pairs(&ours, &p.intersecting_pairs);
             let our_d = o.r.closest.map_or(f64::NAN, |c| c.distance);
             let _ = writeln!(
                 table,

@@ -2,8 +2,8 @@
 //! (`fcl_env_rob_reference.json`, python-fcl 0.7 OBBRSS): env moved, rob fixed.
 
 use glam::{DMat4, DVec4};
-use meshclash::narrow::distance::triangle_distance;
 use meshclash::check::query::{check, load_input, place, InputSpec, Settings, Verdict};
+use meshclash::narrow::distance::triangle_distance;
 use meshclash::narrow::tri_tri::classify;
 use serde_json::Value;
 use std::path::PathBuf;

@@ -6,9 +6,9 @@
 use glam::{DMat4, DQuat, DVec3};
 use meshclash::bvh::triangle;
 use meshclash::check::cross_check::parry_f64;
+use meshclash::check::query::{check, place, Settings};
 use meshclash::narrow::distance::closest_point_on_triangle;
 use meshclash::scene::mesh::{Mesh, Object};
-use meshclash::check::query::{check, place, Settings};
 use proptest::prelude::*;
 use std::path::Path;
 

@@ -26,15 +26,15 @@ pub mod layout;
 pub mod svg;
 pub mod sweep;
 
+use crate::bvh::traverse;
 use crate::bvh::{self, BuildOptions, Bvh, Strategy};
 use crate::check::cross_check::{self, ParryResult};
+use crate::check::query::{self, ClashResult, DistanceError, Mode, Settings};
 use crate::error::{Error, Result};
 use crate::geom::predicates;
 use crate::geom::Aabb;
-use crate::scene::mesh::Mesh;
-use crate::check::query::{self, ClashResult, DistanceError, Mode, Settings};
-use crate::bvh::traverse;
 use crate::narrow::tri_tri;
+use crate::scene::mesh::Mesh;
 use serde::Serialize;
 use std::path::PathBuf;
 use std::sync::atomic::{AtomicBool, Ordering};

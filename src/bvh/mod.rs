@@ -9,8 +9,8 @@
 //! of the centroid bounds and equal counts (object median).
 
 mod build;
-mod validate;
 pub mod traverse;
+mod validate;
 
 use crate::geom::{Aabb, DVec3};
 use crate::scene::mesh::Mesh;

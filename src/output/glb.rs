@@ -14,8 +14,8 @@
 //! Highlight and marker nodes are present only when they have something to show. Only the
 //! report's listed pairs are drawn (`--max-pairs`).
 
-use crate::scene::mesh::Mesh;
 use crate::report::Report;
+use crate::scene::mesh::Mesh;
 use glam::DVec3;
 use serde_json::{json, Value};
 use std::collections::BTreeSet;

@@ -12,11 +12,11 @@ pub mod progress;
 pub mod text;
 pub mod write;
 
-use crate::report::baseline;
-use crate::error::{Error, Result};
-use crate::scene::mesh::Mesh;
 use crate::check::query::ClashResult;
+use crate::error::{Error, Result};
+use crate::report::baseline;
 use crate::report::{self, Report};
+use crate::scene::mesh::Mesh;
 use clap::CommandFactory;
 use std::path::PathBuf;
 

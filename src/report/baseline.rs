@@ -19,10 +19,10 @@
 //! `a_in_b|b_in_a|a_partly_in_b|b_partly_in_a`, and the baseline did not say the same).
 //! New touching or clearance pairs are listed but do not fail it.
 
-use crate::error::{Error, Result};
-use crate::scene::mesh::Mesh;
 use crate::check::query::{PairFinding, PairKind};
+use crate::error::{Error, Result};
 use crate::report::Report;
+use crate::scene::mesh::Mesh;
 use serde::{Deserialize, Serialize};
 use std::collections::{BTreeSet, HashMap, HashSet};
 use std::path::Path;

@@ -54,10 +54,11 @@
 //! index into `inputs.*.objects`.
 
 pub mod baseline;
+pub mod self_report;
 
+use crate::check::query::{ClashResult, Input, PairFinding, TreeStats, Verdict};
 use crate::error::Result;
 use crate::geom::{Aabb, DVec3};
-use crate::check::query::{ClashResult, Input, PairFinding, TreeStats, Verdict};
 use glam::DMat4;
 use serde::{Deserialize, Serialize};
 use std::path::Path;
@@ -659,7 +660,8 @@ fn pair_report(p: &PairFinding, ca: &[u32], cb: &[u32]) -> PairReport {
 /// Assemble the report.
 pub fn build(ctx: &Context, r: &ClashResult) -> Report {
     let [ia, ib] = ctx.inputs;
-    let (infa, infb) = (crate::check::query::MeshInfo::of(&ia.mesh), crate::check::query::MeshInfo::of(&ib.mesh));
+    let (infa, infb) =
+        (crate::check::query::MeshInfo::of(&ia.mesh), crate::check::query::MeshInfo::of(&ib.mesh));
     let (oa, ob) = (&ia.mesh.tri_object, &ib.mesh.tri_object);
     let max = ctx.settings.max_pairs;
     let warnings = ctx

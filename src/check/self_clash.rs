@@ -1,0 +1,401 @@
+//! Self-clash: the triangle pairs of one part that meet anywhere the mesh connectivity does not
+//! say they meet.
+//!
+//! # The rule
+//!
+//! Vertices are identified by exact position first (bit-identical coordinates, +0 = −0:
+//! [`crate::scene::bodies::merge_vertices`]). Two triangles `s` and `t` of one part *share* the merged
+//! vertices they both use; connectivity says they meet in `H`, the convex hull of those shared
+//! vertices (nothing, a vertex, an edge, or — three shared vertices — the whole face). Since both
+//! closed triangles contain `H`, their intersection `I` always contains it; the pair is a
+//! **self-clash iff `I ≠ H`**, decided exactly:
+//!
+//! * **Nothing shared**: any contact at all ([`crate::narrow::tri_tri::classify`]).
+//! * **One shared vertex `v`**, `s = conv(v, a, b)`, `t = conv(v, c, d)`: every point `p ≠ v` of
+//!   `s` lies on a ray from `v` that leaves `s` through the opposite segment `[a, b]`, and the same
+//!   holds for `t` and `[c, d]`. If `p ∈ I`, the nearer of the two exit points lies in both
+//!   triangles. Hence `I ≠ {v}` iff `[a, b]` meets `t` or `[c, d]` meets `s` — two exact
+//!   segment–triangle tests. (A zero-area `s` whose opposite segment contains `v` in its interior
+//!   is the union of the segments `[v, a]` and `[v, b]`, each tested the same way.)
+//! * **One shared edge `[u, w]`**, third vertices `a` of `s` and `b` of `t`:
+//!   - both proper (non-zero area) and not coplanar: `I` lies on the planes' common line, which
+//!     meets `s` only in `[u, w]`: no clash;
+//!   - both proper and coplanar: a fold iff `a` and `b` lie on the same side of the line `uw`
+//!     in the plane (exact `orient2d` on the plane's projection): the interiors overlap along the
+//!     whole edge;
+//!   - one proper, one zero-area: the zero-area one lies on the line `uw`, which meets the proper
+//!     one only in `[u, w]`: no clash;
+//!   - both zero-area (all five points on one line): a clash iff `a` and `b` both extend beyond
+//!     the same end of `[u, w]`.
+//! * **All three vertices shared** (the same face stored twice, in either winding): never a
+//!   self-clash pair; such faces are reported by [`crate::check::health`] as duplicates.
+//!
+//! A triangle whose indices repeat a merged vertex has fewer distinct vertices (a segment or a
+//! point), and the rule applies with those. A pair that is a self-clash is then classified like
+//! any pair of a two-mesh check (crossing or touching, and the contact shape) from the two whole
+//! triangles, so the vocabulary is the same.
+//!
+//! # The walk
+//!
+//! One BVH per part (binned SAH, [`crate::bvh`]) is walked against itself: a node is paired with
+//! itself once (its two children each with themselves, and the two children with each other),
+//! and two different nodes as in a dual-tree walk, so each unordered leaf pair is visited once
+//! and each unordered triangle pair is tested once. As in [`crate::bvh::traverse`], the root is
+//! expanded breadth-first into a fixed number of independent sub-walks, and the result is
+//! sorted, so the answer does not depend on the thread count.
+
+use crate::bvh::{BuildOptions, Bvh};
+use crate::geom::predicates::{self as pr, PlaneFilter};
+use crate::geom::{Aabb, DVec3};
+use crate::narrow::tri_tri::{self, Hit};
+use crate::scene::mesh::Mesh;
+use rayon::prelude::*;
+use std::ops::Range;
+
+/// How many independent sub-walks the root is split into (fixed, for determinism).
+const SEED_TASKS: usize = 256;
+
+/// A self-clashing pair of triangles, `a < b` (indices into the mesh).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct SelfPair {
+    /// The lower triangle index.
+    pub a: u32,
+    /// The higher triangle index.
+    pub b: u32,
+    /// How they meet (from the two whole triangles).
+    pub hit: Hit,
+}
+
+/// The distinct merged vertices of a triangle, with their positions (1 to 3 of them).
+fn distinct(tri: &[DVec3; 3], ids: [u32; 3]) -> ([(u32, DVec3); 3], usize) {
+    let mut out = [(ids[0], tri[0]); 3];
+    let mut n = 1;
+    for k in 1..3 {
+        if !out[..n].iter().any(|&(i, _)| i == ids[k]) {
+            out[n] = (ids[k], tri[k]);
+            n += 1;
+        }
+    }
+    (out, n)
+}
+
+/// Exact: is `v` strictly between `a` and `b` on their common line (`a ≠ b`)?
+fn strictly_between(v: DVec3, a: DVec3, b: DVec3) -> bool {
+    if !pr::collinear(v, a, b) {
+        return false;
+    }
+    // On a line, the order along any axis on which `a` and `b` differ is the order on the line.
+    let k = (0..3).find(|&k| a[k] != b[k]).expect("a != b");
+    let (lo, hi) = if a[k] < b[k] { (a[k], b[k]) } else { (b[k], a[k]) };
+    lo < v[k] && v[k] < hi
+}
+
+/// Exact: does the segment `[p, q]` (possibly a point) meet the closed triangle `t`?
+fn segment_meets(p: DVec3, q: DVec3, t: &[DVec3; 3]) -> bool {
+    tri_tri::classify(&[p, q, q], t).is_some()
+}
+
+/// Exact, for `s = conv(v, oa)` and `t = conv(v, ob)` (`oa`, `ob`: the other distinct vertices,
+/// 0 to 2 each, all different from `v`): do they meet anywhere but `v`? See the module docs.
+fn meets_beyond_vertex(v: DVec3, oa: &[DVec3], ob: &[DVec3]) -> bool {
+    if oa.is_empty() || ob.is_empty() {
+        return false; // one of them is the point v
+    }
+    if let [a1, a2] = *oa {
+        if strictly_between(v, a1, a2) {
+            return meets_beyond_vertex(v, &[a1], ob) || meets_beyond_vertex(v, &[a2], ob);
+        }
+    }
+    if let [b1, b2] = *ob {
+        if strictly_between(v, b1, b2) {
+            return meets_beyond_vertex(v, oa, &[b1]) || meets_beyond_vertex(v, oa, &[b2]);
+        }
+    }
+    let tri = |o: &[DVec3]| [v, o[0], o[o.len() - 1]];
+    segment_meets(oa[0], oa[oa.len() - 1], &tri(ob)) || segment_meets(ob[0], ob[ob.len() - 1], &tri(oa))
+}
+
+/// Exact, for `s = conv(u, w, a)` and `t = conv(u, w, b)` with `u, w, a, b` four different
+/// points: do they meet anywhere but the segment `[u, w]`? See the module docs.
+fn meets_beyond_edge(u: DVec3, w: DVec3, a: DVec3, b: DVec3) -> bool {
+    let (pa, pb) = (!pr::collinear(u, w, a), !pr::collinear(u, w, b));
+    match (pa, pb) {
+        (true, true) => {
+            if pr::orient3d(u, w, a, b) != 0 {
+                return false;
+            }
+            let axis = pr::projection_axis(u, w, a).expect("proper triangle");
+            pr::orient2d(u, w, a, axis) == pr::orient2d(u, w, b, axis)
+        }
+        (false, false) => {
+            let k = (0..3).find(|&k| u[k] != w[k]).expect("u != w");
+            let (lo, hi) = if u[k] < w[k] { (u[k], w[k]) } else { (w[k], u[k]) };
+            (a[k] > hi && b[k] > hi) || (a[k] < lo && b[k] < lo)
+        }
+        _ => false,
+    }
+}
+
+/// Classify a pair of triangles of one part with its connectivity: `ia`, `ib` are the merged
+/// (exact-position) vertex ids of `ta`, `tb`. `None` unless they meet beyond what they share
+/// (see the module docs); then the classification of the whole pair.
+pub fn classify_adjacent(ta: &[DVec3; 3], ia: [u32; 3], tb: &[DVec3; 3], ib: [u32; 3]) -> Option<Hit> {
+    // Ids first (cheap); positions are gathered only for the pairs the filters cannot settle.
+    let distinct_count = |i: [u32; 3]| 1 + (i[1] != i[0]) as usize + (i[2] != i[0] && i[2] != i[1]) as usize;
+    let (na, nb) = (distinct_count(ia), distinct_count(ib));
+    let shared = (0..3).filter(|&k| ib.contains(&ia[k]) && !ia[..k].contains(&ia[k])).count();
+    if shared == 0 {
+        return tri_tri::classify(ta, tb);
+    }
+    if shared == 3 || (shared == 2 && (na < 3 || nb < 3)) {
+        // All three shared (a duplicate face), or two shared and one triangle is just that
+        // segment: the intersection is exactly what is shared.
+        return None;
+    }
+    // Float filters: a triangle whose unshared vertices the other's plane filter proves strictly
+    // on one side meets that plane only in what is shared, so the pair is fine. Proven signs
+    // are exact, so this only skips work, never changes an answer.
+    let off_plane = |f: &PlaneFilter, t: &[DVec3; 3], own: [u32; 3], other: [u32; 3]| {
+        let mut side = 0;
+        for k in 0..3 {
+            if !other.contains(&own[k]) {
+                match f.side(t[k]) {
+                    Some(s) if s != 0 && (side == 0 || side == s) => side = s,
+                    _ => return false,
+                }
+            }
+        }
+        side != 0
+    };
+    if off_plane(&PlaneFilter::new(ta), tb, ib, ia) || off_plane(&PlaneFilter::new(tb), ta, ia, ib) {
+        return None;
+    }
+    let (da, na) = distinct(ta, ia);
+    let (db, nb) = distinct(tb, ib);
+    let (da, db) = (&da[..na], &db[..nb]);
+    let in_b = |id: u32| db.iter().any(|&(j, _)| j == id);
+    let beyond = match shared {
+        1 => {
+            let v = da.iter().find(|&&(i, _)| in_b(i)).unwrap();
+            let others = |d: &[(u32, DVec3)]| -> ([DVec3; 2], usize) {
+                let mut o = [DVec3::ZERO; 2];
+                let mut n = 0;
+                for &(i, p) in d {
+                    if i != v.0 {
+                        o[n] = p;
+                        n += 1;
+                    }
+                }
+                (o, n)
+            };
+            let ((oa, ka), (ob, kb)) = (others(da), others(db));
+            meets_beyond_vertex(v.1, &oa[..ka], &ob[..kb])
+        }
+        _ => {
+            let shared: Vec<DVec3> = da.iter().filter(|&&(i, _)| in_b(i)).map(|x| x.1).collect();
+            let a = da.iter().find(|&&(i, _)| !in_b(i)).unwrap().1;
+            let b = db.iter().find(|&&(j, _)| !da.iter().any(|&(i, _)| i == j)).unwrap().1;
+            meets_beyond_edge(shared[0], shared[1], a, b)
+        }
+    };
+    if beyond {
+        tri_tri::classify(ta, tb)
+    } else {
+        None
+    }
+}
+
+/// Walk `tree` against itself: `leaf_self` gets each leaf once, `leaf_pair` each unordered pair
+/// of different leaves whose boxes overlap (closed boxes) once, each leaf as its range of
+/// positions in `tree.prims`. Results come back in an order that depends only on the tree.
+pub fn self_walk<T, S, P>(tree: &Bvh, leaf_self: S, leaf_pair: P) -> Vec<T>
+where
+    T: Send,
+    S: Fn(Range<usize>, &mut Vec<T>) + Sync,
+    P: Fn(Range<usize>, Range<usize>, &mut Vec<T>) + Sync,
+{
+    let range = |n: &crate::bvh::Node| n.a as usize..(n.a + n.count) as usize;
+    #[derive(Clone, Copy)]
+    enum Job {
+        Node(u32),
+        Pair(u32, u32),
+    }
+    let nodes = &tree.nodes;
+    if nodes.is_empty() {
+        return Vec::new();
+    }
+    let meet = |i: u32, j: u32| nodes[i as usize].bounds.overlaps(&nodes[j as usize].bounds);
+    // Expand one job; leaf work goes to `out`, new jobs to `push`.
+    let step = |job: Job, out: &mut Vec<T>, push: &mut dyn FnMut(Job)| match job {
+        Job::Node(i) => {
+            let n = &nodes[i as usize];
+            if n.is_leaf() {
+                leaf_self(range(n), out);
+            } else {
+                push(Job::Node(i + 1));
+                push(Job::Node(n.a));
+                if meet(i + 1, n.a) {
+                    push(Job::Pair(i + 1, n.a));
+                }
+            }
+        }
+        Job::Pair(i, j) => {
+            let (a, b) = (&nodes[i as usize], &nodes[j as usize]);
+            let open_a = match (a.is_leaf(), b.is_leaf()) {
+                (true, true) => {
+                    leaf_pair(range(a), range(b), out);
+                    return;
+                }
+                (true, false) => false,
+                (false, true) => true,
+                (false, false) => a.bounds.half_area() >= b.bounds.half_area(),
+            };
+            let kids = if open_a { [(i + 1, j), (a.a, j)] } else { [(i, j + 1), (i, b.a)] };
+            for (x, y) in kids {
+                if meet(x, y) {
+                    push(Job::Pair(x, y));
+                }
+            }
+        }
+    };
+    // Breadth-first seeding: leaf work met on the way is done here, in order.
+    let mut early = Vec::new();
+    let mut level = vec![Job::Node(0)];
+    while !level.is_empty() && level.len() < SEED_TASKS {
+        let mut next = Vec::with_capacity(level.len() * 3);
+        for &job in &level {
+            step(job, &mut early, &mut |j| next.push(j));
+        }
+        level = next;
+    }
+    let parts: Vec<Vec<T>> = level
+        .par_iter()
+        .map(|&seed| {
+            let mut out = Vec::new();
+            let mut stack = vec![seed];
+            while let Some(job) = stack.pop() {
+                step(job, &mut out, &mut |j| stack.push(j));
+            }
+            out
+        })
+        .collect();
+    early.into_iter().chain(parts.into_iter().flatten()).collect()
+}
+
+/// Every self-clashing pair among `tris` (triangle indices of `mesh`, one part), sorted by
+/// `(a, b)`. `merged` gives each vertex of `mesh` its exact-position id
+/// ([`crate::scene::bodies::merge_vertices`]).
+pub fn self_pairs(mesh: &Mesh, merged: &[u32], tris: &[u32], opts: BuildOptions) -> Vec<SelfPair> {
+    let boxes: Vec<Aabb> =
+        tris.par_iter().map(|&t| Aabb::of_triangle(&crate::bvh::triangle(mesh, t))).collect();
+    let tree = Bvh::build_from_boxes(&boxes, opts);
+    drop(boxes);
+    // What a pair test reads, laid out in the tree's leaf order so that a leaf is one run of
+    // memory: (box, merged ids, triangle index in `mesh`). 64 bytes per triangle.
+    let slots: Vec<(Aabb, [u32; 3], u32)> = tree
+        .prims
+        .par_iter()
+        .map(|&k| {
+            let t = tris[k as usize];
+            let v = mesh.triangles[t as usize];
+            (Aabb::of_triangle(&crate::bvh::triangle(mesh, t)), v.map(|i| merged[i as usize]), t)
+        })
+        .collect();
+    let test = |x: &(Aabb, [u32; 3], u32), y: &(Aabb, [u32; 3], u32), out: &mut Vec<SelfPair>| {
+        if !x.0.overlaps(&y.0) {
+            return;
+        }
+        // Lower triangle first, so the listed segment does not depend on the tree.
+        let (x, y) = if x.2 < y.2 { (x, y) } else { (y, x) };
+        let (ta, tb) = (crate::bvh::triangle(mesh, x.2), crate::bvh::triangle(mesh, y.2));
+        if let Some(hit) = classify_adjacent(&ta, x.1, &tb, y.1) {
+            out.push(SelfPair { a: x.2, b: y.2, hit });
+        }
+    };
+    let mut pairs = self_walk(
+        &tree,
+        |leaf, out| {
+            let leaf = &slots[leaf];
+            for (k, x) in leaf.iter().enumerate() {
+                for y in &leaf[k + 1..] {
+                    test(x, y, out);
+                }
+            }
+        },
+        |la, lb, out| {
+            for x in &slots[la] {
+                for y in &slots[lb.clone()] {
+                    test(x, y, out);
+                }
+            }
+        },
+    );
+    pairs.par_sort_unstable_by_key(|p| (p.a, p.b));
+    pairs
+}
+
+/// The same answer as [`self_pairs`] by testing every pair (quadratic; for tests).
+pub fn self_pairs_brute_force(mesh: &Mesh, merged: &[u32], tris: &[u32]) -> Vec<SelfPair> {
+    let mut sorted = tris.to_vec();
+    sorted.sort_unstable();
+    let ids = |t: u32| mesh.triangles[t as usize].map(|v| merged[v as usize]);
+    let mut out = Vec::new();
+    for (x, &a) in sorted.iter().enumerate() {
+        for &b in &sorted[x + 1..] {
+            let (ta, tb) = (crate::bvh::triangle(mesh, a), crate::bvh::triangle(mesh, b));
+            if let Some(hit) = classify_adjacent(&ta, ids(a), &tb, ids(b)) {
+                out.push(SelfPair { a, b, hit });
+            }
+        }
+    }
+    out
+}
+
+#[cfg(test)]
+mod tests;
+
+/// Generated inputs for tests and the benchmark.
+pub mod gen {
+    use crate::geom::DVec3;
+    use crate::scene::mesh::Mesh;
+
+    /// [`crate::bench::gen::torus`] (`≈ n` triangles, closed, major radius 1, minor 0.35) with
+    /// one fold: the vertex on the outer equator at angle 0 is pulled through the tube to
+    /// `(0.5, 0, 0)`, inside the hole, so its six triangles pierce the inner wall.
+    pub fn folded_torus(n: usize) -> Mesh {
+        let mut m = crate::bench::gen::torus(n);
+        m.positions[0] = DVec3::new(0.5, 0.0, 0.0);
+        m
+    }
+
+    /// A closed tube of radius `small` swept along the figure eight `(cos t, sin 2t / 2, 0)`:
+    /// the path crosses itself at the origin (at `t = π/2` and `t = 3π/2`, at right angles), so
+    /// the tube overlaps itself there. `u` rings of `v` vertices, two triangles per quad.
+    pub fn figure_eight_tube(u: usize, v: usize, small: f64) -> Mesh {
+        let mut positions = Vec::with_capacity(u * v);
+        for i in 0..u {
+            let t = i as f64 / u as f64 * std::f64::consts::TAU;
+            let c = DVec3::new(t.cos(), (2.0 * t).sin() / 2.0, 0.0);
+            let tangent = DVec3::new(-t.sin(), (2.0 * t).cos(), 0.0).normalize();
+            let side = tangent.cross(DVec3::Z);
+            for j in 0..v {
+                let ph = j as f64 / v as f64 * std::f64::consts::TAU;
+                positions.push(c + small * (ph.cos() * side + ph.sin() * DVec3::Z));
+            }
+        }
+        let id = |i: usize, j: usize| ((i % u) * v + (j % v)) as u32;
+        let mut triangles = Vec::with_capacity(2 * u * v);
+        for i in 0..u {
+            for j in 0..v {
+                triangles.push([id(i, j), id(i + 1, j), id(i + 1, j + 1)]);
+                triangles.push([id(i, j), id(i + 1, j + 1), id(i, j + 1)]);
+            }
+        }
+        Mesh {
+            positions,
+            tri_object: vec![0; triangles.len()],
+            triangles,
+            objects: vec![crate::scene::mesh::Object { name: "figure8".into(), ..Default::default() }],
+        }
+    }
+}

@@ -1,0 +1,295 @@
+use super::*;
+use crate::narrow::tri_tri::Contact;
+use crate::scene::mesh::Object;
+use proptest::prelude::*;
+
+fn mesh(p: &[[f64; 3]], t: &[[u32; 3]]) -> Mesh {
+    Mesh {
+        positions: p.iter().map(|&x| DVec3::from_array(x)).collect(),
+        triangles: t.to_vec(),
+        tri_object: vec![0; t.len()],
+        objects: vec![Object { name: "m".into(), ..Default::default() }],
+    }
+}
+
+/// Self-clash pairs of the whole mesh as (a, b, crossing, contact); checked against the brute
+/// force on the way, for every leaf size.
+fn pairs(m: &Mesh) -> Vec<(u32, u32, bool, Contact)> {
+    let (merged, _) = crate::scene::bodies::merge_vertices(&m.positions);
+    let all: Vec<u32> = (0..m.triangles.len() as u32).collect();
+    let want = self_pairs_brute_force(m, &merged, &all);
+    for leaf_size in [1, 2, 4] {
+        let got = self_pairs(m, &merged, &all, BuildOptions { leaf_size, ..Default::default() });
+        assert_eq!(got, want, "leaf size {leaf_size}");
+    }
+    want.iter().map(|p| (p.a, p.b, p.hit.crossing, p.hit.contact)).collect()
+}
+
+fn cube() -> Mesh {
+    let p: Vec<[f64; 3]> =
+        (0..8).map(|i| [(i & 1) as f64, (i >> 1 & 1) as f64, (i >> 2 & 1) as f64]).collect();
+    let faces = [[0, 1, 3, 2], [4, 6, 7, 5], [0, 4, 5, 1], [2, 3, 7, 6], [0, 2, 6, 4], [1, 5, 7, 3]];
+    let t: Vec<[u32; 3]> = faces.iter().flat_map(|f| [[f[0], f[1], f[2]], [f[0], f[2], f[3]]]).collect();
+    mesh(&p, &t)
+}
+
+#[test]
+fn a_closed_cube_has_no_self_clash_indexed_or_as_a_soup() {
+    let m = cube();
+    assert!(pairs(&m).is_empty());
+    // The same cube with every triangle's vertices stored separately (and one zero negated):
+    // the exact merge restores the connectivity.
+    let mut soup = Mesh { objects: m.objects.clone(), ..Default::default() };
+    for (k, t) in m.triangles.iter().enumerate() {
+        for &v in t {
+            let mut p = m.positions[v as usize];
+            if k == 3 && p.x == 0.0 {
+                p.x = -0.0;
+            }
+            soup.positions.push(p);
+        }
+        let b = 3 * k as u32;
+        soup.triangles.push([b, b + 1, b + 2]);
+        soup.tri_object.push(0);
+    }
+    assert!(pairs(&soup).is_empty());
+}
+
+#[test]
+fn a_strip_folded_back_through_itself_crosses_exactly_where_it_passes() {
+    // Q1: the quad x in [0,2], y in [0,1], z = 0; Q2 climbs from x = 2 back to x = 1, z = 1;
+    // Q3 drops vertically at x = 1 from z = 1 to z = -1, through Q1.
+    let p = [
+        [0., 0., 0.],
+        [0., 1., 0.],
+        [2., 0., 0.],
+        [2., 1., 0.],
+        [1., 0., 1.],
+        [1., 1., 1.],
+        [1., 0., -1.],
+        [1., 1., -1.],
+    ];
+    let t = [
+        [0, 2, 3], // 0: Q1, y <= x/2
+        [0, 3, 1], // 1: Q1
+        [2, 4, 5], // 2: Q2
+        [2, 5, 3], // 3: Q2
+        [4, 5, 7], // 4: Q3, meets z = 0 for y in [1/2, 1]
+        [4, 7, 6], // 5: Q3, meets z = 0 for y in [0, 1/2]
+    ];
+    let got = pairs(&mesh(&p, &t));
+    assert_eq!(
+        got,
+        [
+            (0, 4, false, Contact::Point),  // only (1, 1/2, 0), on the diagonal of Q1
+            (0, 5, true, Contact::Segment), // y in (0, 1/2): both interiors
+            (1, 4, true, Contact::Segment),
+            (1, 5, false, Contact::Point),
+        ]
+    );
+}
+
+#[test]
+fn coplanar_triangles_sharing_an_edge_fold_only_on_the_same_side() {
+    let p = [[0., 0., 0.], [4., 0., 0.], [2., 1., 0.], [1., 3., 0.], [2., -1., 0.], [2., 1., 1.]];
+    // Same side of the shared edge 0-1: their interiors overlap (a fold).
+    assert_eq!(pairs(&mesh(&p, &[[0, 1, 2], [1, 0, 3]])), [(0, 1, false, Contact::CoplanarArea)]);
+    // Opposite sides, or another plane: they meet exactly in the shared edge.
+    assert!(pairs(&mesh(&p, &[[0, 1, 2], [1, 0, 4]])).is_empty());
+    assert!(pairs(&mesh(&p, &[[0, 1, 2], [1, 0, 5]])).is_empty());
+    // The fold seen as two fans of two triangles each around the shared edge's ends.
+    let fans = mesh(&p, &[[0, 1, 2], [0, 2, 5], [1, 0, 3], [1, 3, 5]]);
+    assert!(pairs(&fans).contains(&(0, 2, false, Contact::CoplanarArea)));
+}
+
+#[test]
+fn triangles_sharing_a_vertex_clash_iff_they_meet_anywhere_else() {
+    let p = [
+        [0., 0., 0.],  // 0: shared v
+        [2., 0., 0.],  // 1
+        [0., 2., 0.],  // 2
+        [1., 1., 1.],  // 3
+        [1., 1., -1.], // 4
+        [-1., 0., 0.], // 5
+        [0., -1., 0.], // 6
+        [1., 0.5, 0.], // 7: inside triangle 0-1-2
+        [3., 0., 0.],  // 8
+        [0., 0., 1.],  // 9
+    ];
+    // A fan: only the vertex in common.
+    assert!(pairs(&mesh(&p, &[[0, 1, 2], [0, 5, 6]])).is_empty());
+    assert!(pairs(&mesh(&p, &[[0, 1, 2], [0, 9, 5]])).is_empty());
+    // Through the other's interior: a crossing.
+    assert_eq!(pairs(&mesh(&p, &[[0, 1, 2], [0, 3, 4]])), [(0, 1, true, Contact::Segment)]);
+    // Coplanar and overlapping near the vertex.
+    assert_eq!(pairs(&mesh(&p, &[[0, 1, 2], [0, 7, 8]])), [(0, 1, false, Contact::CoplanarArea)]);
+    // Leaning on the other's edge: a segment beyond the vertex, touching.
+    assert_eq!(pairs(&mesh(&p, &[[0, 1, 2], [0, 8, 9]])), [(0, 1, false, Contact::Segment)]);
+}
+
+#[test]
+fn a_vertex_on_a_face_it_is_not_connected_to_touches() {
+    let p = [[0., 0., 0.], [4., 0., 0.], [0., 4., 0.], [1., 1., 0.], [1., 1., 2.], [2., 1., 2.]];
+    assert_eq!(pairs(&mesh(&p, &[[0, 1, 2], [3, 4, 5]])), [(0, 1, false, Contact::Point)]);
+    // The same vertex one ulp above the face: nothing.
+    let mut q = p;
+    q[3][2] = f64::from_bits(1);
+    assert!(pairs(&mesh(&q, &[[0, 1, 2], [3, 4, 5]])).is_empty());
+}
+
+#[test]
+fn a_duplicated_face_is_not_a_self_clash_pair_but_a_copy_shifted_by_a_vertex_is() {
+    let p = [[0., 0., 0.], [1., 0., 0.], [0., 1., 0.], [0., 0., 0.]];
+    // Stored twice, once in the other winding and through a copied vertex: all three shared.
+    assert!(pairs(&mesh(&p, &[[0, 1, 2], [3, 2, 1]])).is_empty());
+    let p2 = [[0., 0., 0.], [1., 0., 0.], [0., 1., 0.], [0., 0.5, 0.]];
+    assert_eq!(pairs(&mesh(&p2, &[[0, 1, 2], [3, 1, 2]])), [(0, 1, false, Contact::CoplanarArea)]);
+}
+
+#[test]
+fn zero_area_triangles_follow_the_same_rule() {
+    let p =
+        [[0., 0., 0.], [2., 0., 0.], [1., 0., 0.], [3., 0., 0.], [0., 2., 0.], [-1., 0., 0.], [1., 0., 1.]];
+    // A sliver 0-2-1 lying on the edge 0-1 of triangle 0-1-4: shares the edge, stays on it.
+    assert!(pairs(&mesh(&p, &[[0, 1, 4], [0, 2, 1]])).is_empty());
+    // A sliver 0-1-3 extending the edge beyond 1: still only the edge in common.
+    assert!(pairs(&mesh(&p, &[[0, 1, 4], [0, 1, 3]])).is_empty());
+    // Two slivers on one line sharing 0-2, both reaching beyond 2 (to 1 and 3): a clash.
+    assert_eq!(pairs(&mesh(&p, &[[0, 2, 1], [2, 0, 3]])), [(0, 1, false, Contact::Segment)]);
+    // ... one beyond 2, the other beyond 0: only the shared segment.
+    assert!(pairs(&mesh(&p, &[[0, 2, 1], [2, 0, 5]])).is_empty());
+    // The sliver 0-2-1 (vertex 2 strictly inside it) shares only vertex 2 with the triangle
+    // 2-6-3, whose edge 2-3 runs along the sliver from 2 to 1: they share [2, 1], a clash.
+    assert_eq!(pairs(&mesh(&p, &[[0, 2, 1], [2, 6, 3]])), [(0, 1, false, Contact::Segment)]);
+    // The same triangle against a sliver reaching from 2 only backwards (to 5): just vertex 2.
+    assert!(pairs(&mesh(&p, &[[5, 0, 2], [2, 6, 3]])).is_empty());
+    // Sliver 5-1-2 (2 strictly inside it) and triangle 2-3-4 lying on its line beyond 2 to 3:
+    // they share vertex 2 and the segment [2, 1] in the edge 2-3: a clash.
+    assert_eq!(pairs(&mesh(&p, &[[5, 1, 2], [2, 3, 4]])), [(0, 1, false, Contact::Segment)]);
+    // A point-triangle at a shared vertex: nothing else to meet.
+    assert!(pairs(&mesh(&p, &[[2, 2, 2], [2, 3, 4]])).is_empty());
+}
+
+#[test]
+fn results_do_not_depend_on_the_thread_count() {
+    let m = crate::bench::gen::torus(4000);
+    let (merged, _) = crate::scene::bodies::merge_vertices(&m.positions);
+    let all: Vec<u32> = (0..m.triangles.len() as u32).collect();
+    let run = |n| {
+        let pool = rayon::ThreadPoolBuilder::new().num_threads(n).build().unwrap();
+        pool.install(|| self_pairs(&m, &merged, &all, BuildOptions::default()))
+    };
+    assert!(run(1).is_empty());
+    // Squash the torus flat (z = 0): every far-apart pair of the top and bottom halves now
+    // overlaps; one thread and two give the same list.
+    let mut flat = m.clone();
+    for p in &mut flat.positions {
+        p.z = 0.0;
+    }
+    let run_flat = |n| {
+        let pool = rayon::ThreadPoolBuilder::new().num_threads(n).build().unwrap();
+        pool.install(|| self_pairs(&flat, &merged, &all, BuildOptions::default()))
+    };
+    let one = run_flat(1);
+    assert!(!one.is_empty());
+    assert_eq!(one, run_flat(2));
+}
+
+/// Integer coordinates in [0, 3]: many shared, collinear and coplanar configurations.
+fn small_mesh() -> impl Strategy<Value = Mesh> {
+    (3usize..9).prop_flat_map(|nv| {
+        (
+            prop::collection::vec(prop::array::uniform3(0i32..4), nv),
+            prop::collection::vec(prop::array::uniform3(0..nv as u32), 1..12),
+        )
+            .prop_map(|(p, t)| {
+                let p: Vec<[f64; 3]> = p.iter().map(|v| v.map(|c| c as f64)).collect();
+                mesh(&p, &t)
+            })
+    })
+}
+
+/// An independent oracle for two proper triangles: cut a sliver of relative width 2^-20 off
+/// each at what they share; with coordinates in [0, 3] every point of the intersection beyond
+/// the shared part is much farther from it than that, so the intersection is more than the
+/// shared part iff one cut triangle still meets the other whole one.
+fn oracle(ta: &[DVec3; 3], ia: [u32; 3], tb: &[DVec3; 3], ib: [u32; 3]) -> bool {
+    let lam = (2.0f64).powi(-20);
+    let cut = |t: &[DVec3; 3], own: [u32; 3], other: [u32; 3]| -> Vec<[DVec3; 3]> {
+        let shared: Vec<usize> = (0..3).filter(|&k| other.contains(&own[k])).collect();
+        let toward = |from: DVec3, to: DVec3| from + (to - from) * lam;
+        match shared[..] {
+            [] => vec![*t],
+            [k] => {
+                let (v, a, b) = (t[k], t[(k + 1) % 3], t[(k + 2) % 3]);
+                let (a2, b2) = (toward(v, a), toward(v, b));
+                vec![[a, b, a2], [b, b2, a2]]
+            }
+            [k, l] => {
+                let m = 3 - k - l;
+                let (u, w, a) = (t[k], t[l], t[m]);
+                vec![[a, toward(u, a), toward(w, a)]]
+            }
+            _ => vec![],
+        }
+    };
+    cut(ta, ia, ib).iter().any(|c| tri_tri::classify(c, tb).is_some())
+        || cut(tb, ib, ia).iter().any(|c| tri_tri::classify(ta, c).is_some())
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig { cases: 300, ..ProptestConfig::default() })]
+
+    /// The tree walk finds exactly the brute-force pairs (every leaf size), and for proper
+    /// triangles the rule agrees with the cut-sliver oracle.
+    #[test]
+    fn walk_matches_brute_force_and_the_rule_matches_an_oracle(m in small_mesh()) {
+        let got = pairs(&m);
+        let (merged, _) = crate::scene::bodies::merge_vertices(&m.positions);
+        let ids = |t: usize| m.triangles[t].map(|v| merged[v as usize]);
+        for a in 0..m.triangles.len() {
+            for b in a + 1..m.triangles.len() {
+                let (ta, tb) = (crate::bvh::triangle(&m, a as u32), crate::bvh::triangle(&m, b as u32));
+                let distinct = |i: [u32; 3]| i[0] != i[1] && i[1] != i[2] && i[0] != i[2];
+                if !distinct(ids(a)) || !distinct(ids(b)) || tri_tri::Shape::of(&ta).is_degenerate()
+                    || tri_tri::Shape::of(&tb).is_degenerate() {
+                    continue;
+                }
+                let listed = got.iter().any(|p| (p.0, p.1) == (a as u32, b as u32));
+                prop_assert_eq!(listed, oracle(&ta, ids(a), &tb, ids(b)), "pair {} {}", a, b);
+            }
+        }
+    }
+}
+
+#[test]
+fn a_folded_torus_crosses_only_around_the_fold() {
+    let m = gen::folded_torus(2000);
+    let got = pairs(&m);
+    assert!(got.iter().any(|p| p.2), "the pulled vertex's triangles pierce the inner wall");
+    // Every pair involves one of the six triangles around the moved vertex 0.
+    let moved = |t: u32| m.triangles[t as usize].contains(&0);
+    assert!(got.iter().all(|p| moved(p.0) || moved(p.1)), "{got:?}");
+    assert_eq!(m.triangles.iter().filter(|t| t.contains(&0)).count(), 6);
+    // The same torus unfolded: nothing.
+    assert!(pairs(&crate::bench::gen::torus(2000)).is_empty());
+}
+
+#[test]
+fn a_tube_swept_along_a_figure_eight_overlaps_itself_only_at_the_crossing() {
+    let (u, v) = (96, 12);
+    let m = gen::figure_eight_tube(u, v, 0.1);
+    let got = pairs(&m);
+    assert!(got.iter().filter(|p| p.2).count() >= 4, "{got:?}");
+    // Every pair joins the two branches through the origin: one triangle from the ring range
+    // around t = π/2, the other from around t = 3π/2 (rings are triangle / (2v)).
+    let t_of = |tri: u32| (tri as usize / (2 * v)) as f64 / u as f64 * std::f64::consts::TAU;
+    let near = |t: f64, c: f64| (t - c).abs() < 0.35;
+    for p in &got {
+        let (ta, tb) = (t_of(p.0), t_of(p.1));
+        let (h, h3) = (std::f64::consts::FRAC_PI_2, 3.0 * std::f64::consts::FRAC_PI_2);
+        assert!((near(ta, h) && near(tb, h3)) || (near(ta, h3) && near(tb, h)), "{p:?}: t = {ta}, {tb}");
+    }
+    // A thinner tube still crosses itself there.
+    assert!(pairs(&gen::figure_eight_tube(u, v, 0.02)).iter().any(|p| p.2));
+}

@@ -1,0 +1,377 @@
+//! `meshclash self FILE`: one file checked against itself, part by part — the self-clashing
+//! triangle pairs ([`crate::check::self_clash`]) and the mesh health ([`crate::check::health`]) in one report
+//! (`meshclash.self/1`, see [`crate::report::self_report`]).
+//!
+//! Exit code: 0 nothing selected by `--fail-on` was found, 1 something was, 2 bad input, I/O or
+//! usage error (as for a check).
+
+use crate::bvh::{BuildOptions, Strategy};
+use crate::check::health::{self, Health};
+use crate::check::query::{self, InputSpec};
+use crate::check::self_clash::{self, SelfPair};
+use crate::error::{Error, Result};
+use crate::report::self_report::{self as rep, SelfReport};
+use glam::DMat4;
+use std::path::PathBuf;
+use std::time::Instant;
+
+/// Check one mesh against itself: every pair of triangles of one part that meets anywhere the
+/// connectivity does not say it meets (after merging exactly coincident vertices), and each
+/// part's health (closed, duplicate faces, zero-area triangles, non-manifold edges and
+/// vertices, boundary edges, inconsistent winding, signed volume).
+#[derive(Debug, Clone, clap::Args)]
+pub struct SelfArgs {
+    /// The mesh (OBJ, STL, glTF/GLB).
+    pub file: PathBuf,
+    /// Check only parts whose name matches GLOB (`*`, `?`; repeatable).
+    #[arg(long, value_name = "GLOB")]
+    pub select: Vec<String>,
+    /// Leave out parts matching GLOB (repeatable).
+    #[arg(long, value_name = "GLOB")]
+    pub exclude: Vec<String>,
+    /// Split every part into its connected bodies first (as for a check).
+    #[arg(long)]
+    pub split_bodies: bool,
+    /// Check the whole file as one part (objects ignored): connectivity and health across
+    /// objects, e.g. two solids glued face to face.
+    #[arg(long, conflicts_with_all = ["select", "exclude", "split_bodies"])]
+    pub whole_file: bool,
+    /// Exit 1 when any of these is found (comma-separated): `self-clash` (alias `clash`:
+    /// crossing pairs), `touching` (any self-clash pair), `open`, `non-manifold` (edges or
+    /// vertices), `duplicates`, `degenerate` (zero-area triangles), `winding`, `never`.
+    #[arg(long, value_enum, value_delimiter = ',', value_name = "WHAT", default_value = "self-clash")]
+    pub fail_on: Vec<SelfFailOn>,
+    /// Write the report to FILE (atomically) instead of stdout.
+    #[arg(short, long, value_name = "FILE")]
+    pub output: Option<PathBuf>,
+    /// Also write JUnit XML to FILE (atomically): one test case per checked part, failed when
+    /// the part has something in --fail-on.
+    #[arg(long, value_name = "FILE")]
+    pub junit: Option<PathBuf>,
+    /// What to print on stdout [default: json, or nothing when -o is given].
+    #[arg(long, value_enum, value_name = "FORMAT")]
+    pub format: Option<SelfFormat>,
+    /// List at most N pairs (the counts stay complete).
+    #[arg(long, value_name = "N", default_value_t = 1000)]
+    pub max_pairs: usize,
+    /// List at most N triangle ids per health finding.
+    #[arg(long, value_name = "N", default_value_t = 10)]
+    pub first_n: usize,
+    /// BVH split strategy (the answer is the same with each; only the time differs).
+    #[arg(long, value_enum, default_value_t = crate::cli::BvhArg::Sah)]
+    pub bvh: crate::cli::BvhArg,
+    /// Largest BVH leaf, in triangles (1..=64).
+    #[arg(long, value_name = "N", default_value_t = 4)]
+    pub leaf_size: u32,
+    /// Worker threads (0 = one per core).
+    #[arg(long, value_name = "N", default_value_t = 0)]
+    pub threads: usize,
+    /// Deterministic report: no timings, no thread count (byte-identical across runs).
+    #[arg(long)]
+    pub no_timings: bool,
+    /// Nothing on stderr but errors.
+    #[arg(short, long)]
+    pub quiet: bool,
+}
+
+/// `--fail-on` values of `self`.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord, clap::ValueEnum)]
+pub enum SelfFailOn {
+    /// Crossing self-clash pairs (the default).
+    #[value(name = "self-clash", alias = "clash")]
+    SelfClash,
+    /// Any self-clash pair, crossing or touching.
+    Touching,
+    /// A part that is not closed.
+    Open,
+    /// Non-manifold edges or vertices.
+    NonManifold,
+    /// Duplicate faces.
+    Duplicates,
+    /// Zero-area triangles.
+    Degenerate,
+    /// Edges used twice in the same direction.
+    Winding,
+    /// Never fail on findings.
+    Never,
+}
+
+impl SelfFailOn {
+    /// Name on the command line and in the report.
+    pub fn name(self) -> &'static str {
+        match self {
+            SelfFailOn::SelfClash => "self-clash",
+            SelfFailOn::Touching => "touching",
+            SelfFailOn::Open => "open",
+            SelfFailOn::NonManifold => "non-manifold",
+            SelfFailOn::Duplicates => "duplicates",
+            SelfFailOn::Degenerate => "degenerate",
+            SelfFailOn::Winding => "winding",
+            SelfFailOn::Never => "never",
+        }
+    }
+
+    /// Does this part's result meet the condition?
+    pub fn hit(self, part: &PartResult) -> bool {
+        let h = &part.health;
+        match self {
+            SelfFailOn::SelfClash => part.crossing > 0,
+            SelfFailOn::Touching => !part.pairs.is_empty(),
+            SelfFailOn::Open => !h.closed,
+            SelfFailOn::NonManifold => h.non_manifold_edges.count + h.non_manifold_vertices.count > 0,
+            SelfFailOn::Duplicates => h.duplicate_faces.count > 0,
+            SelfFailOn::Degenerate => h.zero_area_triangles.count > 0,
+            SelfFailOn::Winding => h.inconsistent_winding_edges.count > 0,
+            SelfFailOn::Never => false,
+        }
+    }
+}
+
+/// `--format` values of `self`.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
+pub enum SelfFormat {
+    /// The JSON report (`meshclash.self/1`).
+    Json,
+    /// A summary for a person.
+    Text,
+}
+
+/// The result for one part.
+#[derive(Debug, Clone, PartialEq)]
+pub struct PartResult {
+    /// Object index in the (possibly split) mesh; None for `--whole-file`.
+    pub object: Option<u32>,
+    /// Its name.
+    pub name: String,
+    /// Its triangles (indices into the mesh).
+    pub triangles: usize,
+    /// Its self-clashing pairs, sorted by (a, b).
+    pub pairs: Vec<SelfPair>,
+    /// How many of them cross.
+    pub crossing: u64,
+    /// Its health.
+    pub health: Health,
+}
+
+/// What the binary prints after a successful run.
+#[derive(Debug, Clone, PartialEq)]
+pub struct SelfOutcome {
+    /// For stdout (None when the report went to `-o` and no `--format` was given).
+    pub stdout: Option<String>,
+    /// The human summary (the binary shows it on stderr at a terminal).
+    pub summary: String,
+    /// Warnings, one line each.
+    pub warnings: Vec<String>,
+    /// 0 or 1.
+    pub exit_code: u8,
+    /// The report.
+    pub report: Box<SelfReport>,
+}
+
+/// Which parts [`check_parts`] checks.
+pub enum PartChoice<'a> {
+    /// Every object (object order) whose name passes the filter.
+    Objects(&'a dyn Fn(&str) -> bool),
+    /// All triangles as one part with this name.
+    Whole(&'a str),
+}
+
+/// Self-clash and health of the chosen parts of `mesh`, with the milliseconds spent on health
+/// (with the vertex merge) and on the self-clash walks (the two run at the same time, so their
+/// times overlap).
+pub fn check_parts(
+    mesh: &crate::scene::mesh::Mesh,
+    choice: PartChoice,
+    opts: BuildOptions,
+    first_n: usize,
+) -> (Vec<PartResult>, f64, f64) {
+    let t = Instant::now();
+    let (merged, _) = crate::scene::bodies::merge_vertices(&mesh.positions);
+    let parts: Vec<(Option<u32>, String, Vec<u32>)> = match choice {
+        PartChoice::Objects(keep) => crate::check::assembly::parts_of(mesh, 0)
+            .into_iter()
+            .filter(|p| keep(&p.name))
+            .map(|p| (Some(p.object), p.name, p.triangles))
+            .collect(),
+        PartChoice::Whole(name) => vec![(None, name.to_string(), (0..mesh.triangles.len() as u32).collect())],
+    };
+    let merge_ms = t.elapsed().as_secs_f64() * 1e3;
+    // Health and the self-clash walks run side by side: parts of the health pass are
+    // sequential (union-find), and the walk fills the other cores meanwhile.
+    let ms = |t: Instant| t.elapsed().as_secs_f64() * 1e3;
+    let ((healths, health_ms), (found, query_ms)) = rayon::join(
+        || {
+            let t = Instant::now();
+            let h: Vec<Health> = parts.iter().map(|p| health::health(mesh, &merged, &p.2, first_n)).collect();
+            (h, ms(t))
+        },
+        || {
+            let t = Instant::now();
+            let f: Vec<Vec<SelfPair>> =
+                parts.iter().map(|p| self_clash::self_pairs(mesh, &merged, &p.2, opts)).collect();
+            (f, ms(t))
+        },
+    );
+    let results = parts
+        .into_iter()
+        .zip(healths.into_iter().zip(found))
+        .map(|((object, name, tris), (health, pairs))| {
+            let crossing = pairs.iter().filter(|q| q.hit.crossing).count() as u64;
+            PartResult { object, name, triangles: tris.len(), pairs, crossing, health }
+        })
+        .collect();
+    (results, merge_ms + health_ms, query_ms)
+}
+
+/// Do the whole `self` job.
+pub fn run(args: &SelfArgs) -> Result<SelfOutcome> {
+    if !(1..=64).contains(&args.leaf_size) {
+        return Err(Error::Usage(format!("--leaf-size must be 1..=64, got {}", args.leaf_size)));
+    }
+    if let Some(out) = &args.output {
+        if let (Ok(a), Ok(b)) = (std::fs::canonicalize(out), std::fs::canonicalize(&args.file)) {
+            if a == b {
+                return Err(Error::Usage(format!(
+                    "-o {} is the input file; refusing to overwrite it",
+                    out.display()
+                )));
+            }
+        }
+    }
+    crate::cli::in_pool(args.threads, |threads| run_in_pool(args, threads))
+}
+
+fn run_in_pool(args: &SelfArgs, threads: usize) -> Result<SelfOutcome> {
+    let t0 = Instant::now();
+    let mut input = query::load_input(&InputSpec { path: args.file.clone(), transform: DMat4::IDENTITY })?;
+    if args.split_bodies {
+        crate::scene::bodies::split_bodies(&mut input.mesh);
+    }
+    let load_ms = t0.elapsed().as_secs_f64() * 1e3;
+    // Health numbers triangle corners in u32 (3 per triangle).
+    if input.mesh.triangles.len() > (u32::MAX / 3) as usize {
+        return Err(Error::input(
+            &args.file,
+            format!("{} triangles: `self` handles at most {}", input.mesh.triangles.len(), u32::MAX / 3),
+        ));
+    }
+    let keep = |name: &str| {
+        (args.select.is_empty() || args.select.iter().any(|g| crate::check::assembly::glob_match(g, name)))
+            && !args.exclude.iter().any(|g| crate::check::assembly::glob_match(g, name))
+    };
+    let strategy = match args.bvh {
+        crate::cli::BvhArg::Sah => Strategy::Sah,
+        crate::cli::BvhArg::Median => Strategy::Median,
+        crate::cli::BvhArg::Equal => Strategy::Equal,
+    };
+    let opts = BuildOptions { strategy, leaf_size: args.leaf_size };
+    let whole_name = args.file.display().to_string();
+    let choice = if args.whole_file { PartChoice::Whole(&whole_name) } else { PartChoice::Objects(&keep) };
+    let (parts, health_ms, query_ms) = check_parts(&input.mesh, choice, opts, args.first_n);
+    let mut warnings: Vec<String> =
+        input.warnings.iter().map(|w| format!("{}: {w}", args.file.display())).collect();
+    if parts.is_empty() {
+        warnings.push(format!("{}: no part matches the selection", args.file.display()));
+    }
+    let mut fail_on = args.fail_on.clone();
+    fail_on.sort_unstable();
+    fail_on.dedup();
+    let failed_on: Vec<SelfFailOn> =
+        fail_on.iter().copied().filter(|f| parts.iter().any(|p| f.hit(p))).collect();
+    let deterministic = args.no_timings;
+    let report = rep::build(&rep::Context {
+        input: &input,
+        parts: &parts,
+        fail_on: &fail_on,
+        failed_on: &failed_on,
+        split_bodies: args.split_bodies,
+        whole_file: args.whole_file,
+        select: &args.select,
+        exclude: &args.exclude,
+        bvh: strategy.name(),
+        leaf_size: args.leaf_size,
+        max_pairs: args.max_pairs,
+        first_n: args.first_n,
+        threads: (!deterministic).then_some(threads),
+        timings: (!deterministic).then(|| rep::SelfTimings {
+            load: load_ms,
+            health: health_ms,
+            query: query_ms,
+            total: t0.elapsed().as_secs_f64() * 1e3,
+        }),
+        warnings: warnings.clone(),
+    });
+    let json = rep::to_json(&report);
+    if let Some(path) = &args.junit {
+        crate::report::write_atomic(path, junit(&parts, &fail_on).as_bytes())?;
+    }
+    if let Some(path) = &args.output {
+        crate::report::write_atomic(path, json.as_bytes())?;
+    }
+    let summary = rep::text(&report);
+    let stdout = match args.format {
+        None if args.output.is_some() => None,
+        None | Some(SelfFormat::Json) => Some(json),
+        Some(SelfFormat::Text) => Some(summary.clone()),
+    };
+    Ok(SelfOutcome { stdout, summary, warnings, exit_code: report.failed as u8, report: Box::new(report) })
+}
+
+/// JUnit XML: one test case per part, failed when the part meets a `fail_on` condition; the
+/// failure lists its first pairs and health findings.
+pub fn junit(parts: &[PartResult], fail_on: &[SelfFailOn]) -> String {
+    use crate::output::junit::{render, Case, FIRST};
+    let cases: Vec<Case> = parts
+        .iter()
+        .map(|p| {
+            let h = &p.health;
+            let touching = p.pairs.len() as u64 - p.crossing;
+            let mut findings: Vec<String> = p
+                .pairs
+                .iter()
+                .take(FIRST)
+                .map(|q| {
+                    let kind = if q.hit.crossing { "crossing" } else { "touching" };
+                    format!("triangles {} × {}: {kind} ({})", q.a, q.b, q.hit.contact.name())
+                })
+                .collect();
+            let health = [
+                ("boundary edges", &h.boundary_edges),
+                ("non-manifold edges", &h.non_manifold_edges),
+                ("non-manifold vertices", &h.non_manifold_vertices),
+                ("duplicate faces", &h.duplicate_faces),
+                ("zero-area triangles", &h.zero_area_triangles),
+                ("inconsistent winding edges", &h.inconsistent_winding_edges),
+            ];
+            let mut total = p.pairs.len() as u64;
+            for (what, f) in health {
+                if f.count > 0 {
+                    total += 1; // one line per kind of health finding
+                    findings.push(format!("{} {what}, first triangles {:?}", f.count, f.triangles));
+                }
+            }
+            let verdict = if p.crossing > 0 {
+                "clash"
+            } else if touching > 0 {
+                "touching"
+            } else {
+                "clear"
+            };
+            Case {
+                name: p.name.clone(),
+                verdict: verdict.into(),
+                counts: format!(
+                    "{} crossing, {touching} touching self-clash pairs; {}",
+                    p.crossing,
+                    if h.closed { "closed" } else { "open" }
+                ),
+                findings,
+                total,
+                failed: fail_on.iter().any(|f| f.hit(p)),
+                time_s: 0.0,
+                output: String::new(),
+            }
+        })
+        .collect();
+    render("meshclash self", &cases)
+}
