@@ -23,7 +23,7 @@ use std::path::PathBuf;
 /// `--format`: what goes to stdout.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
 pub enum Format {
-    /// The JSON report (`meshclash.report/1`).
+    /// The JSON report (`meshclash.report/2`).
     Json,
     /// The human summary (the one shown on stderr on a terminal).
     Text,

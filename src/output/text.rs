@@ -208,10 +208,11 @@ pub fn render(r: &Report, color: bool) -> String {
             "b_in_a" => "B lies inside A",
             "a_partly_in_b" => "part of A lies inside B",
             "b_partly_in_a" => "part of B lies inside A",
+            "volumes_overlap" => "the closed parts' volumes overlap (faces in contact enclose shared volume)",
             _ => "undecided",
         };
         let why = m.contained_reason.as_deref().map(|w| format!(": {w}")).unwrap_or_default();
-        let style = if ct == "undecided" { YELLOW } else { RED };
+        let style = if what == "undecided" { YELLOW } else { RED };
         let _ = writeln!(s, "  containment: {}{why}", c.p(style, what));
     }
     let worst = worst(r);

@@ -168,7 +168,7 @@ pub fn parse(path: &str, bytes: &[u8]) -> std::result::Result<Baseline, String> 
 }
 
 fn is_containment_clash(c: Option<&str>) -> bool {
-    matches!(c, Some("a_in_b" | "b_in_a" | "a_partly_in_b" | "b_partly_in_a"))
+    matches!(c, Some("a_in_b" | "b_in_a" | "a_partly_in_b" | "b_partly_in_a" | "volumes_overlap"))
 }
 
 /// Mark the listed pairs `new`/`persistent` and add the `baseline` block. `findings` are all the
@@ -204,6 +204,16 @@ pub fn fails_on_new(b: &BaselineReport) -> bool {
 
 #[cfg(test)]
 mod tests {
+
+    #[test]
+    fn volumes_overlap_counts_as_containment_clash_for_fail_on_new() {
+        // Regression: a new `volumes_overlap` was not counted as new containment.
+        assert!(is_containment_clash(Some("volumes_overlap")));
+        assert!(is_containment_clash(Some("a_in_b")));
+        assert!(!is_containment_clash(Some("undecided")));
+        assert!(!is_containment_clash(None));
+    }
+
     use super::*;
     use crate::scene::mesh::Object;
     use glam::DVec3;
