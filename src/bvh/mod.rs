@@ -9,6 +9,7 @@
 //! of the centroid bounds and equal counts (object median).
 
 mod build;
+pub mod slab;
 pub mod traverse;
 mod validate;
 

@@ -31,6 +31,23 @@ pub trait Tree: Sync {
     fn prims_of(&self, n: &Node) -> &[u32];
     /// Size and quality of the underlying tree.
     fn stats(&self) -> crate::bvh::Stats;
+    /// Every triangle index, grouped by leaf in depth-first order (so the triangles below any
+    /// node are one contiguous run: [`Tree::subtree_prims`]).
+    fn all_prims(&self) -> &[u32];
+    /// The triangles below node `i` (a contiguous run of [`Tree::all_prims`]).
+    fn subtree_prims(&self, i: u32) -> &[u32] {
+        let nodes = self.nodes();
+        let mut first = i as usize;
+        while !nodes[first].is_leaf() {
+            first += 1;
+        }
+        let mut last = i as usize;
+        while !nodes[last].is_leaf() {
+            last = nodes[last].a as usize;
+        }
+        let (s, e) = (nodes[first].a as usize, (nodes[last].a + nodes[last].count) as usize);
+        &self.all_prims()[s..e]
+    }
     /// The root box (empty for an empty tree).
     fn root_box(&self) -> Aabb {
         if self.nodes().is_empty() {
@@ -56,6 +73,10 @@ impl Tree for Bvh {
     }
     fn stats(&self) -> crate::bvh::Stats {
         Bvh::stats(self)
+    }
+    #[inline]
+    fn all_prims(&self) -> &[u32] {
+        &self.prims
     }
 }
 
@@ -212,11 +233,41 @@ where
     D: Fn(&Aabb, &Aabb) -> f64 + Sync,
     L: Fn(&[u32], &[u32], f64) -> Option<Candidate<R>> + Sync,
 {
+    min_pair_with(ta, tb, || (), |_, _, x, _, y, _| box_distance(x, y), slack, leaf)
+}
+
+/// As [`min_pair`], with a lower bound that may look at the nodes themselves (their indices in
+/// `ta` and `tb` beside their boxes) and keep per-walk state `S` (e.g. a cache of oriented
+/// bounds): `new_state` makes one per independent sub-walk. The last argument of `lower_bound`
+/// is the current pruning cutoff: once the bound is known to exceed it, any value above it may
+/// be returned (a cheap bound first, a finer one only when needed). Pruning uses only the
+/// bound's relation to the cutoff and every candidate that could win is evaluated, so the answer
+/// does not depend on the state or on the thread count.
+pub fn min_pair_with<R, S, A, B, N, D, L>(
+    ta: &A,
+    tb: &B,
+    new_state: N,
+    lower_bound: D,
+    slack: f64,
+    leaf: L,
+) -> Option<Candidate<R>>
+where
+    R: Send + Copy,
+    A: Tree + ?Sized,
+    B: Tree + ?Sized,
+    N: Fn() -> S + Sync,
+    D: Fn(&mut S, u32, &Aabb, u32, &Aabb, f64) -> f64 + Sync,
+    L: Fn(&[u32], &[u32], f64) -> Option<Candidate<R>> + Sync,
+{
     // Best distance so far, as f64 bits (order-preserving for non-negative values).
     let best = AtomicU64::new(f64::INFINITY.to_bits());
     let bound = |best: &AtomicU64| f64::from_bits(best.load(Ordering::Relaxed)) + slack;
-    let mut seeds: Vec<(f64, Entry)> =
-        seed(ta, tb, &|_, _| true).into_iter().map(|e| (box_distance(&e.2, &e.3), e)).collect();
+    let mut seed_state = new_state();
+    let mut seeds: Vec<(f64, Entry)> = seed(ta, tb, &|_, _| true)
+        .into_iter()
+        .map(|e| (lower_bound(&mut seed_state, e.0, &e.2, e.1, &e.3, f64::INFINITY), e))
+        .collect();
+    drop(seed_state);
     seeds.sort_by(|x, y| x.0.total_cmp(&y.0).then((x.1 .0, x.1 .1).cmp(&(y.1 .0, y.1 .1))));
     let found: Vec<Option<Candidate<R>>> = seeds
         .par_iter()
@@ -225,6 +276,7 @@ where
             if lb > bound(&best) {
                 return None;
             }
+            let mut state = new_state();
             let mut stack = vec![(lb, e)];
             while let Some((lb, e)) = stack.pop() {
                 if lb > bound(&best) {
@@ -242,7 +294,8 @@ where
                         }
                     }
                     Some(kids) => {
-                        let d = kids.map(|k| box_distance(&k.2, &k.3));
+                        let cut = bound(&best);
+                        let d = kids.map(|k| lower_bound(&mut state, k.0, &k.2, k.1, &k.3, cut));
                         // Push the farther first so the nearer is opened first.
                         let order = if d[0] <= d[1] { [1, 0] } else { [0, 1] };
                         for k in order {

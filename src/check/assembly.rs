@@ -218,6 +218,10 @@ impl Tree for PartTree<'_> {
     fn stats(&self) -> crate::bvh::Stats {
         self.bvh.stats()
     }
+    #[inline]
+    fn all_prims(&self) -> &[u32] {
+        &self.bvh.prims
+    }
 }
 
 /// The affine map from `leader`'s world coordinates to `inst`'s: `world(inst) · world(leader)⁻¹`

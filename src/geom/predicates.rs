@@ -522,6 +522,21 @@ pub fn distance_rounding_slack(scale: f64) -> f64 {
 /// of coordinates; 64 ulps of the coordinate scale bounds them with room to spare.
 pub const DISTANCE_ROUNDING_ULPS: f64 = 64.0;
 
+/// How much f64 rounding may raise an oriented (slab) lower bound on a distance
+/// ([`crate::bvh::slab`]) above the true distance, for coordinates at most `scale` in magnitude:
+/// `ORIENTED_BOUND_ROUNDING_ULPS` ulps of `scale`. The search subtracts it from every oriented
+/// bound before pruning, so an oriented bound never prunes a pair a box bound would keep for a
+/// reason other than geometry. A search margin, not a tolerance on any verdict.
+pub fn oriented_bound_margin(scale: f64) -> f64 {
+    ORIENTED_BOUND_ROUNDING_ULPS * f64::EPSILON * scale
+}
+
+/// See [`oriented_bound_margin`]. A slab bound reads projections (three products and two sums
+/// each, on vectors of norm 1 to rounding) back through a second frame that is orthonormal to a
+/// few ulps: each step loses at most a few ulps of the largest coordinate; 64 covers their sum
+/// several times over.
+pub const ORIENTED_BOUND_ROUNDING_ULPS: f64 = 64.0;
+
 /// User tolerances, all in model units (absolute), all zero by default.
 ///
 /// * `touch`: a pair of triangles that do not share a point but whose f64 closed-form distance
