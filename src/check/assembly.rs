@@ -25,12 +25,14 @@
 use crate::bvh::traverse::{self, Tree};
 use crate::bvh::{BuildOptions, Bvh, Node};
 use crate::check::containment::Containment;
-use crate::check::query::{check_built, ClashResult, PairFinding, Settings, Verdict};
+use crate::check::containment::Topology;
+use crate::check::query::{check_built_with, ClashResult, PairFinding, Settings, Verdict};
 use crate::geom::predicates::BoxMap;
 use crate::geom::{Aabb, DVec3};
 use crate::scene::mesh::{Mesh, Object, TriMesh};
 use rayon::prelude::*;
 use std::collections::HashMap;
+use std::sync::OnceLock;
 use std::time::Instant;
 
 /// One part of one input.
@@ -464,10 +466,21 @@ pub fn check_parts(
     };
     let build_ms = t0.elapsed().as_secs_f64() * 1e3;
     let t1 = Instant::now();
+    // Each part's topology is computed at most once, and only if a verdict of one of its pairs
+    // needs it (containment or volumes overlap).
+    let topology: Vec<OnceLock<Topology>> = (0..parts.len()).map(|_| OnceLock::new()).collect();
     let part_pairs: Vec<PartPair> = candidates
         .par_iter()
         .map(|&(a, b)| {
-            let mut r = check_built(&view(a), &tree(a), &view(b), &tree(b), settings);
+            let mut r = check_built_with(
+                &view(a),
+                &tree(a),
+                &topology[a],
+                &view(b),
+                &tree(b),
+                &topology[b],
+                settings,
+            );
             r.timings = Default::default();
             to_input_indices(&mut r, &parts[a], &parts[b]);
             PartPair { a, b, result: r }
@@ -796,7 +809,7 @@ pub fn run(a: &Mesh, b: &Mesh, sel: &Selection, settings: &Settings) -> Result<O
         closest,
         verdict,
         containment,
-        closed: [false, false],
+        closed: [None, None],
         trees: [crate::bvh::Stats { nodes: 0, leaves: 0, depth: 0, sah_cost: 0.0, bytes: 0 }; 2],
         timings: crate::check::query::Timings { build_ms: ar.build_ms, query_ms: ar.query_ms },
     };

@@ -236,9 +236,8 @@ pub fn point_in_closed_mesh<M: TriMesh + ?Sized, T: Tree + ?Sized>(p: DVec3, m: 
     let reach = bounds.extent().length() * 2.0 + 1.0;
     'dir: for d in DIRECTIONS {
         let q = p + DVec3::from(d) * reach;
-        let seg = Aabb { min: p.min(q), max: p.max(q) };
         let mut crossings = 0usize;
-        let degenerate = crate::bvh::traverse::any_in_box(t, &seg, |tri| {
+        let degenerate = crate::bvh::traverse::any_on_segment(t, p, q, |tri| {
             let [a, b, c] = m.triangle(tri);
             match segment_crosses(p, q, a, b, c) {
                 Crossing::No => false,
@@ -381,6 +380,20 @@ enum OneWay {
 }
 
 /// Which components of `inner` lie inside `outer`?
+/// Could either input lie (partly) inside the other? Not when neither's tree box meets the
+/// box of the other's vertices: then [`decide`] answers [`Containment::None`] whatever the
+/// topology, so it need not be computed.
+pub fn may_nest<A, TA, B, TB>(a: &A, ta: &TA, b: &B, tb: &TB) -> bool
+where
+    A: TriMesh + ?Sized,
+    TA: Tree + ?Sized,
+    B: TriMesh + ?Sized,
+    TB: Tree + ?Sized,
+{
+    let (ba, bb) = (Aabb::of_points(a.positions().iter()), Aabb::of_points(b.positions().iter()));
+    tb.root_box().overlaps(&ba) || ta.root_box().overlaps(&bb)
+}
+
 fn one_way<I, O, T>(inner: &I, it: &Topology, outer: &O, ot: &T, otopo: &Topology, name: &str) -> OneWay
 where
     I: TriMesh + ?Sized,

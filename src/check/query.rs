@@ -4,8 +4,8 @@
 //! Every candidate pair is classified exactly ([`crate::narrow::tri_tri`]); distances (for tolerance
 //! bands, clearance and the closest pair) are f64 closed forms ([`crate::narrow::distance`]).
 
-use crate::bvh::traverse::{self, Candidate, Tree};
 use crate::bvh::slab::{self, Oriented};
+use crate::bvh::traverse::{self, Candidate, Tree};
 use crate::bvh::{self, BuildOptions, Bvh};
 use crate::check::containment::{self, Containment};
 use crate::error::{Error, Result};
@@ -339,8 +339,9 @@ pub struct ClashResult {
     pub verdict: Verdict,
     /// Whether one part hides inside the other (decided only when no triangles meet).
     pub containment: Containment,
-    /// Whether each input is closed (see [`crate::check::containment::topology`]).
-    pub closed: [bool; 2],
+    /// Whether each input is closed (see [`crate::check::containment::topology`]); `None` where
+    /// no verdict needed it ([`check_built_with`]).
+    pub closed: [Option<bool>; 2],
     /// The two trees.
     pub trees: [TreeStats; 2],
     /// Phase times.
@@ -405,7 +406,35 @@ where
 }
 
 /// As [`check`], with both trees already built (assemblies reuse one tree for many pairs).
+/// Both inputs' topology is computed (the report states whether each input is closed).
 pub fn check_built<A, TA, B, TB>(a: &A, ta: &TA, b: &B, tb: &TB, settings: &Settings) -> ClashResult
+where
+    A: TriMesh + ?Sized,
+    TA: Tree + ?Sized,
+    B: TriMesh + ?Sized,
+    TB: Tree + ?Sized,
+{
+    let (topo_a, topo_b) = (OnceLock::new(), OnceLock::new());
+    let _ = rayon::join(
+        || topo_a.get_or_init(|| containment::topology(a)),
+        || topo_b.get_or_init(|| containment::topology(b)),
+    );
+    check_built_with(a, ta, &topo_a, b, tb, &topo_b, settings)
+}
+
+/// As [`check_built`], with each side's topology (closedness, components, merged vertices)
+/// computed only if the verdict needs it — containment when no pair crosses and the boxes
+/// allow it, volumes overlap when faces touch — and kept in `topo_*` for other checks of the
+/// same part. [`ClashResult::closed`] says `None` for a side whose topology was not needed.
+pub fn check_built_with<A, TA, B, TB>(
+    a: &A,
+    ta: &TA,
+    topo_a: &OnceLock<containment::Topology>,
+    b: &B,
+    tb: &TB,
+    topo_b: &OnceLock<containment::Topology>,
+    settings: &Settings,
+) -> ClashResult
 where
     A: TriMesh + ?Sized,
     TA: Tree + ?Sized,
@@ -423,13 +452,25 @@ where
         None if stopped => None,
         None => closest_pair(a, ta, b, tb, settings.distance_error),
     };
-    let (topo_a, topo_b) = rayon::join(|| containment::topology(a), || containment::topology(b));
+    let topology = || {
+        rayon::join(
+            || topo_a.get_or_init(|| containment::topology(a)),
+            || topo_b.get_or_init(|| containment::topology(b)),
+        )
+    };
     let containment = if counts.crossing > 0 || settings.first_hit {
         Containment::None // a crossing is a clash already (and first-hit stops looking)
-    } else if volumes_overlap(a, &topo_a, b, &topo_b, &pairs) {
-        Containment::VolumesOverlap
+    } else if !containment::may_nest(a, ta, b, tb)
+        && !pairs.iter().any(|p| p.contact == Some(Contact::CoplanarArea))
+    {
+        Containment::None // neither box meets the other's points, and no faces touch
     } else {
-        containment::decide(a, ta, &topo_a, b, tb, &topo_b)
+        let (ta_, tb_) = topology();
+        if volumes_overlap(a, ta_, b, tb_, &pairs) {
+            Containment::VolumesOverlap
+        } else {
+            containment::decide(a, ta, ta_, b, tb, tb_)
+        }
     };
     let verdict = if counts.crossing > 0 || containment.is_clash() {
         Verdict::Clash
@@ -446,7 +487,7 @@ where
         closest,
         verdict,
         containment,
-        closed: [topo_a.closed, topo_b.closed],
+        closed: [topo_a.get().map(|t| t.closed), topo_b.get().map(|t| t.closed)],
         trees: [ta.stats(), tb.stats()],
         timings: Timings { build_ms: 0.0, query_ms: ms(t1) },
     }

@@ -537,6 +537,13 @@ pub fn oriented_bound_margin(scale: f64) -> f64 {
 /// several times over.
 pub const ORIENTED_BOUND_ROUNDING_ULPS: f64 = 64.0;
 
+/// Relative widening (in ulps) of a segment's entry and exit parameters across a box's slabs
+/// ([`crate::bvh::traverse::any_on_segment`]): each parameter is one subtraction and one
+/// product away from exact (a few ulps); widening by 8 ulps of its magnitude plus 8 ulps absolute
+/// keeps every box the segment touches. Pruning only: the crossings themselves are decided by
+/// the exact segment–triangle test.
+pub const SEGMENT_BOX_ROUNDING_ULPS: f64 = 8.0;
+
 /// User tolerances, all in model units (absolute), all zero by default.
 ///
 /// * `touch`: a pair of triangles that do not share a point but whose f64 closed-form distance

@@ -673,8 +673,8 @@ pub fn build(ctx: &Context, r: &ClashResult) -> Report {
         schema: SCHEMA.to_string(),
         tool: Tool::this(),
         inputs: Inputs {
-            a: input_report(ia, &ctx.transforms[0], &infa, r.closed[0]),
-            b: input_report(ib, &ctx.transforms[1], &infb, r.closed[1]),
+            a: input_report(ia, &ctx.transforms[0], &infa, r.closed[0].unwrap_or(false)),
+            b: input_report(ib, &ctx.transforms[1], &infb, r.closed[1].unwrap_or(false)),
         },
         settings: ctx.settings.clone(),
         verdict: r.verdict.name().to_string(),
