@@ -22,11 +22,11 @@
 //! Timed per two-file case (wall clock, one run each, after one untimed warm-up of rayon's
 //! pool): **load** both files (meshclash's loaders; parry has none, so the same figure is
 //! charged to every tool); meshclash **build** (both trees, in parallel), **pairs** (dual walk
-//! + exact classification), **distance** (0 at the first contact, else the exact
+//! and exact classification), **distance** (0 at the first contact, else the exact
 //! branch-and-bound minimum) and the whole library **check** (`query::check`: build, pairs,
-//! closest pair, topology, containment); parry: `TriMesh::new` (build), `Bvh::leaf_pairs` + GJK
-//! per candidate (pairs), `query::distance` (distance). Scene cases (the engines) time the load
-//! and `assembly::run` in scene mode; parry has no counterpart there.
+//! closest pair, topology, containment); parry: `TriMesh::new` (build), `Bvh::leaf_pairs` and
+//! GJK per candidate (pairs), `query::distance` (distance). Scene cases (the engines) time the
+//! load and `assembly::run` in scene mode; parry has no counterpart there.
 
 use meshclash::bvh::{BuildOptions, Bvh};
 use meshclash::check::assembly::{self, Selection};
@@ -219,11 +219,11 @@ pub fn obj_text(v: &[[f32; 3]], f: &[[u32; 3]]) -> String {
 /// GLB bytes: a JSON chunk padded with spaces and a BIN chunk padded with zeros.
 pub fn glb_bytes(json: &Value, bin: &[u8]) -> Vec<u8> {
     let mut j = serde_json::to_vec(json).expect("JSON serialises");
-    while j.len() % 4 != 0 {
+    while !j.len().is_multiple_of(4) {
         j.push(b' ');
     }
     let mut b = bin.to_vec();
-    while b.len() % 4 != 0 {
+    while !b.len().is_multiple_of(4) {
         b.push(0);
     }
     let total = 12 + 8 + j.len() + if b.is_empty() { 0 } else { 8 + b.len() };
