@@ -191,3 +191,24 @@ fn the_reader_sees_cycles() {
         BTreeSet::from(["bvh".to_string()])
     );
 }
+
+/// `autotests = false` (one test binary, issue 13): a `tests/*.rs` file that `tests/suite.rs`
+/// does not declare would silently never run.
+#[test]
+fn every_test_file_is_in_the_suite() {
+    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests");
+    let suite = std::fs::read_to_string(dir.join("suite.rs")).unwrap();
+    let mut missing = Vec::new();
+    for e in std::fs::read_dir(&dir).unwrap() {
+        let p = e.unwrap().path();
+        let (Some(stem), Some("rs")) =
+            (p.file_stem().and_then(|s| s.to_str()), p.extension().and_then(|s| s.to_str()))
+        else {
+            continue;
+        };
+        if stem != "suite" && !suite.contains(&format!("#[path = \"{stem}.rs\"]\nmod {stem};")) {
+            missing.push(format!("#[path = \"{stem}.rs\"]\nmod {stem};"));
+        }
+    }
+    assert!(missing.is_empty(), "add to tests/suite.rs:\n{}", missing.join("\n"));
+}
