@@ -2,8 +2,8 @@
 //! `cargo run --release --example self_torus -- N FILE [--fold]` (N ≈ triangle count; with
 //! `--fold`, one vertex is pulled through the tube so the surface crosses itself).
 
-use meshclash::bench::gen::{to_obj, torus};
 use meshclash::check::self_clash::gen::folded_torus;
+use meshclash::testing::gen::{to_obj, torus};
 
 fn main() -> std::process::ExitCode {
     let args: Vec<String> = std::env::args().skip(1).collect();

@@ -153,15 +153,24 @@ pub enum Command {
     /// `schema`, `completions <shell>`, `man`.
     #[command(flatten)]
     Output(crate::output::Command),
-    /// Time meshclash against parry3d (f32 and f64) on generated and given meshes, compare their
-    /// answers, and (--trade) tabulate every speed/accuracy option against the exact default.
-    Bench(crate::bench::BenchArgs),
+    /// Moved to the `meshclash-bench` binary (workspace member `bench/`): runs it with these
+    /// arguments when it sits next to `meshclash`, else says how to run it.
+    #[command(disable_help_flag = true)]
+    Bench(BenchForward),
     /// Run the named checks of a clash-set file (JSON) in one go: one JSON document with every
     /// check's report, exit 1 if any check fails its --fail-on, 2 on bad input in any check.
     ClashSet(crate::clash_set::ClashSetArgs),
     /// Check one mesh against itself: self-clashing triangle pairs and mesh health per part.
     #[command(name = "self")]
     SelfCheck(crate::self_cmd::SelfArgs),
+}
+
+/// `meshclash bench ARGS..`: forwarded to `meshclash-bench`.
+#[derive(Debug, Clone, clap::Args)]
+pub struct BenchForward {
+    /// Arguments for `meshclash-bench` (see `cargo run --release -p meshclash-bench -- --help`).
+    #[arg(trailing_var_arg = true, allow_hyphen_values = true, num_args = 0..)]
+    pub args: Vec<std::ffi::OsString>,
 }
 
 /// `--fail-on` values.

@@ -16,7 +16,6 @@
 //! and GLB. The library never prints.
 #![deny(missing_docs)]
 
-pub mod bench;
 pub mod bvh;
 pub mod check;
 pub mod clash_set;
@@ -29,5 +28,7 @@ pub mod output;
 pub mod report;
 pub mod scene;
 pub mod self_cmd;
+#[cfg(any(test, feature = "testing"))]
+pub mod testing;
 
 pub use error::{Error, Result};

@@ -29,17 +29,11 @@ fn main() -> ExitCode {
         return self_check(s);
     }
     if let Some(cmd) = &args.command {
-        // `schema`, `completions <shell>`, `man`: generated text on stdout; `bench`: its tables.
+        // `schema`, `completions <shell>`, `man`: generated text on stdout; `bench`: forwarded.
         let text = match cmd {
             cli::Command::Output(c) => c.render(),
             cli::Command::ClashSet(_) | cli::Command::SelfCheck(_) => unreachable!("handled above"),
-            cli::Command::Bench(b) => match meshclash::bench::run_command(b) {
-                Ok(t) => t,
-                Err(e) => {
-                    eprintln!("meshclash: error: {e}");
-                    return ExitCode::from(e.exit_code());
-                }
-            },
+            cli::Command::Bench(b) => return bench_forward(&b.args),
         };
         let mut so = std::io::stdout().lock();
         let _ = so.write_all(text.as_bytes()).and_then(|_| so.flush());
@@ -172,6 +166,28 @@ fn self_check(args: meshclash::self_cmd::SelfArgs) -> ExitCode {
         Err(e) => {
             eprintln!("meshclash: error: {e}");
             ExitCode::from(e.exit_code())
+        }
+    }
+}
+
+/// `meshclash bench ARGS`: the harness is the `meshclash-bench` binary of the workspace member
+/// `bench/` (so a default build does not compile parry3d f32). Run it with ARGS when it sits
+/// next to this executable, else say how to run it (exit 2).
+fn bench_forward(args: &[std::ffi::OsString]) -> ExitCode {
+    let name = format!("meshclash-bench{}", std::env::consts::EXE_SUFFIX);
+    let sibling = std::env::current_exe().ok().and_then(|p| Some(p.parent()?.join(&name)));
+    let Some(exe) = sibling.filter(|p| p.is_file()) else {
+        eprintln!(
+            "meshclash: error: `meshclash bench` is now the meshclash-bench binary: run \
+             `cargo run --release -p meshclash-bench -- ARGS` in the source tree"
+        );
+        return ExitCode::from(2);
+    };
+    match std::process::Command::new(&exe).args(args).status() {
+        Ok(s) => ExitCode::from(s.code().map_or(2, |c| u8::try_from(c).unwrap_or(2))),
+        Err(e) => {
+            eprintln!("meshclash: error: cannot run {}: {e}", exe.display());
+            ExitCode::from(2)
         }
     }
 }

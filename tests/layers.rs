@@ -1,9 +1,11 @@
 //! The module graph of `src/`, read from `crate::` paths (issue 13): the lower layers import
-//! nothing above them. Run with `cargo test --test layers -- --nocapture` to print the graph.
+//! nothing above them, and no two top-level modules import each other, directly or through
+//! others, except the cycles listed in [`KNOWN_CYCLES`] (which fail the test when they grow,
+//! when a new one appears, or when one is gone and still listed). Run with
+//! `cargo test --test suite layers -- --nocapture` to print the graph and its cycles.
 //!
-//! Not yet enforced (still cyclic, see README "Layout"): `cli`, `clash_set`, `output`, `report`,
-//! `check` and `bench`; unit-test code (`#[cfg(test)]` modules and `tests.rs` files) may use the
-//! test fixtures in `bench::gen` until they move.
+//! Unit-test code (`#[cfg(test)]` blocks and `tests.rs` files) is not counted; the test support
+//! of `src/testing/` is (it is a module like the others).
 
 use std::collections::{BTreeMap, BTreeSet};
 use std::path::Path;
@@ -32,10 +34,17 @@ fn crate_refs(text: &str, is_test_file: bool) -> BTreeSet<String> {
     if is_test_file {
         return refs;
     }
-    for line in text.lines() {
+    let lines: Vec<&str> = text.lines().collect();
+    for (i, line) in lines.iter().enumerate() {
         let code = line.split("//").next().unwrap();
         if line.trim_start().starts_with("#[cfg(test)]") {
-            break; // unit tests sit at the end of a file by convention
+            // `#[cfg(test)] mod tests;` only declares a file (read as a test file); an inline
+            // test block sits at the end of a file by convention.
+            let next = lines[i + 1..].iter().map(|l| l.trim()).find(|l| !l.is_empty()).unwrap_or("");
+            if next.starts_with("mod ") && next.ends_with(';') {
+                continue;
+            }
+            break;
         }
         let mut rest = code;
         while let Some(i) = rest.find("crate::") {
@@ -100,6 +109,66 @@ fn lower_layers_import_nothing_above_them() {
     }
 }
 
+/// Import cycles between top-level modules that exist today, each as its sorted member list
+/// (a strongly connected component of the graph). Issue 13 removes them; remove an entry here
+/// when its cycle is gone (the test says so).
+const KNOWN_CYCLES: &[&[&str]] = &[KNOWN_CYCLE_0];
+const KNOWN_CYCLE_0: &[&str] = &["check", "clash_set", "cli", "output", "report", "self_cmd"];
+
+/// Strongly connected components that contain a cycle (the import cycles), each sorted, in
+/// sorted order.
+fn cycles(g: &BTreeMap<String, BTreeSet<String>>) -> Vec<Vec<String>> {
+    let mut out: Vec<Vec<String>> = Vec::new();
+    let mut placed = BTreeSet::new();
+    for m in g.keys() {
+        if placed.contains(m) {
+            continue;
+        }
+        let from_m = reachable(g, m);
+        if !from_m.contains(m) {
+            continue;
+        }
+        let scc: Vec<String> =
+            from_m.iter().filter(|x| *x == m || reachable(g, x).contains(m)).cloned().collect();
+        placed.extend(scc.iter().cloned());
+        out.push(scc);
+    }
+    out.sort();
+    out
+}
+
+#[test]
+fn no_new_import_cycle_between_top_level_modules() {
+    let g = graph();
+    let found = cycles(&g);
+    println!("import cycles between top-level modules: {}", found.len());
+    for c in &found {
+        // One concrete loop per cycle, to show where to cut: the direct edges inside it.
+        let edges: Vec<String> = c
+            .iter()
+            .flat_map(|a| g[a].iter().filter(|b| c.contains(b)).map(move |b| format!("{a}->{b}")))
+            .collect();
+        println!("  {{{}}}: {}", c.join(", "), edges.join(" "));
+    }
+    let known: Vec<Vec<String>> =
+        KNOWN_CYCLES.iter().map(|c| c.iter().map(|s| s.to_string()).collect()).collect();
+    for c in &found {
+        assert!(
+            known.contains(c),
+            "new or grown import cycle between top-level modules: {{{}}} (known: {known:?}); \
+             cut one of its edges (see the printed graph: --nocapture)",
+            c.join(", ")
+        );
+    }
+    for k in &known {
+        assert!(
+            found.contains(k),
+            "known cycle {{{}}} is gone or smaller: update KNOWN_CYCLES in tests/layers.rs",
+            k.join(", ")
+        );
+    }
+}
+
 #[test]
 fn the_reader_sees_cycles() {
     // The checker itself: a made-up cyclic graph is caught.
@@ -107,8 +176,39 @@ fn the_reader_sees_cycles() {
     g.insert("a".to_string(), BTreeSet::from(["b".to_string()]));
     g.insert("b".to_string(), BTreeSet::from(["a".to_string()]));
     assert!(reachable(&g, "a").contains("a"));
+    g.insert("c".to_string(), BTreeSet::from(["a".to_string()]));
+    g.insert("d".to_string(), BTreeSet::from(["d".to_string(), "c".to_string()]));
+    assert_eq!(cycles(&g), vec![vec!["a".to_string(), "b".to_string()], vec!["d".to_string()]]);
     assert_eq!(
         crate_refs("use crate::geom::Aabb; // crate::cli\n#[cfg(test)]\nuse crate::bench;", false),
         BTreeSet::from(["geom".to_string()])
     );
+    assert_eq!(
+        crate_refs(
+            "#[cfg(test)]\nmod tests;\n\nfn f() { crate::bvh::x() }\n#[cfg(test)]\nmod t {\n crate::cli",
+            false
+        ),
+        BTreeSet::from(["bvh".to_string()])
+    );
+}
+
+/// `autotests = false` (one test binary, issue 13): a `tests/*.rs` file that `tests/suite.rs`
+/// does not declare would silently never run.
+#[test]
+fn every_test_file_is_in_the_suite() {
+    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests");
+    let suite = std::fs::read_to_string(dir.join("suite.rs")).unwrap();
+    let mut missing = Vec::new();
+    for e in std::fs::read_dir(&dir).unwrap() {
+        let p = e.unwrap().path();
+        let (Some(stem), Some("rs")) =
+            (p.file_stem().and_then(|s| s.to_str()), p.extension().and_then(|s| s.to_str()))
+        else {
+            continue;
+        };
+        if stem != "suite" && !suite.contains(&format!("#[path = \"{stem}.rs\"]\nmod {stem};")) {
+            missing.push(format!("#[path = \"{stem}.rs\"]\nmod {stem};"));
+        }
+    }
+    assert!(missing.is_empty(), "add to tests/suite.rs:\n{}", missing.join("\n"));
 }

@@ -479,8 +479,8 @@ fn partition(items: &mut [Item], left: impl Fn(&Item) -> bool) -> (usize, Box32,
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::bench::gen;
     use crate::scene::mesh::Mesh;
+    use crate::testing::gen;
 
     fn boxes(m: &Mesh) -> Vec<Aabb> {
         (0..m.triangles.len() as u32).map(|t| Aabb::of_triangle(&super::super::triangle(m, t))).collect()
@@ -583,7 +583,7 @@ mod tests {
         for m in [gen::torus(20_000), gen::crossing_tori(20_000).1] {
             let b = boxes(&m);
             let binned = Bvh::build(&m, BuildOptions::default()).stats().sah_cost;
-            let full = crate::bench::sweep::build_full_sweep(&b, 4).stats().sah_cost;
+            let full = crate::testing::sweep::build_full_sweep(&b, 4).stats().sah_cost;
             assert!(binned <= full * 1.05, "binned {binned} vs full sweep {full}");
         }
     }
@@ -602,7 +602,7 @@ mod tests {
             let t1 = one.install(|| Bvh::build(&m, BuildOptions::default()));
             assert!(t1.nodes == t.nodes && t1.prims == t.prims, "{name}: thread count changed the tree");
             let (binned, full) =
-                (t.stats().sah_cost, crate::bench::sweep::build_full_sweep(&b, 4).stats().sah_cost);
+                (t.stats().sah_cost, crate::testing::sweep::build_full_sweep(&b, 4).stats().sah_cost);
             assert!(binned <= full * 1.05, "{name}: binned {binned} vs full sweep {full}");
         }
     }

@@ -33,7 +33,7 @@
 //! * The distance converges only to a relative `sqrt(eps_tol)`, returns 0 when GJK gives up
 //!   after 100 iterations, and returns 0 for gaps around 1e-14 (f64) or 1e-6 (f32) at unit
 //!   scale while the intersection test reports no pair for the same geometry.
-//! * `parry_f32` (behind the `parry-f32` feature) first rounds every f64 position to the
+//! * `parry_f32` (in the `meshclash-bench` crate, built from the same macro) first rounds every f64 position to the
 //!   nearest f32: that rounding is part of what it measures, and it alone opens or closes gaps
 //!   of about `|x| · 6e-8`.
 //!
@@ -59,6 +59,10 @@
 //! includes f64 values that overflow f32.
 
 use crate::scene::mesh::Mesh;
+
+/// rayon, for [`__impl_parry`](crate::__impl_parry) expanded in another crate.
+#[doc(hidden)]
+pub use rayon as __rayon;
 
 /// What parry3d reports for the same two meshes (already in world coordinates).
 #[derive(Debug, Clone, PartialEq)]
@@ -120,7 +124,8 @@ pub fn diff_pairs(ours: &[(u32, u32)], parry: &[(u32, u32)]) -> (Vec<(u32, u32)>
 /// Rejects what would make parry panic instead of failing: out-of-range indices and
 /// coordinates that are not finite or exceed `max_abs` (the largest finite value of parry's
 /// scalar type).
-fn check_input(m: &Mesh, which: &str, max_abs: f64) -> Result<(), String> {
+#[doc(hidden)]
+pub fn check_input(m: &Mesh, which: &str, max_abs: f64) -> Result<(), String> {
     let n = m.positions.len();
     if let Some((t, tri)) =
         m.triangles.iter().enumerate().find(|(_, tri)| tri.iter().any(|&v| v as usize >= n))
@@ -135,13 +140,22 @@ fn check_input(m: &Mesh, which: &str, max_abs: f64) -> Result<(), String> {
     Ok(())
 }
 
-/// Instantiates the parry cross-check for one parry crate (`parry3d_f64` or `parry3d`) and its
-/// scalar type.
-macro_rules! impl_parry {
+/// Instantiates the parry cross-check for one parry crate (`parry3d_f64` here, `parry3d` in the
+/// `meshclash-bench` crate, which is where the f32 variant lives so that the product does not
+/// link parry3d f32) and its scalar type. The caller's crate must depend on `$krate`.
+#[doc(hidden)]
+#[macro_export]
+macro_rules! __impl_parry {
     ($(#[$attr:meta])* $name:ident, $krate:ident, $real:ty) => {
         $(#[$attr])*
-        pub fn $name(a: &Mesh, b: &Mesh, compute_distance: bool) -> Result<ParryResult, String> {
-            use rayon::prelude::*;
+        pub fn $name(
+            a: &$crate::scene::mesh::Mesh,
+            b: &$crate::scene::mesh::Mesh,
+            compute_distance: bool,
+        ) -> Result<$crate::check::cross_check::ParryResult, String> {
+            use $crate::check::cross_check::{check_input, ParryResult};
+            use $crate::scene::mesh::Mesh;
+            use $crate::check::cross_check::__rayon::prelude::*;
             use std::time::Instant;
             use $krate::math::{Pose, Vector};
             use $krate::query::{self, ClosestPoints};
@@ -173,7 +187,7 @@ macro_rules! impl_parry {
             let id = Pose::identity();
             let unsupported = |what: &str| format!("parry: {what} unsupported for these shapes");
             // Start rayon's pool outside the timed region.
-            rayon::current_num_threads();
+            $crate::check::cross_check::__rayon::current_num_threads();
 
             let start = Instant::now();
             let candidates: Vec<(u32, u32)> =
@@ -216,7 +230,7 @@ macro_rules! impl_parry {
     };
 }
 
-impl_parry!(
+__impl_parry!(
     /// Runs parry3d-f64 on `a` and `b` (see the module docs): every triangle pair whose parry
     /// BVH leaves overlap, tested with parry's triangle–triangle `intersection_test`, and, if
     /// `compute_distance`, parry's `TriMesh`–`TriMesh` distance and witness points.
@@ -233,28 +247,7 @@ impl_parry!(
     f64
 );
 
-/// The f32 instantiation, in its own module only so that `allow(unexpected_cfgs)` can reach the
-/// cfg while the crate does not declare the `parry-f32` feature yet.
-#[allow(unexpected_cfgs, unused_imports)]
-mod f32_variant {
-    use super::*;
-
-    // parry3d is a normal dependency now (`meshclash bench`), so this is always built.
-    impl_parry!(
-        /// [`parry_f64`] with parry3d (f32): every position is first rounded to the nearest f32,
-        /// and parry's tolerances are those of f32. Witness points are converted back to f64.
-        ///
-        /// Errors as [`parry_f64`] does, and also when a coordinate overflows f32.
-        parry_f32,
-        parry3d,
-        f32
-    );
-}
-#[allow(unused_imports)]
-pub use f32_variant::*;
-
 #[cfg(test)]
-#[allow(unexpected_cfgs)] // see `f32_variant`
 mod tests {
     use super::*;
     use glam::DVec3;
@@ -457,24 +450,5 @@ mod tests {
         let r = pair(1e-4);
         assert!(r.intersecting_pairs.is_empty());
         assert!(r.distance > 1.2 * 0.5e-4, "parry's small-triangle distance is now right: {r:?}");
-    }
-
-    #[cfg(feature = "parry-f32")]
-    #[test]
-    fn f32_cubes() {
-        let a = cube(DVec3::ZERO, 1.0);
-        let b = cube(DVec3::new(0.5, 0.0, 0.0), 1.0);
-        let r32 = parry_f32(&a, &b, true).unwrap();
-        let r64 = parry_f64(&a, &b, true).unwrap();
-        assert!(!r32.intersecting_pairs.is_empty());
-        assert_eq!(r32.distance, 0.0);
-        // Unit-size triangles: rounding to f32 is exact here and f32 GJK agrees with f64.
-        assert_eq!(r32.intersecting_pairs, r64.intersecting_pairs);
-
-        let b = cube(DVec3::new(1.25, 0.0, 0.0), 1.0);
-        let r = parry_f32(&a, &b, true).unwrap();
-        assert_eq!(r.intersecting_pairs, vec![]);
-        assert!((r.distance - 0.25).abs() < 1e-6, "{}", r.distance);
-        assert!(r.points.is_some());
     }
 }

@@ -354,16 +354,17 @@ pub fn self_pairs_brute_force(mesh: &Mesh, merged: &[u32], tris: &[u32]) -> Vec<
 #[cfg(test)]
 mod tests;
 
-/// Generated inputs for tests and the benchmark.
+/// Generated inputs for tests and the benchmark (with [`crate::testing`]).
+#[cfg(any(test, feature = "testing"))]
 pub mod gen {
     use crate::geom::DVec3;
     use crate::scene::mesh::Mesh;
 
-    /// [`crate::bench::gen::torus`] (`≈ n` triangles, closed, major radius 1, minor 0.35) with
+    /// [`crate::testing::gen::torus`] (`≈ n` triangles, closed, major radius 1, minor 0.35) with
     /// one fold: the vertex on the outer equator at angle 0 is pulled through the tube to
     /// `(0.5, 0, 0)`, inside the hole, so its six triangles pierce the inner wall.
     pub fn folded_torus(n: usize) -> Mesh {
-        let mut m = crate::bench::gen::torus(n);
+        let mut m = crate::testing::gen::torus(n);
         m.positions[0] = DVec3::new(0.5, 0.0, 0.0);
         m
     }

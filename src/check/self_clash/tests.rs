@@ -172,7 +172,7 @@ fn zero_area_triangles_follow_the_same_rule() {
 
 #[test]
 fn results_do_not_depend_on_the_thread_count() {
-    let m = crate::bench::gen::torus(4000);
+    let m = crate::testing::gen::torus(4000);
     let (merged, _) = crate::scene::bodies::merge_vertices(&m.positions);
     let all: Vec<u32> = (0..m.triangles.len() as u32).collect();
     let run = |n| {
@@ -272,7 +272,7 @@ fn a_folded_torus_crosses_only_around_the_fold() {
     assert!(got.iter().all(|p| moved(p.0) || moved(p.1)), "{got:?}");
     assert_eq!(m.triangles.iter().filter(|t| t.contains(&0)).count(), 6);
     // The same torus unfolded: nothing.
-    assert!(pairs(&crate::bench::gen::torus(2000)).is_empty());
+    assert!(pairs(&crate::testing::gen::torus(2000)).is_empty());
 }
 
 #[test]

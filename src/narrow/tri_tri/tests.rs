@@ -359,9 +359,9 @@ mod filtered_vs_unfiltered {
 #[test]
 #[ignore]
 fn replay_candidates_for_profiling() {
-    use crate::bench::gen;
     use crate::bvh::{self, BuildOptions, Bvh};
     use crate::geom::Aabb;
+    use crate::testing::gen;
     let which = std::env::var("MESHCLASH_REPLAY").unwrap_or_else(|_| "tori".into());
     let (a, b) = match which.as_str() {
         "grid" => gen::coplanar_grids(20_000),

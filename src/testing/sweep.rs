@@ -73,7 +73,7 @@ mod tests {
 
     #[test]
     fn full_sweep_is_valid_and_not_worse_than_binned() {
-        let m = super::super::gen::torus(4000);
+        let m = crate::testing::gen::torus(4000);
         let boxes: Vec<Aabb> =
             (0..m.triangles.len() as u32).map(|t| Aabb::of_triangle(&crate::bvh::triangle(&m, t))).collect();
         let full = build_full_sweep(&boxes, 4);

@@ -1,8 +1,8 @@
 //! Criterion: BVH build per strategy on generated tori of 10k / 100k / 1M triangles
 //! (throughput in triangles per second; the SAH cost of each tree is printed once).
-//! `cargo bench --bench build`.
+//! `cargo bench -p meshclash-bench --bench build`.
 //!
-//! With `BUILD_REPORT=1` (e.g. `BUILD_REPORT=1 cargo bench --bench build`) criterion is skipped
+//! With `BUILD_REPORT=1` (e.g. `BUILD_REPORT=1 cargo bench -p meshclash-bench --bench build`) criterion is skipped
 //! and a short report is printed instead, per size: SAH build Mtris/s for one tree and for two
 //! trees built side by side (median of several runs, as `meshclash check` builds), tree bytes per
 //! triangle, the peak heap the build allocates beyond its input (counted by this binary's global
@@ -10,9 +10,9 @@
 //! sweep (up to `BUILD_REPORT_SWEEP_MAX` triangles, default 300k).
 
 use criterion::{black_box, criterion_group, criterion_main, BenchmarkId, Criterion, Throughput};
-use meshclash::bench::{gen, sweep};
 use meshclash::bvh::{self, BuildOptions, Bvh, Strategy};
 use meshclash::geom::Aabb;
+use meshclash::testing::{gen, sweep};
 use std::alloc::{GlobalAlloc, Layout, System};
 use std::sync::atomic::{AtomicUsize, Ordering};
 use std::time::{Duration, Instant};

@@ -1,13 +1,15 @@
 //! Criterion: the same operations for meshclash and parry3d (f64 and f32) in one group, on
 //! generated crossing tori (10k and 100k triangles each): build, all pairs, and the whole
 //! pipeline (build + pairs). parry's distance on crossing meshes is left out (seconds per call
-//! at 100k); `meshclash bench` measures it once. `cargo bench --bench vs_parry`.
+//! at 100k); `meshclash-bench` measures it once. `cargo bench -p meshclash-bench --bench vs_parry`.
 
 use criterion::{black_box, criterion_group, criterion_main, BenchmarkId, Criterion};
-use meshclash::bench::{exact_pairs, gen};
 use meshclash::bvh::{BuildOptions, Bvh};
-use meshclash::check::cross_check::{parry_f32, parry_f64};
+use meshclash::check::cross_check::parry_f64;
 use meshclash::check::query::{check, Settings};
+use meshclash::testing::gen;
+use meshclash_bench::exact_pairs;
+use meshclash_bench::parry32::parry_f32;
 use std::time::Duration;
 
 fn vs_parry(c: &mut Criterion) {

@@ -1,4 +1,5 @@
-//! `meshclash bench`: meshclash and parry3d (f64 and f32) on the same inputs in one process,
+//! `meshclash-bench` (was `meshclash bench`): meshclash and parry3d (f64 and f32) on the same
+//! inputs in one process,
 //! phase by phase, with the answers compared against meshclash's exact ones; and, with
 //! `--trade`, every speed/accuracy option a user can pick, timed and compared with the exact
 //! default.
@@ -13,34 +14,35 @@
 //!   **distance**: what a distance query needs: for inputs that touch, a walk that stops at the
 //!   first contact (distance 0); otherwise the branch-and-bound closest pair. **check**: the
 //!   whole [`query::check`] (build, pairs, closest pair, topology and containment).
-//! * parry: [`cross_check::parry_f64`] / [`cross_check::parry_f32`]: `TriMesh::new` (build),
+//! * parry: [`cross_check::parry_f64`] / [`parry32::parry_f32`]: `TriMesh::new` (build),
 //!   `Bvh::leaf_pairs` + per-pair `intersection_test` (pairs), `query::distance` (distance).
 //!
-//! Memory: tree bytes are meshclash's [`crate::bvh::Stats::bytes`] (nodes + triangle indices)
+//! Memory: tree bytes are meshclash's [`meshclash::bvh::Stats::bytes`] (nodes + triangle indices)
 //! and parry's `Bvh::total_memory_size`; "peak RSS Δ" is `VmHWM` (after resetting it through
 //! `/proc/self/clear_refs`) minus `VmRSS` before the run, i.e. everything the run allocated at
 //! its peak including transient buffers (and, for parry, its copy of the vertex buffers).
 
-pub mod gen;
+pub mod cases;
 pub mod layout;
+pub mod parry32;
 pub mod svg;
-pub mod sweep;
 
-use crate::bvh::traverse;
-use crate::bvh::{self, BuildOptions, Bvh, Strategy};
-use crate::check::cross_check::{self, ParryResult};
-use crate::check::query::{self, ClashResult, DistanceError, Mode, Settings};
-use crate::error::{Error, Result};
-use crate::geom::predicates;
-use crate::geom::Aabb;
-use crate::narrow::tri_tri;
-use crate::scene::mesh::Mesh;
+use meshclash::bvh::traverse;
+use meshclash::bvh::{self, BuildOptions, Bvh, Strategy};
+use meshclash::check::cross_check::{self, ParryResult};
+use meshclash::check::query::{self, ClashResult, DistanceError, Mode, Settings};
+use meshclash::error::{Error, Result};
+use meshclash::geom::predicates;
+use meshclash::geom::Aabb;
+use meshclash::narrow::tri_tri;
+use meshclash::scene::mesh::Mesh;
+pub use meshclash::testing::{gen, sweep};
 use serde::Serialize;
 use std::path::PathBuf;
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::time::Instant;
 
-/// `meshclash bench` flags.
+/// `meshclash-bench` flags.
 #[derive(Debug, Clone, clap::Args)]
 pub struct BenchArgs {
     /// Generated input sizes, triangles per mesh (`k` = 1e3, `M` = 1e6), comma-separated.
@@ -98,7 +100,7 @@ pub fn parse_sizes(s: &str) -> Result<Vec<usize>> {
         .collect()
 }
 
-/// What the binary runs for `meshclash bench`: measure, write the plot, and return the text
+/// What the binary runs for `meshclash-bench`: measure, write the plot, and return the text
 /// (tables or JSON) to print on stdout.
 pub fn run_command(args: &BenchArgs) -> Result<String> {
     let opts = BenchOptions {
@@ -109,7 +111,7 @@ pub fn run_command(args: &BenchArgs) -> Result<String> {
     };
     let rep = run(&opts)?;
     if let Some(path) = &args.plot {
-        crate::report::write_atomic(path, svg::plot_svg(&rep).as_bytes())?;
+        meshclash::report::write_atomic(path, svg::plot_svg(&rep).as_bytes())?;
     }
     let bad: Vec<String> = rep
         .trade
@@ -133,7 +135,7 @@ pub fn run_command(args: &BenchArgs) -> Result<String> {
     })
 }
 
-/// Everything one `meshclash bench` run measured.
+/// Everything one `meshclash-bench` run measured.
 #[derive(Debug, Clone, Serialize)]
 pub struct BenchReport {
     /// Cores, threads and load.
@@ -375,8 +377,8 @@ type ExactPair = (u32, u32, bool);
 
 /// The pairs phase: dual walk, exact classification of every candidate (zero tolerances).
 pub fn exact_pairs(a: &Mesh, ta: &Bvh, b: &Mesh, tb: &Bvh) -> Vec<ExactPair> {
-    let (pairs, _) = crate::check::query::find_pairs(a, ta, b, tb, &Settings::default());
-    pairs.iter().map(|p| (p.a, p.b, p.kind == crate::check::query::PairKind::Crossing)).collect()
+    let (pairs, _) = meshclash::check::query::find_pairs(a, ta, b, tb, &Settings::default());
+    pairs.iter().map(|p| (p.a, p.b, p.kind == meshclash::check::query::PairKind::Crossing)).collect()
 }
 
 /// The distance a standalone distance query needs: 0 at the first contact found, else the
@@ -414,7 +416,7 @@ pub fn distance_within(a: &Mesh, ta: &Bvh, b: &Mesh, tb: &Bvh, err: DistanceErro
     if !hit.is_empty() {
         return Some(0.0);
     }
-    crate::check::query::closest_pair(a, ta, b, tb, err).map(|c| c.distance)
+    meshclash::check::query::closest_pair(a, ta, b, tb, err).map(|c| c.distance)
 }
 
 /// Candidate triangle pairs (boxes overlap), at most `cap`.
@@ -631,7 +633,7 @@ fn measure(case: &Case, parry_rate: &mut Option<f64>) -> InputResult {
         }
     };
     let parry_f64 = parry(cross_check::parry_f64);
-    let parry_f32 = parry(cross_check::parry_f32);
+    let parry_f32 = parry(parry32::parry_f32);
     if touching {
         if let Some(d) = parry_f64.distance_ms {
             let rate = d / tris as f64;
@@ -760,7 +762,7 @@ fn obj_parse(opts: &BenchOptions) -> Vec<ParseResult> {
             let mut best = f64::INFINITY;
             for _ in 0..3 {
                 let t = Instant::now();
-                crate::load::load_bytes(&path, &bytes, crate::load::Format::Obj).ok()?;
+                meshclash::load::load_bytes(&path, &bytes, meshclash::load::Format::Obj).ok()?;
                 best = best.min(ms(t));
             }
             Some(ParseResult {
@@ -1007,7 +1009,7 @@ pub fn render(rep: &BenchReport) -> String {
     let load = |l: Option<f64>| l.map_or("?".into(), |v| format!("{v:.2}"));
     let _ = writeln!(
         out,
-        "meshclash bench: {} cores, {} threads, load average {} at start, {} at end{}, {:.0} s",
+        "meshclash-bench: {} cores, {} threads, load average {} at start, {} at end{}, {:.0} s",
         rep.machine.cores,
         rep.machine.threads,
         load(rep.machine.load[0]),

@@ -1,4 +1,4 @@
-//! Deterministic generated inputs for the benchmark: tessellated tori (closed, no degenerate
+//! Deterministic generated inputs for tests and the benchmark: tessellated tori (closed, no degenerate
 //! triangles, ~n triangles each), placed so that they cross or stay apart, and two
 //! near-degenerate inputs on which plain f64 predicates change answers.
 

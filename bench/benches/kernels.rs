@@ -1,16 +1,16 @@
 //! Criterion benchmarks of the kernels and phases: exact triangle–triangle classification,
 //! closed-form distance, BVH build per strategy, and the whole check on real meshes.
-//! `cargo bench --bench kernels` (needs ../shared/meshes beside the repo for the mesh cases).
+//! `cargo bench -p meshclash-bench --bench kernels` (needs ../shared/meshes beside the repo for the mesh cases).
 
 use criterion::{black_box, criterion_group, criterion_main, Criterion, Throughput};
 use glam::{DMat4, DVec3};
-use meshclash::bench::gen;
 use meshclash::bvh::{BuildOptions, Bvh, Strategy};
 use meshclash::check::query::{check, load_input, InputSpec, Settings};
 use meshclash::geom::Aabb;
 use meshclash::narrow::distance::triangle_distance;
 use meshclash::narrow::tri_tri::{classify, classify_unfiltered, Hit};
 use meshclash::scene::mesh::Mesh;
+use meshclash::testing::gen;
 
 /// Deterministic pseudo-random triangle pairs near each other (a mix of crossing and apart).
 fn pairs(n: usize) -> Vec<([DVec3; 3], [DVec3; 3])> {
@@ -45,7 +45,7 @@ fn kernels(c: &mut Criterion) {
 }
 
 fn shared(name: &str) -> Option<meshclash::scene::mesh::Mesh> {
-    let path = std::path::PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../shared/meshes").join(name);
+    let path = std::path::PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../shared/meshes").join(name);
     load_input(&InputSpec { path, transform: DMat4::IDENTITY }).ok().map(|i| i.mesh)
 }
 

@@ -1,10 +1,11 @@
 //! Criterion: the dual walk with exact classification (all pairs) and the distance query on
 //! generated tori (crossing and apart), 10k / 100k / 1M triangles each.
-//! `cargo bench --bench query`.
+//! `cargo bench -p meshclash-bench --bench query`.
 
 use criterion::{black_box, criterion_group, criterion_main, BenchmarkId, Criterion};
-use meshclash::bench::{exact_distance, exact_pairs, gen};
 use meshclash::bvh::{BuildOptions, Bvh};
+use meshclash::testing::gen;
+use meshclash_bench::{exact_distance, exact_pairs};
 use std::time::Duration;
 
 fn query(c: &mut Criterion) {

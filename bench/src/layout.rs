@@ -1,18 +1,18 @@
-//! Two node layouts for one-tree walks, measured against each other by `meshclash bench`.
+//! Two node layouts for one-tree walks, measured against each other by `meshclash-bench`.
 //!
-//! * **Stack** (the layout of [`crate::bvh`]): depth-first array, left child = next node, right
+//! * **Stack** (the layout of [`meshclash::bvh`]): depth-first array, left child = next node, right
 //!   child index stored in the node, walked with an explicit stack.
 //! * **Stackless** (skip pointers): the same depth-first order, but each node stores where to go
 //!   when its box is missed (or when its leaf is done): `skip(left) = right`,
 //!   `skip(right) = skip(parent)`, `skip(root) = end`. A hit on an interior node goes to the next
 //!   node. No stack, no right-child index; the leaf's triangle count is packed into the top 8
-//!   bits of the skip word, so a node is 56 bytes like [`crate::bvh::Node`].
+//!   bits of the skip word, so a node is 56 bytes like [`meshclash::bvh::Node`].
 //!
 //! The workload: for each leaf of tree A, find every leaf of tree B whose box overlaps it (the
-//! "one-tree" alternative to the dual walk of [`crate::bvh::traverse`]).
+//! "one-tree" alternative to the dual walk of [`meshclash::bvh::traverse`]).
 
-use crate::bvh::Bvh;
-use crate::geom::Aabb;
+use meshclash::bvh::Bvh;
+use meshclash::geom::Aabb;
 use rayon::prelude::*;
 
 /// A skip-pointer node: box, `skip | count << 24`, first triangle (leaves only).
@@ -166,8 +166,8 @@ pub fn leaves_vs_tree_stackless(ta: &Bvh, tb: &SkipBvh, work: impl Fn(&[u32], &[
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::bvh::{BuildOptions, Strategy};
-    use crate::geom::DVec3;
+    use meshclash::bvh::{BuildOptions, Strategy};
+    use meshclash::geom::DVec3;
 
     #[test]
     fn stackless_visits_the_same_leaves() {

@@ -1,0 +1,40 @@
+//! The one integration-test crate (issue 13: one test binary links once instead of one per
+//! file). Every `tests/*.rs` file is a module here; run one file's tests with
+//! `cargo test --test suite cli::` (module path as the filter).
+
+#[path = "assembly.rs"]
+mod assembly;
+#[path = "bench_cmd.rs"]
+mod bench_cmd;
+#[path = "bodies_penetration.rs"]
+mod bodies_penetration;
+#[path = "brute_force.rs"]
+mod brute_force;
+#[path = "clash_set.rs"]
+mod clash_set;
+#[path = "cli.rs"]
+mod cli;
+#[path = "extremes.rs"]
+mod extremes;
+#[path = "fcl_reference.rs"]
+mod fcl_reference;
+#[path = "gltf_ext.rs"]
+mod gltf_ext;
+#[path = "hostile.rs"]
+mod hostile;
+#[path = "layers.rs"]
+mod layers;
+#[path = "obj_vs_tobj.rs"]
+mod obj_vs_tobj;
+#[path = "outputs.rs"]
+mod outputs;
+#[path = "parry_oracle.rs"]
+mod parry_oracle;
+#[path = "part_pairs.rs"]
+mod part_pairs;
+#[path = "self_clash.rs"]
+mod self_clash;
+#[path = "tri_tri_oracle.rs"]
+mod tri_tri_oracle;
+#[path = "trust.rs"]
+mod trust;
