@@ -12,14 +12,18 @@ differ where parts only touch or one lies inside another (see meshclash.collisio
 
 import argparse
 import statistics
+import sys
 import time
 from pathlib import Path
 
-import meshclash
-import trimesh
-from trimesh.collision import CollisionManager as FclManager
-
 HERE = Path(__file__).resolve().parent
+# This script sits beside the package's sources (python/meshclash, without the compiled
+# module): import the installed package instead.
+sys.path = [p for p in sys.path if Path(p or ".").resolve() != HERE]
+
+import meshclash  # noqa: E402
+import trimesh  # noqa: E402
+from trimesh.collision import CollisionManager as FclManager  # noqa: E402
 DEFAULT = HERE.parent.parent / "shared" / "meshes" / "2CylinderEngine.glb"
 
 

@@ -21,10 +21,11 @@ if [ ! -x "$venv/bin/python" ]; then
 fi
 "$venv/bin/python" -m pip install --quiet --upgrade pip
 "$venv/bin/python" -m pip install --quiet maturin numpy pytest trimesh python-fcl scipy
-# The one install command (from the repository root). The extension builds in its own target
-# directory (python/target, or $MESHCLASH_PY_TARGET) so it never contends with the CLI's.
+# The one install command (from the repository root). The extension builds in the CLI's target
+# directory by default, so the library and its dependencies compiled for the CLI above are
+# reused ($MESHCLASH_PY_TARGET to build elsewhere).
 cd "$repo"
-CARGO_TARGET_DIR="${MESHCLASH_PY_TARGET:-$here/target}" "$venv/bin/python" -m pip install --quiet ./python
+CARGO_TARGET_DIR="${MESHCLASH_PY_TARGET:-$target}" "$venv/bin/python" -m pip install --quiet --force-reinstall --no-deps ./python
 cd "$here"
 # -p no:cacheprovider: leave no .pytest_cache in the tree.
 "$venv/bin/pytest" -p no:cacheprovider -q tests "$@"

@@ -18,7 +18,7 @@ use crate::bvh::{BuildOptions, Bvh, Node};
 use crate::check::assembly::{self, PartPairSummary, Selection};
 use crate::check::containment::{self, Containment, Topology};
 use crate::check::query::{
-    self, Closest, DistanceError, Input, InputSpec, Mode, PairFinding, Settings, Verdict,
+    self, Closest, DistanceError, Input, InputSpec, Mode, PairFinding, PairKind, Settings, Verdict,
 };
 use crate::error::{Error, Result};
 use crate::geom::predicates::{self, BoxMap, Tolerances};
@@ -28,6 +28,7 @@ use crate::report::{self, Report, SettingsReport};
 use crate::scene::mesh::{Loaded, Mesh, Object, TriMesh};
 use glam::DMat4;
 use std::path::{Path, PathBuf};
+use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::{Arc, OnceLock};
 use std::time::Instant;
 
@@ -627,16 +628,66 @@ impl Collision {
     }
 }
 
+/// Every triangle pair of `a` and `b` that meets exactly (crossing or touching), sorted; with
+/// `first`, the walk stops at the first one found (which one depends on timing).
+pub fn meeting_pairs<A, TA, B, TB>(a: &A, ta: &TA, b: &B, tb: &TB, first: bool) -> Vec<PairFinding>
+where
+    A: TriMesh + ?Sized,
+    TA: Tree + ?Sized,
+    B: TriMesh + ?Sized,
+    TB: Tree + ?Sized,
+{
+    if !first {
+        return query::find_pairs(a, ta, b, tb, &Settings::default()).0;
+    }
+    let tol = Tolerances::default();
+    let stop = AtomicBool::new(false);
+    let mut found = crate::bvh::traverse::collect_pairs(
+        ta,
+        tb,
+        |x, y| !stop.load(Ordering::Relaxed) && tol.boxes_may_meet(x, y),
+        |la, lb, out| {
+            for &i in la {
+                let ti = a.triangle(i);
+                let bi = Aabb::of_triangle(&ti);
+                for &j in lb {
+                    if stop.load(Ordering::Relaxed) {
+                        return;
+                    }
+                    let tj = b.triangle(j);
+                    if !tol.boxes_may_meet(&bi, &Aabb::of_triangle(&tj)) {
+                        continue;
+                    }
+                    if let Some(h) = crate::narrow::tri_tri::classify(&ti, &tj) {
+                        let kind = if h.crossing { PairKind::Crossing } else { PairKind::Touching };
+                        out.push(PairFinding {
+                            a: i,
+                            b: j,
+                            kind,
+                            contact: Some(h.contact),
+                            distance: 0.0,
+                            segment: h.segment,
+                        });
+                        stop.store(true, Ordering::Relaxed);
+                        return;
+                    }
+                }
+            }
+        },
+    );
+    found.sort_unstable_by_key(|p| (p.a, p.b));
+    found
+}
+
 /// Exact collision test of two placed meshes: every meeting triangle pair (`all`), or stop at
-/// the first crossing pair; when none meet, containment decides.
+/// the first meeting pair; when none meet, containment decides.
 pub fn collide(a: &Placed, b: &Placed, all: bool) -> Collision {
     let none = Collision { contacts: Vec::new(), containment: Containment::None };
     if !a.bounds().overlaps(&b.bounds()) {
         return none;
     }
-    let settings = Settings { first_hit: !all, ..Settings::default() };
     let (ma, mb, ta, tb) = (a.mesh(), b.mesh(), a.tree(), b.tree());
-    let (contacts, _) = query::find_pairs(&ma, &ta, &mb, &tb, &settings);
+    let contacts = meeting_pairs(&ma, &ta, &mb, &tb, !all);
     if !contacts.is_empty() {
         return Collision { contacts, containment: Containment::None };
     }
@@ -653,11 +704,9 @@ pub fn distance(a: &Placed, b: &Placed, bound: f64) -> Option<Closest> {
     }
     let (ma, mb, ta, tb) = (a.mesh(), b.mesh(), a.tree(), b.tree());
     if a.bounds().overlaps(&b.bounds()) {
-        // Stops at the first crossing pair: the distance is 0 either way, the witness is a
+        // Stops at the first meeting pair: the distance is 0 either way, the witness is a
         // shared point of some meeting pair.
-        let settings = Settings { first_hit: true, ..Settings::default() };
-        let (contacts, _) = query::find_pairs(&ma, &ta, &mb, &tb, &settings);
-        if let Some(p) = contacts.first() {
+        if let Some(p) = meeting_pairs(&ma, &ta, &mb, &tb, true).first() {
             return Some(query::pair_witness(&ma, &mb, p));
         }
     }

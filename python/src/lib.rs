@@ -13,8 +13,8 @@ use pyo3::exceptions::{PyOSError, PyValueError};
 use pyo3::prelude::*;
 use rayon::prelude::*;
 use std::path::{Path, PathBuf};
-use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
-use std::sync::Arc;
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::{Arc, Mutex};
 
 /// A library error as the Python exception the API documents: OSError for files that cannot be
 /// read, ValueError for everything else; the message is the command line's line.
@@ -41,9 +41,12 @@ fn positions(label: &Path, v: &Bound<'_, PyAny>) -> PyResult<Vec<DVec3>> {
     if let Ok(a) = v.extract::<PyReadonlyArray2<'_, f64>>() {
         if shape_ok(a.shape()) {
             return Ok(match a.as_slice() {
-                // C-contiguous float64: read in place, one pass.
-                Ok(s) => s.chunks_exact(3).map(|c| DVec3::new(c[0], c[1], c[2])).collect(),
-                Err(_) => rows(a),
+                // C-contiguous float64: read in place, one pass (as_slice also accepts
+                // Fortran order, which is not row-major).
+                Ok(s) if a.is_c_contiguous() => {
+                    s.chunks_exact(3).map(|c| DVec3::new(c[0], c[1], c[2])).collect()
+                }
+                _ => rows(a),
             });
         }
     } else if let Ok(a) = v.extract::<PyReadonlyArray2<'_, f32>>() {
@@ -61,8 +64,9 @@ fn positions(label: &Path, v: &Bound<'_, PyAny>) -> PyResult<Vec<DVec3>> {
 fn triangles(label: &Path, f: &Bound<'_, PyAny>, vertices: usize) -> PyResult<Vec<[u32; 3]>> {
     fn flat<T: Copy + numpy::Element>(a: &PyReadonlyArray2<'_, T>) -> Vec<T> {
         match a.as_slice() {
-            Ok(s) => s.to_vec(),
-            Err(_) => a.as_array().iter().copied().collect(),
+            Ok(s) if a.is_c_contiguous() => s.to_vec(),
+            // Logical (row-major) order whatever the memory layout.
+            _ => a.as_array().iter().copied().collect(),
         }
     }
     let shape_ok = |shape: &[usize]| shape.len() == 2 && shape[1] == 3;
@@ -417,9 +421,18 @@ fn transform_of(t: Option<Vec<Vec<f64>>>) -> PyResult<DMat4> {
     transform("transform", t)
 }
 
-/// One colliding pair: (index in the first list, index in the second, contacts as
-/// (face, face, point, normal), containment name or None).
-type Hit = (usize, usize, Vec<(u32, u32, [f64; 3], [f64; 3])>, Option<&'static str>);
+/// One meeting triangle pair: (face, face, shared point, unit normal of the second face).
+type Contact = (u32, u32, [f64; 3], [f64; 3]);
+
+/// One colliding pair: (index in the first list, index in the second, contacts, containment
+/// name or None).
+type Hit = (usize, usize, Vec<Contact>, Option<&'static str>);
+
+/// A colliding pair by name: (name, name, contacts, containment name or None).
+type NamedHit = (String, String, Vec<Contact>, Option<&'static str>);
+
+/// A closest pair by name: (distance, name, name, face, face, point, point).
+type NamedNear = (f64, String, String, u32, u32, [f64; 3], [f64; 3]);
 
 fn hit(i: usize, j: usize, a: &Placed, b: &Placed, all: bool) -> Option<Hit> {
     let c = api::collide(a, b, all);
@@ -503,24 +516,32 @@ fn box_pairs(a: &[Arc<Placed>], b: Option<&[Arc<Placed>]>) -> Vec<(usize, usize)
 type Near = (f64, usize, usize, u32, u32, [f64; 3], [f64; 3]);
 
 fn nearest(pairs: Vec<(usize, usize)>, a: &[Arc<Placed>], b: &[Arc<Placed>]) -> Option<Near> {
+    let key = |x: &(f64, usize, usize), y: &(f64, usize, usize)| {
+        x.0.total_cmp(&y.0).then((x.1, x.2).cmp(&(y.1, y.2)))
+    };
     let mut by_bound: Vec<(f64, usize, usize)> =
         pairs.into_iter().map(|(i, j)| (a[i].bounds().distance_sq(&b[j].bounds()).sqrt(), i, j)).collect();
-    by_bound.sort_by(|x, y| x.0.total_cmp(&y.0).then((x.1, x.2).cmp(&(y.1, y.2))));
-    let best = AtomicU64::new(f64::INFINITY.to_bits());
+    by_bound.sort_by(key);
+    // The best (distance, i, j) so far: a pair can only beat it if its (lower bound, i, j)
+    // comes first, so the answer (smallest distance, then smallest (i, j)) does not depend on
+    // the order the threads finish in.
+    let best = Mutex::new((f64::INFINITY, usize::MAX, usize::MAX));
     let found: Vec<Near> = by_bound
         .par_iter()
         .filter_map(|&(lb, i, j)| {
-            let bound = f64::from_bits(best.load(Ordering::Relaxed));
-            if lb > bound {
+            let bound = *best.lock().unwrap();
+            if key(&(lb, i, j), &bound).is_gt() {
                 return None;
             }
-            let c = api::distance(&a[i], &b[j], bound)?;
-            // Non-negative f64s order as their bit patterns.
-            best.fetch_min(c.distance.to_bits(), Ordering::Relaxed);
+            let c = api::distance(&a[i], &b[j], bound.0)?;
+            let mut g = best.lock().unwrap();
+            if key(&(c.distance, i, j), &g).is_lt() {
+                *g = (c.distance, i, j);
+            }
             Some((c.distance, i, j, c.a.0, c.b.0, c.a.1.to_array(), c.b.1.to_array()))
         })
         .collect();
-    found.into_iter().min_by(|x, y| x.0.total_cmp(&y.0).then((x.1, x.2).cmp(&(y.1, y.2))))
+    found.into_iter().min_by(|x, y| key(&(x.0, x.1, x.2), &(y.0, y.1, y.2)))
 }
 
 /// The native collision manager (`meshclash.CollisionManager` wraps it with trimesh's
@@ -592,12 +613,7 @@ impl Manager {
     }
 
     /// Colliding pairs among the objects: (name, name, contacts, containment).
-    fn collide_internal(
-        &self,
-        py: Python<'_>,
-        all: bool,
-        stop_at_first: bool,
-    ) -> Vec<(String, String, Vec<(u32, u32, [f64; 3], [f64; 3])>, Option<&'static str>)> {
+    fn collide_internal(&self, py: Python<'_>, all: bool, stop_at_first: bool) -> Vec<NamedHit> {
         let objs = self.objs.clone();
         let hits = py.detach(move || collide_pairs(box_pairs(&objs, None), &objs, &objs, all, stop_at_first));
         hits.into_iter().map(|(i, j, c, k)| (self.names[i].clone(), self.names[j].clone(), c, k)).collect()
@@ -610,7 +626,7 @@ impl Manager {
         other: PyRef<'_, Manager>,
         all: bool,
         stop_at_first: bool,
-    ) -> Vec<(String, String, Vec<(u32, u32, [f64; 3], [f64; 3])>, Option<&'static str>)> {
+    ) -> Vec<NamedHit> {
         let (a, b) = (self.objs.clone(), other.objs.clone());
         let hits = py.detach(move || collide_pairs(box_pairs(&a, Some(&b)), &a, &b, all, stop_at_first));
         hits.into_iter().map(|(i, j, c, k)| (self.names[i].clone(), other.names[j].clone(), c, k)).collect()
@@ -626,7 +642,7 @@ impl Manager {
         transform: Option<Vec<Vec<f64>>>,
         all: bool,
         stop_at_first: bool,
-    ) -> PyResult<Vec<(String, Vec<(u32, u32, [f64; 3], [f64; 3])>, Option<&'static str>)>> {
+    ) -> PyResult<Vec<(String, Vec<Contact>, Option<&'static str>)>> {
         let single = vec![place(py, &mesh.inner, transform_of(transform)?)?];
         let a = self.objs.clone();
         let hits =
@@ -636,11 +652,7 @@ impl Manager {
 
     /// The closest pair among our objects (or between `name` and the others).
     #[pyo3(signature = (name=None))]
-    fn distance_internal(
-        &self,
-        py: Python<'_>,
-        name: Option<String>,
-    ) -> PyResult<Option<(f64, String, String, u32, u32, [f64; 3], [f64; 3])>> {
+    fn distance_internal(&self, py: Python<'_>, name: Option<String>) -> PyResult<Option<NamedNear>> {
         let objs = self.objs.clone();
         let pairs: Vec<(usize, usize)> = match &name {
             None => (0..objs.len()).flat_map(|i| (i + 1..objs.len()).map(move |j| (i, j))).collect(),
@@ -655,11 +667,7 @@ impl Manager {
         }))
     }
 
-    fn distance_other(
-        &self,
-        py: Python<'_>,
-        other: PyRef<'_, Manager>,
-    ) -> Option<(f64, String, String, u32, u32, [f64; 3], [f64; 3])> {
+    fn distance_other(&self, py: Python<'_>, other: PyRef<'_, Manager>) -> Option<NamedNear> {
         let (a, b) = (self.objs.clone(), other.objs.clone());
         let pairs: Vec<(usize, usize)> =
             (0..a.len()).flat_map(|i| (0..b.len()).map(move |j| (i, j))).collect();

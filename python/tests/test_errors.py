@@ -23,8 +23,8 @@ V, F = box()
         (V, F.astype(np.int16), "faces must be int32, int64 or uint32"),
         (V, np.zeros((0, 3), dtype=np.int64), "no triangles"),
         (np.zeros((0, 3)), F, "triangle 0 refers to vertex 0 but there are 0 vertices"),
-        (V, np.where(F == 7, 8, F), "triangle 2 refers to vertex 8 but there are 8 vertices"),
-        (V, np.where(F == 7, -1, F), "triangle 2 refers to vertex -1 but there are 8 vertices"),
+        (V, np.where(F == 7, 8, F), "triangle 3 refers to vertex 8 but there are 8 vertices"),
+        (V, np.where(F == 7, -1, F), "triangle 3 refers to vertex -1 but there are 8 vertices"),
         (V, np.where(F == 7, 2**40, F), "refers to vertex 1099511627776"),
         (V, np.where(F == 7, 2**32 - 1, F).astype(np.uint32), "refers to vertex 4294967295"),
         (np.where(V == 1.0, np.nan, V), F, r"vertex 1 has a non-finite coordinate \(NaN\)"),
@@ -53,18 +53,24 @@ def test_strided_and_non_contiguous_arrays_are_read_correctly():
 
 
 def test_array_errors_read_like_the_cli(tmp_path):
-    """The message after the input's name is the CLI's for the same mesh in a file."""
+    """The CLI's wording for the same mesh saved as OBJ; arrays number vertices and triangles
+    from 0 (as NumPy does) where the OBJ loader gives 1-based OBJ numbers and a line."""
     bad = np.where(V == 1.0, np.nan, V)
     p = write_obj(tmp_path / "bad.obj", bad, F, "a")
     _, _, err = run_cli(p, MESHES / "shared.STL", expect=(2,))
+    assert err.strip().endswith("vertex 2 has a non-finite coordinate (NaN)")
     with pytest.raises(ValueError) as e:
         meshclash.check((bad, F), (V, F))
-    assert str(e.value) == "<array a>: " + err.strip().split(": ", 1)[1]
+    assert str(e.value) == "<array a>: vertex 1 has a non-finite coordinate (NaN)"
     p = write_obj(tmp_path / "idx.obj", V, np.where(F == 7, 8, F), "a")
     _, _, err = run_cli(p, MESHES / "shared.STL", expect=(2,))
+    assert err.strip().endswith("refers to vertex 9 but there are 8 vertices")
     with pytest.raises(ValueError) as e:
         meshclash.check((V, np.where(F == 7, 8, F)), (V, F))
-    assert str(e.value) == "<array a>: " + err.strip().split(": ", 1)[1]
+    assert str(e.value) == "<array a>: triangle 3 refers to vertex 8 but there are 8 vertices"
+
+
+CLI_PREFIX = "meshclash: error: "
 
 
 def test_file_errors_are_the_cli_line(tmp_path):
@@ -72,13 +78,13 @@ def test_file_errors_are_the_cli_line(tmp_path):
     _, _, err = run_cli(missing, MESHES / "shared.STL", expect=(2,))
     with pytest.raises(OSError) as e:
         meshclash.check(missing, MESHES / "shared.STL")
-    assert str(e.value) == err.strip()
+    assert CLI_PREFIX + str(e.value) == err.strip()
     empty = tmp_path / "empty.stl"
     empty.write_bytes(b"")
     _, _, err = run_cli(empty, MESHES / "shared.STL", expect=(2,))
     with pytest.raises(ValueError) as e:
         meshclash.check(empty, MESHES / "shared.STL")
-    assert str(e.value) == err.strip()
+    assert CLI_PREFIX + str(e.value) == err.strip()
     with pytest.raises(OSError):
         meshclash.scene(tmp_path)  # a directory
     with pytest.raises(ValueError, match="matches no part"):

@@ -149,7 +149,7 @@ def test_mesh_collides_and_distance():
     assert a.distance(a, other_transform=moved(1.0))[0] == 0.0
     big = meshclash.Mesh(*box((-2, -2, -2), (3, 3, 3)), name="big")
     assert big.collides(a)  # containment
-    assert big.distance(a)[0] == 1.0
+    assert big.distance(a)[0] == 2.0
     assert (a.vertex_count, a.face_count, a.name) == (8, 12, "a")
     assert a.bounds.tolist() == [[0, 0, 0], [1, 1, 1]]
 

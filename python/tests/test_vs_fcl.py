@@ -165,3 +165,30 @@ def test_touching_and_one_ulp_cases_show_fcls_differences():
     print("\n".join(rows))
     assert "inside a larger L" in fcl_wrong  # containment: FCL's meshes are surfaces
     assert exact_collides(a, cases["faces touch (x = 2)"]) and not exact_collides(a, cases["1 ulp apart"])
+
+
+def test_tiny_gaps_fcl_reports_distance_zero():
+    """A tilted L and a copy moved along a face normal by 2 + gap: for gaps of 1e-12 to 1e-9,
+    FCL says 'no collision' yet 'distance 0'; meshclash's manager gives the exact check's
+    distance (about the gap) and its verdict."""
+    v, f = l_prism()
+    axis = np.array([1.0, 2.0, 3.0]) / np.linalg.norm([1.0, 2.0, 3.0])
+    r = trimesh.transformations.rotation_matrix(0.7, axis)[:3, :3]
+    a = trimesh.Trimesh(vertices=v @ r.T, faces=f, process=False)
+    normal = r @ np.array([1.0, 0.0, 0.0])
+    rows, fcl_zero = [], []
+    for gap in [1e-12, 1e-9, 1e-6, -1e-9]:
+        b = trimesh.Trimesh(vertices=v @ r.T + normal * (2.0 + gap), faces=f, process=False)
+        ours, theirs = both({"a": a})
+        exact = meshclash.check(a, b)
+        d, fd = ours.min_distance_single(b), theirs.min_distance_single(b)
+        assert d == exact["summary"]["min_distance"]
+        assert ours.in_collision_single(b) == (exact["verdict"] == "clash") == (gap < 0)
+        assert theirs.in_collision_single(b) == (gap < 0)  # FCL's verdicts agree here
+        if gap > 0:
+            assert abs(d - gap) < 1e-14 + 1e-6 * gap
+            if fd == 0.0:
+                fcl_zero.append(gap)
+        rows.append(f"gap {gap:8g}: meshclash d={d:.3g}, fcl d={fd:.3g}")
+    print("\n".join(rows))
+    assert 1e-9 in fcl_zero and 1e-12 in fcl_zero
