@@ -120,7 +120,7 @@ fn transform(flag: &str, t: Option<Vec<Vec<f64>>>) -> PyResult<DMat4> {
 
 /// One input of `check`: a path, a (vertices, faces) pair, or a prepared Mesh.
 enum In {
-    Source(Source),
+    Source(Box<Source>),
     Prepared(Arc<Prepared>),
 }
 
@@ -129,12 +129,12 @@ fn input(side: char, obj: &Bound<'_, PyAny>, t: DMat4, split: bool) -> PyResult<
         return Ok((In::Prepared(m.inner.clone()), t));
     }
     if let Ok(path) = obj.extract::<PathBuf>() {
-        return Ok((In::Source(api::file_source(&path, t, split).map_err(py_err)?), t));
+        return Ok((In::Source(Box::new(api::file_source(&path, t, split).map_err(py_err)?)), t));
     }
     if let Ok((v, f)) = obj.extract::<(Bound<'_, PyAny>, Bound<'_, PyAny>)>() {
         let label = PathBuf::from(format!("<array {side}>"));
         let mesh = mesh_from(&label, &side.to_string(), &v, &f)?;
-        return Ok((In::Source(api::array_source(&label, mesh, t, split).map_err(py_err)?), t));
+        return Ok((In::Source(Box::new(api::array_source(&label, mesh, t, split).map_err(py_err)?)), t));
     }
     Err(PyValueError::new_err(format!(
         "{side} must be a file path, a (vertices, faces) pair of arrays or a meshclash.Mesh"
@@ -406,7 +406,7 @@ impl Mesh {
         other: PyRef<'_, Mesh>,
         transform: Option<Vec<Vec<f64>>>,
         other_transform: Option<Vec<Vec<f64>>>,
-    ) -> PyResult<(f64, [f64; 3], [f64; 3], u32, u32)> {
+    ) -> PyResult<Witness> {
         let (ta, tb) = (transform_of(transform)?, transform_of(other_transform)?);
         let (a, b) = (self.inner.clone(), other.inner.clone());
         py.detach(move || -> meshclash::Result<_> {
@@ -430,6 +430,15 @@ type Hit = (usize, usize, Vec<Contact>, Option<&'static str>);
 
 /// A colliding pair by name: (name, name, contacts, containment name or None).
 type NamedHit = (String, String, Vec<Contact>, Option<&'static str>);
+
+/// Mesh.distance's answer: (distance, point on self, point on other, face, face).
+type Witness = (f64, [f64; 3], [f64; 3], u32, u32);
+
+/// A colliding object of the manager against a single mesh: (name, contacts, containment).
+type SingleHit = (String, Vec<Contact>, Option<&'static str>);
+
+/// The closest object to a single mesh: (distance, name, face, face, point, point).
+type SingleNear = (f64, String, u32, u32, [f64; 3], [f64; 3]);
 
 /// A closest pair by name: (distance, name, name, face, face, point, point).
 type NamedNear = (f64, String, String, u32, u32, [f64; 3], [f64; 3]);
@@ -485,6 +494,7 @@ fn collide_pairs(
 }
 
 /// Candidate pairs whose world boxes meet (closed boxes: touching boxes count).
+#[allow(clippy::needless_range_loop)]
 fn box_pairs(a: &[Arc<Placed>], b: Option<&[Arc<Placed>]>) -> Vec<(usize, usize)> {
     let mut out = Vec::new();
     match b {
@@ -642,7 +652,7 @@ impl Manager {
         transform: Option<Vec<Vec<f64>>>,
         all: bool,
         stop_at_first: bool,
-    ) -> PyResult<Vec<(String, Vec<Contact>, Option<&'static str>)>> {
+    ) -> PyResult<Vec<SingleHit>> {
         let single = vec![place(py, &mesh.inner, transform_of(transform)?)?];
         let a = self.objs.clone();
         let hits =
@@ -683,7 +693,7 @@ impl Manager {
         py: Python<'_>,
         mesh: PyRef<'_, Mesh>,
         transform: Option<Vec<Vec<f64>>>,
-    ) -> PyResult<Option<(f64, String, u32, u32, [f64; 3], [f64; 3])>> {
+    ) -> PyResult<Option<SingleNear>> {
         let single = vec![place(py, &mesh.inner, transform_of(transform)?)?];
         let a = self.objs.clone();
         let pairs: Vec<(usize, usize)> = (0..a.len()).map(|i| (i, 0)).collect();
