@@ -680,7 +680,8 @@ where
 }
 
 /// Exact collision test of two placed meshes: every meeting triangle pair (`all`), or stop at
-/// the first meeting pair; when none meet, containment decides.
+/// the first meeting pair; when none meet, containment decides (left at `None`, not decided,
+/// when no vertex of either mesh lies in the other's box: nothing can be contained then).
 pub fn collide(a: &Placed, b: &Placed, all: bool) -> Collision {
     let none = Collision { contacts: Vec::new(), containment: Containment::None };
     if !a.bounds().overlaps(&b.bounds()) {
@@ -690,6 +691,16 @@ pub fn collide(a: &Placed, b: &Placed, all: bool) -> Collision {
     let contacts = meeting_pairs(&ma, &ta, &mb, &tb, !all);
     if !contacts.is_empty() {
         return Collision { contacts, containment: Containment::None };
+    }
+    // Every vertex of a contained component lies in the other mesh's box: with no vertex of
+    // either mesh in the other's box, no containment is possible (exact test), and the
+    // topology and ray casts are skipped.
+    let any_inside = |p: &Placed, q: &Placed| {
+        let bq = q.bounds();
+        p.positions().iter().any(|v| bq.contains(&Aabb { min: *v, max: *v }))
+    };
+    if !any_inside(a, b) && !any_inside(b, a) {
+        return none;
     }
     let containment = containment::decide(&ma, &ta, a.topology(), &mb, &tb, b.topology());
     Collision { contacts, containment }
