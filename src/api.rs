@@ -640,6 +640,9 @@ where
     if !first {
         return query::find_pairs(a, ta, b, tb, &Settings::default()).0;
     }
+    if a.triangle_count() + b.triangle_count() <= SEQUENTIAL_FIRST_CONTACT {
+        return first_contact_sequential(a, ta, b, tb).into_iter().collect();
+    }
     let tol = Tolerances::default();
     let stop = AtomicBool::new(false);
     let mut found = crate::bvh::traverse::collect_pairs(
@@ -677,6 +680,74 @@ where
     );
     found.sort_unstable_by_key(|p| (p.a, p.b));
     found
+}
+
+/// Up to this many triangles in both meshes together, the first-contact search walks the two
+/// trees on one thread: a collision manager runs many small pairs at once, and splitting each
+/// into parallel sub-walks cost more than the walk itself (a speed threshold, no verdict
+/// depends on it).
+const SEQUENTIAL_FIRST_CONTACT: usize = 50_000;
+
+/// The first meeting triangle pair of a depth-first dual walk on this thread (descending the
+/// node with the larger box, as the parallel walks do).
+fn first_contact_sequential<A, TA, B, TB>(a: &A, ta: &TA, b: &B, tb: &TB) -> Option<PairFinding>
+where
+    A: TriMesh + ?Sized,
+    TA: Tree + ?Sized,
+    B: TriMesh + ?Sized,
+    TB: Tree + ?Sized,
+{
+    let tol = Tolerances::default();
+    let (na, nb) = (ta.nodes(), tb.nodes());
+    if na.is_empty() || nb.is_empty() {
+        return None;
+    }
+    let mut stack = vec![(0u32, 0u32, ta.node_box(0), tb.node_box(0))];
+    while let Some((i, j, bi, bj)) = stack.pop() {
+        if !tol.boxes_may_meet(&bi, &bj) {
+            continue;
+        }
+        let (x, y) = (&na[i as usize], &nb[j as usize]);
+        let open_a = match (x.is_leaf(), y.is_leaf()) {
+            (true, true) => {
+                for &s in ta.prims_of(x) {
+                    let ts = a.triangle(s);
+                    let bs = Aabb::of_triangle(&ts);
+                    for &t in tb.prims_of(y) {
+                        let tt = b.triangle(t);
+                        if !tol.boxes_may_meet(&bs, &Aabb::of_triangle(&tt)) {
+                            continue;
+                        }
+                        if let Some(h) = crate::narrow::tri_tri::classify(&ts, &tt) {
+                            let kind = if h.crossing { PairKind::Crossing } else { PairKind::Touching };
+                            return Some(PairFinding {
+                                a: s,
+                                b: t,
+                                kind,
+                                contact: Some(h.contact),
+                                distance: 0.0,
+                                segment: h.segment,
+                            });
+                        }
+                    }
+                }
+                continue;
+            }
+            (false, true) => true,
+            (true, false) => false,
+            (false, false) => bi.half_area() >= bj.half_area(),
+        };
+        if open_a {
+            for c in [x.a, i + 1] {
+                stack.push((c, j, ta.node_box(c), bj));
+            }
+        } else {
+            for c in [y.a, j + 1] {
+                stack.push((i, c, bi, tb.node_box(c)));
+            }
+        }
+    }
+    None
 }
 
 /// Exact collision test of two placed meshes: every meeting triangle pair (`all`), or stop at
