@@ -837,6 +837,13 @@ mod tests {
             let c = collide(&pa, &pb, true);
             assert_eq!(c.collides(), meets, "shift {shift}");
             assert_eq!(c.contacts, fresh.pairs);
+            // The first-contact searches (one thread for small pairs, parallel otherwise) find
+            // one of those pairs, or none.
+            let (ma, mb, ta, tb) = (pa.mesh(), pb.mesh(), pa.tree(), pb.tree());
+            let seq = first_contact_sequential(&ma, &ta, &mb, &tb);
+            assert_eq!(seq.is_some(), meets);
+            assert!(seq.is_none_or(|p| fresh.pairs.contains(&p)));
+            assert_eq!(collide(&pa, &pb, false).collides(), meets);
             let d = distance(&pa, &pb, f64::INFINITY).unwrap();
             assert_eq!(d.distance, fresh.closest.unwrap().distance);
         }
