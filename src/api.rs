@@ -5,7 +5,7 @@
 //!
 //! [`report`] goes the same way as the command line (load, place, [`crate::check::assembly::run`],
 //! [`crate::report::build`], finding ids), so the same inputs and settings give the same document
-//! (the Python tests compare them byte for byte with the binary's `--no-timings` output).
+//! (the Python tests compare them, parsed, with the binary's `--no-timings` output).
 //!
 //! A placed mesh ([`Placed`]) reads its own world coordinates — every vertex transformed in f64,
 //! exactly as `--transform` does — and walks the prepared tree through a conservative box map
