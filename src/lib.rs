@@ -16,6 +16,7 @@
 //! and GLB. The library never prints.
 #![deny(missing_docs)]
 
+pub mod api;
 pub mod bvh;
 pub mod check;
 pub mod clash_set;

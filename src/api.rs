@@ -1,0 +1,875 @@
+//! Entry points for embedding meshclash in another program (the Python package in `python/`
+//! uses nothing else): the JSON report for two inputs that are files or in-memory meshes, and
+//! *prepared* meshes — a mesh whose tree is built once, then placed under any number of affine
+//! transforms for the yes/no and distance queries a collision manager makes.
+//!
+//! [`report`] goes the same way as the command line (load, place, [`crate::check::assembly::run`],
+//! [`crate::report::build`], finding ids), so the same inputs and settings give the same document
+//! (the Python tests compare them, parsed, with the binary's `--no-timings` output).
+//!
+//! A placed mesh ([`Placed`]) reads its own world coordinates — every vertex transformed in f64,
+//! exactly as `--transform` does — and walks the prepared tree through a conservative box map
+//! ([`BoxMap`], the one instances of a glTF mesh share trees with), so every verdict and distance
+//! is exactly what a tree built on the world coordinates would give; only the tree statistics
+//! differ (they describe the prepared tree).
+
+use crate::bvh::traverse::Tree;
+use crate::bvh::{BuildOptions, Bvh, Node};
+use crate::check::assembly::{self, PartPairSummary, Selection};
+use crate::check::containment::{self, Containment, Topology};
+use crate::check::query::{
+    self, Closest, DistanceError, Input, InputSpec, Mode, PairFinding, PairKind, Settings, Verdict,
+};
+use crate::error::{Error, Result};
+use crate::geom::predicates::{self, BoxMap, Tolerances};
+use crate::geom::{Aabb, DVec3};
+use crate::load::Format;
+use crate::report::{self, Report, SettingsReport};
+use crate::scene::mesh::{Loaded, Mesh, Object, TriMesh};
+use glam::DMat4;
+use std::path::{Path, PathBuf};
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::{Arc, OnceLock};
+use std::time::Instant;
+
+/// The `format` an in-memory input has in the report.
+pub const ARRAY_FORMAT: &str = "array";
+
+/// A tolerance as given: absolute, or relative to the diagonal of the box around both inputs
+/// (the command line's `1e-6rel`).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Tolerance {
+    /// Model units.
+    Abs(f64),
+    /// Times the diagonal of the box around both inputs.
+    Rel(f64),
+}
+
+impl Tolerance {
+    /// Parse `0.5` or `1e-6rel` (finite, >= 0); the error names `flag` as the command line does.
+    pub fn parse(flag: &str, s: &str) -> Result<Tolerance> {
+        let t = s.trim();
+        let (num, rel) = match t.strip_suffix("rel") {
+            Some(n) => (n, true),
+            None => (t, false),
+        };
+        match num.trim().parse::<f64>() {
+            Ok(v) if v.is_finite() && v >= 0.0 => Ok(if rel { Tolerance::Rel(v) } else { Tolerance::Abs(v) }),
+            _ => Err(Error::Usage(format!(
+                "--{flag} must be a finite number >= 0, optionally with a 'rel' suffix (e.g. 0.01 or 1e-6rel), got '{s}'"
+            ))),
+        }
+    }
+
+    fn resolve(self, size: f64) -> f64 {
+        match self {
+            Tolerance::Abs(v) => v,
+            Tolerance::Rel(r) => r * size,
+        }
+    }
+
+    fn spec(self) -> String {
+        match self {
+            Tolerance::Abs(v) => format!("{v}"),
+            Tolerance::Rel(r) => format!("{r}rel"),
+        }
+    }
+}
+
+/// What to check and how: the command line's flags that shape the report.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Options {
+    /// `--touch-tolerance`.
+    pub touch: Tolerance,
+    /// `--clearance`.
+    pub clearance: Tolerance,
+    /// `--max-pairs`.
+    pub max_pairs: usize,
+    /// `--mode`.
+    pub mode: Mode,
+    /// `--first-hit`.
+    pub first_hit: bool,
+    /// `--bvh`, `--leaf-size`.
+    pub bvh: BuildOptions,
+    /// `--distance-rel-err`, `--distance-abs-err`.
+    pub distance_error: DistanceError,
+    /// `--no-timings`: no timings and no thread count in the report.
+    pub deterministic: bool,
+    /// `--penetration`.
+    pub penetration: bool,
+    /// Scene mode and part selections (`scene`, `--select-a/-b`, `--exclude`).
+    pub selection: Selection,
+    /// `--split-bodies`.
+    pub split_bodies: bool,
+    /// `--threads` (0 = the current pool, or one per core).
+    pub threads: usize,
+}
+
+impl Default for Options {
+    fn default() -> Self {
+        Options {
+            touch: Tolerance::Abs(0.0),
+            clearance: Tolerance::Abs(0.0),
+            max_pairs: 1000,
+            mode: Mode::Exact,
+            first_hit: false,
+            bvh: BuildOptions::default(),
+            distance_error: DistanceError::default(),
+            deterministic: false,
+            penetration: false,
+            selection: Selection::default(),
+            split_bodies: false,
+            threads: 0,
+        }
+    }
+}
+
+impl Options {
+    /// Reject what the command line rejects (leaf size, distance allowances).
+    pub fn validate(&self) -> Result<()> {
+        if !(1..=64).contains(&self.bvh.leaf_size) {
+            return Err(Error::Usage(format!("--leaf-size must be 1..=64, got {}", self.bvh.leaf_size)));
+        }
+        for (flag, v) in
+            [("distance-rel-err", self.distance_error.rel), ("distance-abs-err", self.distance_error.abs)]
+        {
+            if !(v.is_finite() && v >= 0.0) {
+                return Err(Error::Usage(format!("--{flag} must be a finite number >= 0, got {v}")));
+            }
+        }
+        Ok(())
+    }
+}
+
+/// One input of a report: a loaded file, or a mesh handed over in memory (reported with
+/// [`ARRAY_FORMAT`] and its label as the path).
+#[derive(Debug, Clone)]
+pub struct Source {
+    /// The placed input.
+    pub input: Input,
+    /// The transform applied.
+    pub transform: DMat4,
+    /// True for an in-memory mesh.
+    pub array: bool,
+}
+
+/// Load a file and place it, as the command line does for `A`/`B` (with `--split-bodies` when
+/// `split_bodies`).
+pub fn file_source(path: &Path, transform: DMat4, split_bodies: bool) -> Result<Source> {
+    let mut input = query::load_input(&InputSpec { path: path.to_path_buf(), transform })?;
+    if split_bodies {
+        crate::scene::bodies::split_bodies(&mut input.mesh);
+    }
+    Ok(Source { input, transform, array: false })
+}
+
+/// Place an in-memory mesh (from [`mesh_from_arrays`]); `label` stands for its path in the report
+/// and in error messages.
+pub fn array_source(label: &Path, mesh: Mesh, transform: DMat4, split_bodies: bool) -> Result<Source> {
+    let spec = InputSpec { path: label.to_path_buf(), transform };
+    let mut input =
+        query::prepare_input(&spec, Loaded { mesh, warnings: Vec::new() }, Format::Obj, 1.0, None)?;
+    if split_bodies {
+        crate::scene::bodies::split_bodies(&mut input.mesh);
+    }
+    Ok(Source { input, transform, array: true })
+}
+
+/// Triangle indices from a flat list of any integer type (three per triangle), with the
+/// loaders' message for an index out of range (`label` names the input).
+pub fn triangles_from<I>(label: &Path, flat: &[I], vertices: usize) -> Result<Vec<[u32; 3]>>
+where
+    I: Copy + TryInto<u32> + std::fmt::Display,
+{
+    let bad = |t: usize, v: I| {
+        Error::input(label, format!("triangle {t} refers to vertex {v} but there are {vertices} vertices"))
+    };
+    flat.chunks_exact(3)
+        .enumerate()
+        .map(|(t, c)| {
+            let mut out = [0u32; 3];
+            for k in 0..3 {
+                let v: u32 = c[k].try_into().map_err(|_| bad(t, c[k]))?;
+                if v as usize >= vertices {
+                    return Err(bad(t, c[k]));
+                }
+                out[k] = v;
+            }
+            Ok(out)
+        })
+        .collect()
+}
+
+/// A mesh of one object named `name` from vertex positions and triangles, validated as the
+/// loaders validate a file: at least one triangle, indices in range, finite coordinates.
+pub fn mesh_from_arrays(
+    label: &Path,
+    name: &str,
+    positions: Vec<DVec3>,
+    triangles: Vec<[u32; 3]>,
+) -> Result<Mesh> {
+    if triangles.is_empty() {
+        return Err(Error::input(label, "no triangles"));
+    }
+    let n = positions.len();
+    for (t, tri) in triangles.iter().enumerate() {
+        if let Some(&v) = tri.iter().find(|&&v| v as usize >= n) {
+            return Err(Error::input(
+                label,
+                format!("triangle {t} refers to vertex {v} but there are {n} vertices"),
+            ));
+        }
+    }
+    for (i, p) in positions.iter().enumerate() {
+        if let Some(c) = p.to_array().into_iter().find(|c| !c.is_finite()) {
+            let bad = if c.is_nan() {
+                "NaN"
+            } else if c > 0.0 {
+                "inf"
+            } else {
+                "-inf"
+            };
+            return Err(Error::input(label, format!("vertex {i} has a non-finite coordinate ({bad})")));
+        }
+    }
+    let name = if name.is_empty() { "object0" } else { name };
+    Ok(Mesh {
+        positions,
+        tri_object: vec![0; triangles.len()],
+        triangles,
+        objects: vec![Object { name: name.to_string(), ..Object::default() }],
+    })
+}
+
+/// Run `f` in a pool of `threads` workers (0 = the current pool), giving it the pool's size.
+pub fn in_pool<T: Send>(threads: usize, f: impl FnOnce(usize) -> Result<T> + Send) -> Result<T> {
+    if threads == 0 {
+        return f(rayon::current_num_threads());
+    }
+    let pool = rayon::ThreadPoolBuilder::new()
+        .num_threads(threads)
+        .build()
+        .map_err(|e| Error::Usage(format!("--threads: {e}")))?;
+    pool.install(|| f(pool.current_num_threads()))
+}
+
+/// The report for `a` against `b` (`b` = None: scene mode, `a`'s parts against each other; set
+/// `opts.selection.scene`), as the command line writes it for the same inputs and flags.
+pub fn report(a: &Source, b: Option<&Source>, opts: &Options) -> Result<Report> {
+    opts.validate()?;
+    in_pool(opts.threads, |threads| {
+        let t0 = Instant::now();
+        let bs = b.unwrap_or(a);
+        let outcome_of = |settings: &Settings| {
+            assembly::run(&a.input.mesh, &bs.input.mesh, &opts.selection, settings)
+                .map_err(|e| Error::input(&bs.input.path, e))
+        };
+        finish_report(a, bs, opts, threads, t0, outcome_of)
+    })
+}
+
+/// The settings with the tolerances resolved for two inputs.
+fn resolved_settings(a: &Mesh, b: &Mesh, opts: &Options) -> Result<(Settings, f64)> {
+    let size = Aabb::of_points(&a.positions).union(Aabb::of_points(&b.positions)).extent().length();
+    let tolerances = Tolerances { touch: opts.touch.resolve(size), clearance: opts.clearance.resolve(size) };
+    if !tolerances.touch.is_finite() || !tolerances.clearance.is_finite() {
+        return Err(Error::Usage("relative tolerance overflows for this model size".into()));
+    }
+    let settings = Settings {
+        tolerances,
+        bvh: opts.bvh,
+        mode: opts.mode,
+        first_hit: opts.first_hit,
+        distance_error: opts.distance_error,
+    };
+    Ok((settings, size))
+}
+
+fn finish_report(
+    a: &Source,
+    b: &Source,
+    opts: &Options,
+    threads: usize,
+    t0: Instant,
+    outcome_of: impl FnOnce(&Settings) -> Result<assembly::Outcome>,
+) -> Result<Report> {
+    let (settings, size) = resolved_settings(&a.input.mesh, &b.input.mesh, opts)?;
+    let load_ms = t0.elapsed().as_secs_f64() * 1e3;
+    let outcome = outcome_of(&settings)?;
+    let assembly_view = report::assembly_view(&outcome, opts.max_pairs);
+    let result = outcome.result;
+    let ctx = report::Context {
+        inputs: [&a.input, &b.input],
+        transforms: [a.transform, b.transform],
+        settings: SettingsReport {
+            touch_tolerance: settings.tolerances.touch,
+            clearance: settings.tolerances.clearance,
+            touch_tolerance_given: opts.touch.spec(),
+            clearance_given: opts.clearance.spec(),
+            model_size: size,
+            units: "model".into(),
+            fail_on: query::FailOn::Clash.name().into(),
+            bvh: opts.bvh.strategy.name().into(),
+            mode: opts.mode.name().into(),
+            first_hit: opts.first_hit,
+            penetration: opts.penetration,
+            distance_rel_err: opts.distance_error.rel,
+            distance_abs_err: opts.distance_error.abs,
+            leaf_size: opts.bvh.leaf_size,
+            max_pairs: opts.max_pairs,
+            threads: (!opts.deterministic).then_some(threads),
+        },
+        failed: query::FailOn::Clash.fails(result.verdict),
+        times: (!opts.deterministic).then(|| (load_ms, t0.elapsed().as_secs_f64() * 1e3)),
+        cross_check: None,
+        assembly: assembly_view,
+    };
+    let mut rep = report::build(&ctx, &result);
+    let findings = report::baseline::findings(&result.pairs, &a.input.mesh, &b.input.mesh);
+    report::baseline::assign_ids(&mut rep, &findings);
+    if a.array {
+        rep.inputs.a.format = ARRAY_FORMAT.into();
+    }
+    if b.array {
+        rep.inputs.b.format = ARRAY_FORMAT.into();
+    }
+    Ok(rep)
+}
+
+/// A mesh with its tree built once, to be placed under many transforms ([`Prepared::place`]).
+#[derive(Debug)]
+pub struct Prepared {
+    /// The mesh in its own coordinates.
+    pub mesh: Mesh,
+    /// Its tree.
+    pub tree: Bvh,
+    /// Its name in error messages and reports.
+    pub label: PathBuf,
+}
+
+impl Prepared {
+    /// Build the tree of `mesh` (validated by [`mesh_from_arrays`] or a loader).
+    pub fn new(label: &Path, mesh: Mesh, opts: BuildOptions) -> Result<Prepared> {
+        query::check_range(&mesh, label)?;
+        let tree = Bvh::build(&mesh, opts);
+        Ok(Prepared { mesh, tree, label: label.to_path_buf() })
+    }
+
+    /// Place the mesh: every vertex transformed in f64 (as `--transform` does; identity keeps
+    /// the coordinates as they are), the tree mapped onto the result conservatively.
+    pub fn place(self: &Arc<Self>, m: DMat4) -> Result<Placed> {
+        let local = &self.mesh.positions;
+        if m == DMat4::IDENTITY {
+            let root = Aabb::of_points(local);
+            return Ok(Placed {
+                prepared: self.clone(),
+                transform: m,
+                world: None,
+                tree: Mapping::Own,
+                root,
+                topology: OnceLock::new(),
+            });
+        }
+        let mut world = Vec::with_capacity(local.len());
+        for (i, p) in local.iter().enumerate() {
+            let w = m.transform_point3(*p);
+            if !w.is_finite() {
+                return Err(Error::input(
+                    &self.label,
+                    format!("vertex {i} is not finite after the transform"),
+                ));
+            }
+            if w.abs().max_element() > predicates::MAX_EXACT_MAGNITUDE {
+                return Err(Error::input(
+                    &self.label,
+                    format!("vertex {i} has a coordinate beyond ±2^250 (about 1.8e75) after the transform, where verdicts stop being exact"),
+                ));
+            }
+            world.push(w);
+        }
+        let rows = [0, 1, 2].map(|k| [m.x_axis[k], m.y_axis[k], m.z_axis[k], m.w_axis[k]]);
+        let tree =
+            match BoxMap::fit(rows, &self.tree.bounds(), local.iter().copied().zip(world.iter().copied())) {
+                Some(map) => Mapping::Mapped(map),
+                None => Mapping::Refit(refit(&self.tree, &world, &self.mesh.triangles)),
+            };
+        let root = Aabb::of_points(&world);
+        Ok(Placed {
+            prepared: self.clone(),
+            transform: m,
+            world: Some(world),
+            tree,
+            root,
+            topology: OnceLock::new(),
+        })
+    }
+}
+
+/// How a placed mesh sees the prepared tree.
+#[derive(Debug)]
+enum Mapping {
+    /// Identity placement: the tree as built.
+    Own,
+    /// Boxes mapped by the placement (conservatively widened).
+    Mapped(BoxMap),
+    /// The fallback when no box map fits: same topology, exact boxes.
+    Refit(Bvh),
+}
+
+fn refit(template: &Bvh, world: &[DVec3], tris: &[[u32; 3]]) -> Bvh {
+    let mut nodes: Vec<Node> = template.nodes.clone();
+    for i in (0..nodes.len()).rev() {
+        let n = nodes[i];
+        nodes[i].bounds = if n.is_leaf() {
+            template.leaf_prims(&n).iter().fold(Aabb::EMPTY, |b, &t| {
+                b.union(Aabb::of_triangle(&tris[t as usize].map(|v| world[v as usize])))
+            })
+        } else {
+            nodes[i + 1].bounds.union(nodes[n.a as usize].bounds)
+        };
+    }
+    Bvh { nodes, prims: template.prims.clone() }
+}
+
+/// A prepared mesh under one placement: its world coordinates and a view of the prepared tree.
+#[derive(Debug)]
+pub struct Placed {
+    /// The prepared mesh.
+    pub prepared: Arc<Prepared>,
+    /// The placement.
+    pub transform: DMat4,
+    world: Option<Vec<DVec3>>,
+    tree: Mapping,
+    root: Aabb,
+    topology: OnceLock<Topology>,
+}
+
+/// A placed mesh as the checks read it (world coordinates; nothing copied).
+#[derive(Debug, Clone, Copy)]
+pub struct PlacedMesh<'a> {
+    positions: &'a [DVec3],
+    triangles: &'a [[u32; 3]],
+}
+
+impl TriMesh for PlacedMesh<'_> {
+    #[inline]
+    fn vertex_count(&self) -> usize {
+        self.positions.len()
+    }
+    #[inline]
+    fn vertex(&self, v: u32) -> DVec3 {
+        self.positions[v as usize]
+    }
+    #[inline]
+    fn triangle_count(&self) -> usize {
+        self.triangles.len()
+    }
+    #[inline]
+    fn indices(&self, t: u32) -> [u32; 3] {
+        self.triangles[t as usize]
+    }
+    fn positions(&self) -> std::borrow::Cow<'_, [DVec3]> {
+        std::borrow::Cow::Borrowed(self.positions)
+    }
+}
+
+/// A placed mesh's tree as the walks see it: node boxes in world coordinates (the root box is
+/// the exact world box).
+#[derive(Debug, Clone, Copy)]
+pub struct PlacedTree<'a> {
+    bvh: &'a Bvh,
+    map: Option<&'a BoxMap>,
+    root: Aabb,
+}
+
+impl Tree for PlacedTree<'_> {
+    #[inline]
+    fn nodes(&self) -> &[Node] {
+        &self.bvh.nodes
+    }
+    #[inline]
+    fn node_box(&self, i: u32) -> Aabb {
+        match (self.map, i) {
+            (_, 0) => self.root,
+            (None, _) => self.bvh.nodes[i as usize].bounds,
+            (Some(m), _) => m.map_box(&self.bvh.nodes[i as usize].bounds),
+        }
+    }
+    #[inline]
+    fn prims_of(&self, n: &Node) -> &[u32] {
+        self.bvh.leaf_prims(n)
+    }
+    fn stats(&self) -> crate::bvh::Stats {
+        self.bvh.stats()
+    }
+}
+
+impl Placed {
+    /// The world coordinates.
+    pub fn positions(&self) -> &[DVec3] {
+        self.world.as_deref().unwrap_or(&self.prepared.mesh.positions)
+    }
+
+    /// The mesh view.
+    pub fn mesh(&self) -> PlacedMesh<'_> {
+        PlacedMesh { positions: self.positions(), triangles: &self.prepared.mesh.triangles }
+    }
+
+    /// The tree view.
+    pub fn tree(&self) -> PlacedTree<'_> {
+        let (bvh, map) = match &self.tree {
+            Mapping::Own => (&self.prepared.tree, None),
+            Mapping::Mapped(m) => (&self.prepared.tree, Some(m)),
+            Mapping::Refit(t) => (t, None),
+        };
+        PlacedTree { bvh, map, root: self.root }
+    }
+
+    /// The exact world box.
+    pub fn bounds(&self) -> Aabb {
+        self.root
+    }
+
+    fn topology(&self) -> &Topology {
+        self.topology.get_or_init(|| containment::topology(&self.mesh()))
+    }
+
+    /// A copy as a report input, with `label` as its path.
+    fn source(&self) -> Source {
+        let mut mesh = self.prepared.mesh.clone();
+        mesh.positions = self.positions().to_vec();
+        let input =
+            Input { path: self.prepared.label.clone(), format: Format::Obj, mesh, warnings: Vec::new() };
+        Source { input, transform: self.transform, array: true }
+    }
+}
+
+/// The report for two placed meshes, as [`report`] gives for the same world coordinates
+/// (files mode), except that `bvh` describes the prepared trees and `timings_ms.build` is 0.
+pub fn report_placed(a: &Placed, b: &Placed, opts: &Options) -> Result<Report> {
+    opts.validate()?;
+    if opts.selection.by_parts() || opts.split_bodies {
+        return Err(Error::Usage(
+            "prepared meshes are checked whole: selections, scene mode and --split-bodies need arrays or files".into(),
+        ));
+    }
+    in_pool(opts.threads, |threads| {
+        let t0 = Instant::now();
+        let (sa, sb) = (a.source(), b.source());
+        let outcome_of = |settings: &Settings| {
+            let r = query::check_built(&a.mesh(), &a.tree(), &b.mesh(), &b.tree(), settings);
+            let mut parts = assembly::parts_of(&sa.input.mesh, 0);
+            parts.extend(assembly::parts_of(&sb.input.mesh, 1));
+            let part_pairs = group_by_part(&parts, &sa.input.mesh, &sb.input.mesh, &r);
+            let info = assembly::AssemblyInfo {
+                mode: "files",
+                selected: [1, 1],
+                candidate_part_pairs: part_pairs.len(),
+                built_parts: None,
+                sah_builds: None,
+                sharing: None,
+            };
+            Ok(assembly::Outcome { result: r, parts, part_pairs, info })
+        };
+        finish_report(&sa, &sb, opts, threads, t0, outcome_of)
+    })
+}
+
+/// Files mode: the pairs of a whole check grouped by the parts they fall in (as
+/// [`assembly::run`] groups them).
+fn group_by_part(
+    parts: &[assembly::Part],
+    a: &Mesh,
+    b: &Mesh,
+    r: &query::ClashResult,
+) -> Vec<PartPairSummary> {
+    let index: std::collections::HashMap<(u8, u32), usize> =
+        parts.iter().enumerate().map(|(i, p)| ((p.input, p.object), i)).collect();
+    let mut by: std::collections::BTreeMap<(usize, usize), PartPairSummary> = Default::default();
+    for p in &r.pairs {
+        let pa = index[&(0, a.tri_object[p.a as usize])];
+        let pb = index[&(1, b.tri_object[p.b as usize])];
+        let e = by.entry((pa, pb)).or_insert_with(|| PartPairSummary {
+            a: pa,
+            b: pb,
+            verdict: Verdict::Clear,
+            counts: Default::default(),
+            min_distance: None,
+            containment: Containment::None,
+            closest: None,
+            pairs: Vec::new(),
+        });
+        let v = e.counts.record(p);
+        e.verdict = e.verdict.max(v);
+        e.pairs.push((p.a, p.b));
+        if e.closest.is_none_or(|c| p.distance < c.distance) {
+            e.closest = Some(query::pair_witness(a, b, p));
+        }
+        e.min_distance = e.closest.map(|c| c.distance);
+    }
+    by.into_values().collect()
+}
+
+/// What [`collide`] finds between two placed meshes.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Collision {
+    /// Triangle pairs that meet (crossing or touching exactly), sorted; with `all` false, at
+    /// least one when they meet (the first crossing pair found stops the walk).
+    pub contacts: Vec<PairFinding>,
+    /// Containment, decided when no triangles meet.
+    pub containment: Containment,
+}
+
+impl Collision {
+    /// Do the two meshes collide: triangles meet (crossing or touching), or one lies inside the
+    /// other (containment, including the partial kinds and face-to-face volume overlap).
+    pub fn collides(&self) -> bool {
+        !self.contacts.is_empty() || self.containment.is_clash()
+    }
+}
+
+/// Every triangle pair of `a` and `b` that meets exactly (crossing or touching), sorted; with
+/// `first`, the walk stops at the first one found (which one depends on timing).
+pub fn meeting_pairs<A, TA, B, TB>(a: &A, ta: &TA, b: &B, tb: &TB, first: bool) -> Vec<PairFinding>
+where
+    A: TriMesh + ?Sized,
+    TA: Tree + ?Sized,
+    B: TriMesh + ?Sized,
+    TB: Tree + ?Sized,
+{
+    if !first {
+        return query::find_pairs(a, ta, b, tb, &Settings::default()).0;
+    }
+    if a.triangle_count() + b.triangle_count() <= SEQUENTIAL_FIRST_CONTACT {
+        return first_contact_sequential(a, ta, b, tb).into_iter().collect();
+    }
+    let tol = Tolerances::default();
+    let stop = AtomicBool::new(false);
+    let mut found = crate::bvh::traverse::collect_pairs(
+        ta,
+        tb,
+        |x, y| !stop.load(Ordering::Relaxed) && tol.boxes_may_meet(x, y),
+        |la, lb, out| {
+            for &i in la {
+                let ti = a.triangle(i);
+                let bi = Aabb::of_triangle(&ti);
+                for &j in lb {
+                    if stop.load(Ordering::Relaxed) {
+                        return;
+                    }
+                    let tj = b.triangle(j);
+                    if !tol.boxes_may_meet(&bi, &Aabb::of_triangle(&tj)) {
+                        continue;
+                    }
+                    if let Some(h) = crate::narrow::tri_tri::classify(&ti, &tj) {
+                        let kind = if h.crossing { PairKind::Crossing } else { PairKind::Touching };
+                        out.push(PairFinding {
+                            a: i,
+                            b: j,
+                            kind,
+                            contact: Some(h.contact),
+                            distance: 0.0,
+                            segment: h.segment,
+                        });
+                        stop.store(true, Ordering::Relaxed);
+                        return;
+                    }
+                }
+            }
+        },
+    );
+    found.sort_unstable_by_key(|p| (p.a, p.b));
+    found
+}
+
+/// Up to this many triangles in both meshes together, the first-contact search walks the two
+/// trees on one thread: a collision manager runs many small pairs at once, and splitting each
+/// into parallel sub-walks cost more than the walk itself (a speed threshold, no verdict
+/// depends on it).
+const SEQUENTIAL_FIRST_CONTACT: usize = 50_000;
+
+/// The first meeting triangle pair of a depth-first dual walk on this thread (descending the
+/// node with the larger box, as the parallel walks do).
+fn first_contact_sequential<A, TA, B, TB>(a: &A, ta: &TA, b: &B, tb: &TB) -> Option<PairFinding>
+where
+    A: TriMesh + ?Sized,
+    TA: Tree + ?Sized,
+    B: TriMesh + ?Sized,
+    TB: Tree + ?Sized,
+{
+    let tol = Tolerances::default();
+    let (na, nb) = (ta.nodes(), tb.nodes());
+    if na.is_empty() || nb.is_empty() {
+        return None;
+    }
+    let mut stack = vec![(0u32, 0u32, ta.node_box(0), tb.node_box(0))];
+    while let Some((i, j, bi, bj)) = stack.pop() {
+        if !tol.boxes_may_meet(&bi, &bj) {
+            continue;
+        }
+        let (x, y) = (&na[i as usize], &nb[j as usize]);
+        let open_a = match (x.is_leaf(), y.is_leaf()) {
+            (true, true) => {
+                for &s in ta.prims_of(x) {
+                    let ts = a.triangle(s);
+                    let bs = Aabb::of_triangle(&ts);
+                    for &t in tb.prims_of(y) {
+                        let tt = b.triangle(t);
+                        if !tol.boxes_may_meet(&bs, &Aabb::of_triangle(&tt)) {
+                            continue;
+                        }
+                        if let Some(h) = crate::narrow::tri_tri::classify(&ts, &tt) {
+                            let kind = if h.crossing { PairKind::Crossing } else { PairKind::Touching };
+                            return Some(PairFinding {
+                                a: s,
+                                b: t,
+                                kind,
+                                contact: Some(h.contact),
+                                distance: 0.0,
+                                segment: h.segment,
+                            });
+                        }
+                    }
+                }
+                continue;
+            }
+            (false, true) => true,
+            (true, false) => false,
+            (false, false) => bi.half_area() >= bj.half_area(),
+        };
+        if open_a {
+            for c in [x.a, i + 1] {
+                stack.push((c, j, ta.node_box(c), bj));
+            }
+        } else {
+            for c in [y.a, j + 1] {
+                stack.push((i, c, bi, tb.node_box(c)));
+            }
+        }
+    }
+    None
+}
+
+/// Exact collision test of two placed meshes: every meeting triangle pair (`all`), or stop at
+/// the first meeting pair; when none meet, containment decides (left at `None`, not decided,
+/// when no vertex of either mesh lies in the other's box: nothing can be contained then).
+pub fn collide(a: &Placed, b: &Placed, all: bool) -> Collision {
+    let none = Collision { contacts: Vec::new(), containment: Containment::None };
+    if !a.bounds().overlaps(&b.bounds()) {
+        return none;
+    }
+    let (ma, mb, ta, tb) = (a.mesh(), b.mesh(), a.tree(), b.tree());
+    let contacts = meeting_pairs(&ma, &ta, &mb, &tb, !all);
+    if !contacts.is_empty() {
+        return Collision { contacts, containment: Containment::None };
+    }
+    // Every vertex of a contained component lies in the other mesh's box: with no vertex of
+    // either mesh in the other's box, no containment is possible (exact test), and the
+    // topology and ray casts are skipped.
+    let any_inside = |p: &Placed, q: &Placed| {
+        let bq = q.bounds();
+        p.positions().iter().any(|v| bq.contains(&Aabb { min: *v, max: *v }))
+    };
+    if !any_inside(a, b) && !any_inside(b, a) {
+        return none;
+    }
+    let containment = containment::decide(&ma, &ta, a.topology(), &mb, &tb, b.topology());
+    Collision { contacts, containment }
+}
+
+/// The minimum distance between two placed meshes (their surfaces) with a closest pair of
+/// points: 0 at a shared point when triangles meet; `None` beyond `bound` (pass infinity for
+/// no bound).
+pub fn distance(a: &Placed, b: &Placed, bound: f64) -> Option<Closest> {
+    if a.bounds().distance_sq(&b.bounds()).sqrt() > bound {
+        return None;
+    }
+    let (ma, mb, ta, tb) = (a.mesh(), b.mesh(), a.tree(), b.tree());
+    if a.bounds().overlaps(&b.bounds()) {
+        // Stops at the first meeting pair: the distance is 0 either way, the witness is a
+        // shared point of some meeting pair.
+        if let Some(p) = meeting_pairs(&ma, &ta, &mb, &tb, true).first() {
+            return Some(query::pair_witness(&ma, &mb, p));
+        }
+    }
+    query::closest_pair(&ma, &ta, &mb, &tb, DistanceError::default()).filter(|c| c.distance <= bound)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn cube(at: DVec3) -> Mesh {
+        let v: Vec<DVec3> = (0..8)
+            .map(|i| at + DVec3::new((i & 1) as f64, ((i >> 1) & 1) as f64, ((i >> 2) & 1) as f64))
+            .collect();
+        let t = vec![
+            [0, 2, 1],
+            [1, 2, 3],
+            [4, 5, 6],
+            [5, 7, 6],
+            [0, 1, 4],
+            [1, 5, 4],
+            [2, 6, 3],
+            [3, 6, 7],
+            [0, 4, 2],
+            [2, 4, 6],
+            [1, 3, 5],
+            [3, 7, 5],
+        ];
+        mesh_from_arrays(Path::new("<cube>"), "cube", v, t).unwrap()
+    }
+
+    fn prepared(m: Mesh) -> Arc<Prepared> {
+        Arc::new(Prepared::new(Path::new("<cube>"), m, BuildOptions::default()).unwrap())
+    }
+
+    #[test]
+    fn placed_queries_match_a_fresh_check() {
+        let a = prepared(cube(DVec3::ZERO));
+        let pa = a.place(DMat4::IDENTITY).unwrap();
+        for (shift, meets) in [(0.5, true), (1.0, true), (1.25, false)] {
+            let rot = DMat4::from_translation(DVec3::new(shift, 0.2, 0.1)) * DMat4::from_rotation_z(0.0);
+            let pb = a.place(rot).unwrap();
+            let mut world = cube(DVec3::ZERO);
+            query::place(&mut world, &rot, Path::new("x")).unwrap();
+            let fresh = query::check(&cube(DVec3::ZERO), &world, &Settings::default());
+            let c = collide(&pa, &pb, true);
+            assert_eq!(c.collides(), meets, "shift {shift}");
+            assert_eq!(c.contacts, fresh.pairs);
+            // The first-contact searches (one thread for small pairs, parallel otherwise) find
+            // one of those pairs, or none.
+            let (ma, mb, ta, tb) = (pa.mesh(), pb.mesh(), pa.tree(), pb.tree());
+            let seq = first_contact_sequential(&ma, &ta, &mb, &tb);
+            assert_eq!(seq.is_some(), meets);
+            assert!(seq.is_none_or(|p| fresh.pairs.contains(&p)));
+            assert_eq!(collide(&pa, &pb, false).collides(), meets);
+            let d = distance(&pa, &pb, f64::INFINITY).unwrap();
+            assert_eq!(d.distance, fresh.closest.unwrap().distance);
+        }
+        // A small cube inside a big one: no triangles meet, yet they collide (containment).
+        let big = prepared(cube(DVec3::ZERO));
+        let pbig = big.place(DMat4::from_scale(DVec3::splat(4.0))).unwrap();
+        let small = a.place(DMat4::from_translation(DVec3::splat(1.0))).unwrap();
+        let c = collide(&pbig, &small, false);
+        assert!(c.contacts.is_empty());
+        assert_eq!(c.containment, Containment::BInA);
+        assert_eq!(distance(&pbig, &small, f64::INFINITY).unwrap().distance, 1.0);
+    }
+
+    #[test]
+    fn array_errors_are_the_loaders_lines() {
+        let l = Path::new("<array a>");
+        let e = mesh_from_arrays(l, "a", vec![DVec3::ZERO; 3], vec![[0, 1, 3]]).unwrap_err();
+        assert_eq!(e.to_string(), "<array a>: triangle 0 refers to vertex 3 but there are 3 vertices");
+        let e =
+            mesh_from_arrays(l, "a", vec![DVec3::ZERO, DVec3::NAN, DVec3::ONE], vec![[0, 1, 2]]).unwrap_err();
+        assert_eq!(e.to_string(), "<array a>: vertex 1 has a non-finite coordinate (NaN)");
+        let e = mesh_from_arrays(l, "a", vec![DVec3::ZERO; 3], vec![]).unwrap_err();
+        assert_eq!(e.to_string(), "<array a>: no triangles");
+        let e = triangles_from(l, &[0i64, 1, -1], 3).unwrap_err();
+        assert_eq!(e.to_string(), "<array a>: triangle 0 refers to vertex -1 but there are 3 vertices");
+        let e = Tolerance::parse("clearance", "x").unwrap_err();
+        assert!(e.to_string().starts_with("usage: --clearance must be"), "{e}");
+    }
+}
