@@ -502,6 +502,10 @@ impl Tree for PlacedTree<'_> {
     fn stats(&self) -> crate::bvh::Stats {
         self.bvh.stats()
     }
+    #[inline]
+    fn all_prims(&self) -> &[u32] {
+        &self.bvh.prims
+    }
 }
 
 impl Placed {
