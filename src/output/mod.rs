@@ -7,6 +7,7 @@
 //! library never prints. The binary decides what goes to stdout and stderr.
 
 pub mod glb;
+pub mod html;
 pub mod junit;
 pub mod progress;
 pub mod text;
@@ -50,6 +51,10 @@ pub struct OutputArgs {
     /// kind, and markers at the closest points and the crossings.
     #[arg(long, value_name = "FILE")]
     pub export_glb: Option<PathBuf>,
+    /// Write a self-contained HTML report to FILE: the summary, a sortable list of clashes and
+    /// a WebGL viewer of the parts involved (no network needed to open it).
+    #[arg(long, value_name = "FILE")]
+    pub html: Option<PathBuf>,
 }
 
 /// The validated output options (part of [`crate::cli::Config`]).
@@ -63,6 +68,8 @@ pub struct OutputOptions {
     pub baseline: Option<PathBuf>,
     /// `--export-glb FILE`.
     pub export_glb: Option<PathBuf>,
+    /// `--html FILE`.
+    pub html: Option<PathBuf>,
     /// `--fail-on new`: fail only on new crossings and new containment (needs a baseline).
     pub fail_on_new: bool,
 }
@@ -78,6 +85,7 @@ impl OutputArgs {
             junit: self.junit,
             baseline: self.baseline,
             export_glb: self.export_glb,
+            html: self.html,
             fail_on_new,
         })
     }
@@ -157,6 +165,9 @@ pub fn finish(
     }
     if let Some(path) = &opts.export_glb {
         report::write_atomic(path, &glb::export(rep, meshes[0], meshes[1]))?;
+    }
+    if let Some(path) = &opts.html {
+        report::write_atomic(path, html::export(rep, result, meshes[0], meshes[1]).as_bytes())?;
     }
     Ok(())
 }
