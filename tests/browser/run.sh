@@ -51,7 +51,7 @@ fi
 
 if [ "$update_docs" = 1 ]; then
   mkdir -p docs/img
-  for f in fcl-overview fcl-clash pins-clash engine-overview engine-clash; do
+  for f in fcl-clash pins-clash engine-clash; do
     [ -f "$shots/$f.png" ] && cp "$shots/$f.png" "docs/img/html-$f.png"
   done
   echo "screenshots copied to docs/img/"
