@@ -114,6 +114,43 @@ struct Page {
 pub fn export(rep: &Report, result: &ClashResult, a: &Mesh, b: &Mesh) -> String {
     let same = std::ptr::eq(a, b);
     let meshes: Vec<&Mesh> = if same { vec![a] } else { vec![a, b] };
+    let Clashes { rows, keys, centre } = clashes(rep, result, a, b);
+    let title = if same {
+        format!("meshclash scene {}", rep.inputs.a.path)
+    } else {
+        format!("meshclash {} {}", rep.inputs.a.path, rep.inputs.b.path)
+    };
+    let summary = crate::output::text::render(rep, false);
+    page(
+        PageInput {
+            title,
+            verdict: rep.verdict.clone(),
+            failed: rep.failed,
+            units: rep.settings.units.clone(),
+            up: if rep.inputs.a.format == "stl" { "z" } else { "y" }.into(),
+            summary,
+            meshes: &meshes,
+            centre,
+        },
+        rows,
+        &keys,
+    )
+}
+
+/// The clashes of a report, worst first, as the page lists them (the BCF topics use them too).
+pub struct Clashes {
+    /// One per clash region, or part pair without one, or the closest points of a clear run.
+    pub rows: Vec<Row>,
+    /// For each row, its A and B part: (mesh slot: 0, or 1 for B in a two-file check; object).
+    pub keys: Vec<((usize, u32), (usize, u32))>,
+    /// The world point the rows' coordinates are relative to.
+    pub centre: DVec3,
+}
+
+/// The rows of [`Clashes`] for a report (see [`export`] for the arguments).
+pub fn clashes(rep: &Report, result: &ClashResult, a: &Mesh, b: &Mesh) -> Clashes {
+    let same = std::ptr::eq(a, b);
+    let meshes: Vec<&Mesh> = if same { vec![a] } else { vec![a, b] };
     let slot_b = if same { 0 } else { 1 };
     let centre = centre_of(&meshes);
     let rel = |p: DVec3| -> [f32; 3] { (p - centre).as_vec3().to_array() };
@@ -276,26 +313,7 @@ pub fn export(rep: &Report, result: &ClashResult, a: &Mesh, b: &Mesh) -> String 
             .then(x.id.cmp(&y.id))
     });
     let (rows, keys): (Vec<Row>, Vec<(PartKey, PartKey)>) = both.into_iter().unzip();
-    let title = if same {
-        format!("meshclash scene {}", rep.inputs.a.path)
-    } else {
-        format!("meshclash {} {}", rep.inputs.a.path, rep.inputs.b.path)
-    };
-    let summary = crate::output::text::render(rep, false);
-    page(
-        PageInput {
-            title,
-            verdict: rep.verdict.clone(),
-            failed: rep.failed,
-            units: rep.settings.units.clone(),
-            up: if rep.inputs.a.format == "stl" { "z" } else { "y" }.into(),
-            summary,
-            meshes: &meshes,
-            centre,
-        },
-        rows,
-        &keys,
-    )
+    Clashes { rows, keys, centre }
 }
 
 /// Everything [`page`] needs besides the rows.

@@ -6,6 +6,7 @@
 //! Everything here returns strings or bytes, or writes the files it was asked to write; the
 //! library never prints. The binary decides what goes to stdout and stderr.
 
+pub mod bcf;
 pub mod glb;
 pub mod html;
 pub mod junit;
@@ -55,6 +56,13 @@ pub struct OutputArgs {
     /// a WebGL viewer of the parts involved (no network needed to open it).
     #[arg(long, value_name = "FILE")]
     pub html: Option<PathBuf>,
+    /// Write the clashes as BCF 2.1 topics to FILE (.bcfzip), for BIM tools: one topic per
+    /// clash region or part pair (--bcf-topics), with a camera, the parts and the witness line.
+    #[arg(long, value_name = "FILE")]
+    pub bcf: Option<PathBuf>,
+    /// What one BCF topic is.
+    #[arg(long, value_enum, value_name = "WHAT", default_value = "regions")]
+    pub bcf_topics: bcf::Topics,
 }
 
 /// The validated output options (part of [`crate::cli::Config`]).
@@ -70,6 +78,8 @@ pub struct OutputOptions {
     pub export_glb: Option<PathBuf>,
     /// `--html FILE`.
     pub html: Option<PathBuf>,
+    /// `--bcf FILE` and `--bcf-topics`.
+    pub bcf: Option<(PathBuf, bcf::Topics)>,
     /// `--fail-on new`: fail only on new crossings and new containment (needs a baseline).
     pub fail_on_new: bool,
 }
@@ -86,6 +96,7 @@ impl OutputArgs {
             baseline: self.baseline,
             export_glb: self.export_glb,
             html: self.html,
+            bcf: self.bcf.map(|p| (p, self.bcf_topics)),
             fail_on_new,
         })
     }
@@ -168,6 +179,9 @@ pub fn finish(
     }
     if let Some(path) = &opts.html {
         report::write_atomic(path, html::export(rep, result, meshes[0], meshes[1]).as_bytes())?;
+    }
+    if let Some((path, topics)) = &opts.bcf {
+        report::write_atomic(path, &bcf::export(rep, result, meshes[0], meshes[1], *topics))?;
     }
     Ok(())
 }
