@@ -405,8 +405,8 @@ fn page(input: PageInput, mut rows: Vec<Row>, keys: &[(PartKey, PartKey)]) -> St
             max: DVec3::from_array(row.bounds[1].map(f64::from)) + centre,
         };
         for (k, s) in [(ka, "a"), (kb, "b")] {
-            if !side.contains_key(&k) {
-                side.insert(k, s);
+            if let std::collections::btree_map::Entry::Vacant(e) = side.entry(k) {
+                e.insert(s);
                 order.push(k);
             }
             near.entry(k).or_default().push(bx);
