@@ -6,7 +6,9 @@
 //! Everything here returns strings or bytes, or writes the files it was asked to write; the
 //! library never prints. The binary decides what goes to stdout and stderr.
 
+pub mod bcf;
 pub mod glb;
+pub mod html;
 pub mod junit;
 pub mod progress;
 pub mod text;
@@ -50,6 +52,17 @@ pub struct OutputArgs {
     /// kind, and markers at the closest points and the crossings.
     #[arg(long, value_name = "FILE")]
     pub export_glb: Option<PathBuf>,
+    /// Write a self-contained HTML report to FILE: the summary, a sortable list of clashes and
+    /// a WebGL viewer of the parts involved (no network needed to open it).
+    #[arg(long, value_name = "FILE")]
+    pub html: Option<PathBuf>,
+    /// Write the clashes as BCF 2.1 topics to FILE (.bcfzip), for BIM tools: one topic per
+    /// clash region or part pair (--bcf-topics), with a camera, the parts and the witness line.
+    #[arg(long, value_name = "FILE")]
+    pub bcf: Option<PathBuf>,
+    /// What one BCF topic is.
+    #[arg(long, value_enum, value_name = "WHAT", default_value = "regions")]
+    pub bcf_topics: bcf::Topics,
 }
 
 /// The validated output options (part of [`crate::cli::Config`]).
@@ -63,6 +76,10 @@ pub struct OutputOptions {
     pub baseline: Option<PathBuf>,
     /// `--export-glb FILE`.
     pub export_glb: Option<PathBuf>,
+    /// `--html FILE`.
+    pub html: Option<PathBuf>,
+    /// `--bcf FILE` and `--bcf-topics`.
+    pub bcf: Option<(PathBuf, bcf::Topics)>,
     /// `--fail-on new`: fail only on new crossings and new containment (needs a baseline).
     pub fail_on_new: bool,
 }
@@ -78,6 +95,8 @@ impl OutputArgs {
             junit: self.junit,
             baseline: self.baseline,
             export_glb: self.export_glb,
+            html: self.html,
+            bcf: self.bcf.map(|p| (p, self.bcf_topics)),
             fail_on_new,
         })
     }
@@ -157,6 +176,12 @@ pub fn finish(
     }
     if let Some(path) = &opts.export_glb {
         report::write_atomic(path, &glb::export(rep, meshes[0], meshes[1]))?;
+    }
+    if let Some(path) = &opts.html {
+        report::write_atomic(path, html::export(rep, result, meshes[0], meshes[1]).as_bytes())?;
+    }
+    if let Some((path, topics)) = &opts.bcf {
+        report::write_atomic(path, &bcf::export(rep, result, meshes[0], meshes[1], *topics))?;
     }
     Ok(())
 }

@@ -1,0 +1,59 @@
+#!/bin/sh
+# Browser test of the HTML report (issue 17): generate reports from the shipped meshes with the
+# release binary, load each from disk in headless Chromium (Debian package `chromium`; Node.js
+# runs the driver, no npm package needed), screenshot the overview and the first clash, and
+# assert the clash colours are in the frame, no network request was made and the console has no
+# error. Exit non-zero on the first failure.
+#
+#   tests/browser/run.sh                 # screenshots in a temporary directory
+#   tests/browser/run.sh --update-docs   # also copy the screenshots README shows to docs/img/
+#
+# Environment: CHROMIUM (default /usr/bin/chromium), CARGO_TARGET_DIR (default target),
+# MESHCLASH (a binary to use instead of building one).
+set -eu
+cd "$(dirname "$0")/../.."
+update_docs=0
+[ "${1:-}" = "--update-docs" ] && update_docs=1
+
+command -v node >/dev/null || { echo "tests/browser/run.sh: node not found (apt-get install nodejs)" >&2; exit 2; }
+[ -x "${CHROMIUM:-/usr/bin/chromium}" ] || { echo "tests/browser/run.sh: chromium not found (apt-get install chromium)" >&2; exit 2; }
+if [ -z "${MESHCLASH:-}" ]; then
+  cargo build --release --quiet
+  MESHCLASH="${CARGO_TARGET_DIR:-target}/release/meshclash"
+fi
+
+out=$(mktemp -d)
+trap 'rm -rf "$out"' EXIT
+shots="$out/shots"
+mkdir -p "$shots"
+
+# check NAME ROWS -- meshclash arguments...   (ROWS: expected table rows, or - for any)
+check() {
+  name=$1; rows=$2; shift 3
+  set +e
+  "$MESHCLASH" "$@" -q --no-timings --html "$out/$name.html" -o "$out/$name.json"
+  code=$?
+  set -e
+  [ "$code" -le 1 ] || { echo "meshclash failed on $name (exit $code)" >&2; exit 1; }
+  if [ "$rows" = "-" ]; then
+    node tests/browser/driver.mjs "$out/$name.html" "$shots/$name-overview.png" "$shots/$name-clash.png"
+  else
+    node tests/browser/driver.mjs "$out/$name.html" "$shots/$name-overview.png" "$shots/$name-clash.png" --rows "$rows"
+  fi
+}
+
+check fcl 1 -- meshes/fcl_env.obj meshes/fcl_rob.obj
+check pins 6 -- scene meshes/pins.glb
+check pins-apart 1 -- meshes/pins.glb meshes/pins.glb --translate-b 300,0,0
+if [ -f ../shared/meshes/2CylinderEngine.glb ]; then
+  check engine - -- scene ../shared/meshes/2CylinderEngine.glb --penetration
+fi
+
+if [ "$update_docs" = 1 ]; then
+  mkdir -p docs/img
+  for f in fcl-clash pins-clash engine-clash; do
+    [ -f "$shots/$f.png" ] && cp "$shots/$f.png" "docs/img/html-$f.png"
+  done
+  echo "screenshots copied to docs/img/"
+fi
+echo "browser test: all passed"
