@@ -4,6 +4,8 @@
 
 #[path = "assembly.rs"]
 mod assembly;
+#[path = "bcf.rs"]
+mod bcf;
 #[path = "bench_cmd.rs"]
 mod bench_cmd;
 #[path = "bodies_penetration.rs"]
@@ -20,6 +22,8 @@ mod extremes;
 mod fcl_reference;
 #[path = "gltf_ext.rs"]
 mod gltf_ext;
+#[path = "html.rs"]
+mod html;
 #[path = "hostile.rs"]
 mod hostile;
 #[path = "layers.rs"]
