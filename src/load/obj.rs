@@ -434,11 +434,11 @@ mod tests {
     fn fan_triangles_count_against_the_triangle_cap_while_parsing() {
         let src = b"v 0 0 0\nv 1 0 0\nv 0 1 0\nv 1 1 0\nf 1 2 3\nf 1 2 3 4 1 2\nf 1 2 3\n";
         let p = path();
-        let l = Parser::new(&p, 5).run(src).unwrap();
-        assert_eq!(l.mesh.triangles.len(), 5);
+        let l = Parser::new(&p, 6).run(src).unwrap();
+        assert_eq!(l.mesh.triangles.len(), 6);
         let e = Parser::new(&p, 4).run(src).unwrap_err().to_string();
         assert!(e.contains("line 6: the faces so far make 5 triangles, more than the 4 supported"), "{e}");
-        let e = Parser::new(&p, 5).run(&[&src[..], b"f 1 2 3\n"].concat()).unwrap_err().to_string();
+        let e = Parser::new(&p, 6).run(&[&src[..], b"f 1 2 3\n"].concat()).unwrap_err().to_string();
         assert!(e.contains("line 8:"), "{e}");
     }
 

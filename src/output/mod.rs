@@ -205,3 +205,26 @@ pub fn input_paths(cfg: &crate::cli::Config) -> Vec<&std::path::Path> {
     let skip = usize::from(cfg.selection.scene);
     cfg.inputs[skip..].iter().map(|i| i.path.as_path()).collect()
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn streamed_json_is_byte_identical() {
+        use clap::Parser;
+        let m = |f: &str| format!("{}/meshes/{f}", env!("CARGO_MANIFEST_DIR"));
+        let args = crate::cli::Args::try_parse_from([
+            "meshclash".to_string(),
+            m("fcl_env.obj"),
+            m("fcl_rob.obj"),
+            "--no-timings".into(),
+        ])
+        .unwrap();
+        let out = crate::cli::run(&args.into_config().unwrap()).unwrap();
+        assert!(out.json_stdout && out.stdout.is_none());
+        let mut streamed = Vec::new();
+        write_report_json(&mut streamed, &out.report).unwrap();
+        assert_eq!(String::from_utf8(streamed).unwrap(), crate::report::to_json(&out.report));
+    }
+}

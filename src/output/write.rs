@@ -63,17 +63,17 @@ impl Staged {
         fill: impl FnOnce(&mut dyn Write) -> std::io::Result<()>,
     ) -> Result<()> {
         let err = out_err(path);
-        let target = resolve(path).map_err(&err)?;
-        if let Ok(m) = std::fs::metadata(&target) {
-            if m.is_dir() {
-                return Err(Error::Output { path: path.to_path_buf(), msg: "is a directory".into() });
+        let target = match target(path).map_err(&err)? {
+            Target::Directory => {
+                return Err(Error::Output { path: path.to_path_buf(), msg: "is a directory".into() })
             }
-            if !m.is_file() {
-                let f = std::fs::OpenOptions::new().write(true).open(&target).map_err(&err)?;
+            Target::Direct => {
+                let f = std::fs::OpenOptions::new().write(true).truncate(true).open(path).map_err(&err)?;
                 let mut w = BufWriter::new(f);
                 return fill(&mut w).and_then(|_| w.flush()).map_err(&err);
             }
-        }
+            Target::Replace(t) => t,
+        };
         let mut tmp = tempfile::NamedTempFile::new_in(dir_of(&target)).map_err(&err)?;
         {
             let mut w = BufWriter::new(tmp.as_file_mut());
@@ -93,6 +93,32 @@ impl Staged {
     }
 }
 
+/// How an output path is written.
+enum Target {
+    /// An existing directory: refused.
+    Directory,
+    /// Opened and written in place: an existing device, FIFO or socket (also through a
+    /// symlink, e.g. `/dev/stdout` on a pipe), or a file reached through `/proc` or `/dev`
+    /// (`/dev/stdout` redirected to a file: renaming over it would leave the shell's descriptor
+    /// on the old file).
+    Direct,
+    /// Staged in a temporary and renamed over this path (the final target of any symlinks).
+    Replace(PathBuf),
+}
+
+fn target(path: &Path) -> std::io::Result<Target> {
+    match std::fs::metadata(path) {
+        Ok(m) if m.is_dir() => return Ok(Target::Directory),
+        Ok(m) if !m.is_file() => return Ok(Target::Direct),
+        _ => {}
+    }
+    let t = resolve(path)?;
+    if t.starts_with("/proc") || t.starts_with("/dev") {
+        return Ok(Target::Direct);
+    }
+    Ok(Target::Replace(t))
+}
+
 /// The directory a temporary for `target` goes in.
 fn dir_of(target: &Path) -> &Path {
     target.parent().filter(|d| !d.as_os_str().is_empty()).unwrap_or(Path::new("."))
@@ -110,7 +136,11 @@ pub fn check_outputs(outputs: &[Named], inputs: &[&Path]) -> Result<()> {
     let mut seen: Vec<((u64, u64), &str)> = Vec::new();
     for &(flag, path) in outputs {
         let fail = |msg: String| Error::Output { path: path.to_path_buf(), msg };
-        let target = resolve(path).map_err(|e| fail(e.to_string()))?;
+        let target = match target(path).map_err(|e| fail(e.to_string()))? {
+            Target::Directory => return Err(fail(format!("{flag} names a directory"))),
+            Target::Direct => path.to_path_buf(),
+            Target::Replace(t) => t,
+        };
         match std::fs::metadata(&target) {
             Ok(m) => {
                 if let Some((_, input)) = inputs.iter().find(|(i, _)| *i == id(&m)) {
@@ -122,12 +152,12 @@ pub fn check_outputs(outputs: &[Named], inputs: &[&Path]) -> Result<()> {
                 if let Some((_, other)) = seen.iter().find(|(i, _)| *i == id(&m)) {
                     return Err(fail(format!("{flag} names the same file as {other}")));
                 }
-                seen.push((id(&m), flag));
-                if m.is_dir() {
-                    return Err(fail(format!("{flag} names a directory")));
-                }
                 if !m.is_file() {
-                    continue; // a device, FIFO or socket: written directly
+                    continue; // a device, FIFO or socket: written directly (and may repeat)
+                }
+                seen.push((id(&m), flag));
+                if target.starts_with("/proc") || target.starts_with("/dev") {
+                    continue; // written in place
                 }
             }
             Err(e) if e.kind() == std::io::ErrorKind::NotFound => {}
@@ -298,6 +328,25 @@ mod tests {
         std::fs::write(&r, b"old").unwrap();
         let e = check_outputs(&[("-o", &r), ("--junit", &r)], &[]).unwrap_err().to_string();
         assert!(e.contains("--junit names the same file as -o"), "{e}");
+    }
+
+    #[test]
+    fn dev_stdout_on_a_pipe_is_written_in_place() {
+        // A symlink chain to a pipe (`/dev/stdout` -> `/proc/self/fd/1` -> `pipe:[N]`) must not
+        // be resolved to a path to rename over.
+        let d = tempfile::tempdir().unwrap();
+        let fifo = d.path().join("f");
+        assert!(std::process::Command::new("mkfifo").arg(&fifo).status().unwrap().success());
+        let link = d.path().join("out.json");
+        std::os::unix::fs::symlink(&fifo, &link).unwrap();
+        check_outputs(&[("-o", &link)], &[]).unwrap();
+        let reader = std::thread::spawn({
+            let fifo = fifo.clone();
+            move || std::fs::read(fifo).unwrap()
+        });
+        write_file(&link, b"through").unwrap();
+        assert_eq!(reader.join().unwrap(), b"through");
+        assert!(std::fs::symlink_metadata(&link).unwrap().file_type().is_symlink());
     }
 
     #[test]
