@@ -74,7 +74,10 @@ impl Staged {
             }
             Target::Replace(t) => t,
         };
-        let mut tmp = tempfile::NamedTempFile::new_in(dir_of(&target)).map_err(&err)?;
+        // Mode 0666 less the umask, as for any new file (tempfile's default is 0600).
+        let mode = std::os::unix::fs::PermissionsExt::from_mode(0o666);
+        let mut tmp =
+            tempfile::Builder::new().permissions(mode).tempfile_in(dir_of(&target)).map_err(&err)?;
         {
             let mut w = BufWriter::new(tmp.as_file_mut());
             fill(&mut w).and_then(|_| w.flush()).map_err(&err)?;
