@@ -531,6 +531,13 @@ pub fn schema_json(kind: SchemaKind) -> String {
 pub fn run_with_progress(args: &ClashSetArgs, progress: &(dyn Fn(Phase) + Sync)) -> Result<SetOutcome> {
     let file = args.file.as_deref().ok_or_else(|| Error::Usage("missing clash-set FILE".into()))?;
     let checks = load(file, args)?;
+    let outputs: Vec<crate::output::write::Named> = [("-o", &args.output), ("--junit", &args.junit)]
+        .into_iter()
+        .filter_map(|(f, p)| Some((f, p.as_deref()?)))
+        .collect();
+    let mut inputs = vec![file];
+    inputs.extend(checks.iter().flat_map(|c| crate::output::input_paths(&c.config)));
+    crate::output::write::check_outputs(&outputs, &inputs)?;
     let entries = cli::in_pool(args.threads, |threads| {
         checks
             .iter()
@@ -548,16 +555,20 @@ pub fn run_with_progress(args: &ClashSetArgs, progress: &(dyn Fn(Phase) + Sync))
         failed: entries.iter().any(|c| c.report.failed),
         checks: entries,
     };
-    let json = to_json(&doc);
+    let mut staged = crate::output::write::Staged::new();
     if let Some(path) = &args.junit {
-        report::write_atomic(path, junit_xml(&doc).as_bytes())?;
+        staged.stage(path, junit_xml(&doc).as_bytes())?;
     }
     if let Some(path) = &args.output {
-        report::write_atomic(path, json.as_bytes())?;
+        staged.stage_with(path, |w| {
+            serde_json::to_writer_pretty(&mut *w, &doc)?;
+            std::io::Write::write_all(w, b"\n")
+        })?;
     }
+    staged.commit()?;
     let stdout = match args.format {
         None if args.output.is_some() => None,
-        None | Some(SetFormat::Json) => Some(json),
+        None | Some(SetFormat::Json) => Some(to_json(&doc)),
         Some(SetFormat::Text) => Some(summary(&doc)),
         Some(SetFormat::Junit) => Some(junit_xml(&doc)),
     };

@@ -586,8 +586,12 @@ impl Args {
 #[derive(Debug, Clone, PartialEq)]
 pub struct Outcome {
     /// What goes to stdout: the report in `--format` (default JSON; None when the report is
-    /// written to `--output` and no `--format` is given).
+    /// written to `--output` and no `--format` is given, or when the JSON report goes there:
+    /// see `json_stdout`).
     pub stdout: Option<String>,
+    /// The JSON report goes to stdout: the binary streams `report` there
+    /// ([`crate::output::write_report_json`]) instead of holding its text in memory.
+    pub json_stdout: bool,
     /// Lines for stderr (warnings).
     pub warnings: Vec<String>,
     /// 0 or 1.
@@ -603,6 +607,7 @@ pub fn run(cfg: &Config) -> Result<Outcome> {
 
 /// [`run`], calling `progress` as each phase starts (the binary drives a spinner with it).
 pub fn run_with_progress(cfg: &Config, progress: &(dyn Fn(Phase) + Sync)) -> Result<Outcome> {
+    crate::output::check_outputs(cfg)?;
     in_pool(cfg.threads, |threads| run_in_pool(cfg, threads, progress))
 }
 
@@ -617,15 +622,16 @@ pub fn in_pool<T: Send>(threads: usize, f: impl FnOnce(usize) -> Result<T> + Sen
 }
 
 fn run_in_pool(cfg: &Config, threads: usize, progress: &(dyn Fn(Phase) + Sync)) -> Result<Outcome> {
-    let rep = check_in_pool(cfg, threads, progress)?;
-    let json = report::to_json(&rep);
+    let mut staged = crate::output::write::Staged::new();
+    let rep = check_staged(cfg, threads, progress, &mut staged)?;
     let warnings = rep.warnings.clone();
     if let Some(path) = &cfg.output {
-        report::write_atomic(path, json.as_bytes())?;
+        staged.stage_with(path, |w| crate::output::write_report_json(w, &rep))?;
     }
-    let stdout = crate::output::stdout_for(&cfg.outputs, &rep, &json, cfg.output.is_some());
+    staged.commit()?;
+    let (stdout, json_stdout) = crate::output::stdout_for(&cfg.outputs, &rep, cfg.output.is_some());
     let exit_code = rep.failed as u8;
-    Ok(Outcome { stdout, warnings, exit_code, report: Box::new(rep) })
+    Ok(Outcome { stdout, json_stdout, warnings, exit_code, report: Box::new(rep) })
 }
 
 /// Load one input: exactly [`query::load_input`] when no units or scale flag was given; else
@@ -657,6 +663,20 @@ pub fn check_in_pool(
     cfg: &Config,
     threads: usize,
     progress: &(dyn Fn(Phase) + Sync),
+) -> Result<report::Report> {
+    let mut staged = crate::output::write::Staged::new();
+    let rep = check_staged(cfg, threads, progress, &mut staged)?;
+    staged.commit()?;
+    Ok(rep)
+}
+
+/// [`check_in_pool`], with the JUnit and GLB files staged in `staged` (committed by the caller
+/// with its other outputs: all or nothing).
+pub fn check_staged(
+    cfg: &Config,
+    threads: usize,
+    progress: &(dyn Fn(Phase) + Sync),
+    staged: &mut crate::output::write::Staged,
 ) -> Result<report::Report> {
     progress(Phase::Load);
     let t0 = Instant::now();
@@ -728,6 +748,6 @@ pub fn check_in_pool(
     rep.inputs.a.units = ua;
     rep.inputs.b.units = ub;
     progress(Phase::Write);
-    crate::output::finish(&cfg.outputs, &mut rep, &result, [&a.mesh, &b.mesh])?;
+    crate::output::finish(&cfg.outputs, &mut rep, &result, [&a.mesh, &b.mesh], staged)?;
     Ok(rep)
 }

@@ -3,8 +3,9 @@
 use clap::Parser;
 use meshclash::cli::{self, Args};
 use meshclash::output::progress::{self, Spinner};
+use meshclash::output::write;
 use meshclash::output::{text, Format};
-use std::io::{IsTerminal, Write};
+use std::io::IsTerminal;
 use std::process::ExitCode;
 
 fn main() -> ExitCode {
@@ -35,9 +36,7 @@ fn main() -> ExitCode {
             cli::Command::ClashSet(_) | cli::Command::SelfCheck(_) => unreachable!("handled above"),
             cli::Command::Bench(b) => return bench_forward(&b.args),
         };
-        let mut so = std::io::stdout().lock();
-        let _ = so.write_all(text.as_bytes()).and_then(|_| so.flush());
-        return ExitCode::SUCCESS;
+        return print_stdout(&text);
     }
     let quiet = args.quiet;
     let format = args.outputs.format;
@@ -69,14 +68,14 @@ fn main() -> ExitCode {
             if text_on_tty && color {
                 out.stdout = Some(text::render(&out.report, true));
             }
-            if let Some(json) = out.stdout {
-                let mut so = std::io::stdout().lock();
-                if let Err(e) = so.write_all(json.as_bytes()).and_then(|_| so.flush()) {
-                    if e.kind() != std::io::ErrorKind::BrokenPipe {
-                        eprintln!("meshclash: error: cannot write to stdout: {e}");
-                        return ExitCode::from(2);
-                    }
-                }
+            let written = match (&out.stdout, out.json_stdout) {
+                (Some(text), _) => write::to_stdout(|w| w.write_all(text.as_bytes())),
+                (None, true) => write::to_stdout(|w| meshclash::output::write_report_json(w, &out.report)),
+                (None, false) => Ok(true),
+            };
+            if let Err(e) = written {
+                eprintln!("meshclash: error: cannot write to stdout: {e}");
+                return ExitCode::from(2);
             }
             ExitCode::from(out.exit_code)
         }
@@ -134,13 +133,12 @@ fn clash_set(set: meshclash::clash_set::ClashSetArgs) -> ExitCode {
 
 /// Write `text` to stdout; a closed pipe is not an error, any other failure is exit 2.
 fn print_stdout(text: &str) -> ExitCode {
-    let mut so = std::io::stdout().lock();
-    match so.write_all(text.as_bytes()).and_then(|_| so.flush()) {
-        Err(e) if e.kind() != std::io::ErrorKind::BrokenPipe => {
+    match write::to_stdout(|w| w.write_all(text.as_bytes())) {
+        Err(e) => {
             eprintln!("meshclash: error: cannot write to stdout: {e}");
             ExitCode::from(2)
         }
-        _ => ExitCode::SUCCESS,
+        Ok(_) => ExitCode::SUCCESS,
     }
 }
 

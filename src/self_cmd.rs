@@ -228,16 +228,11 @@ pub fn run(args: &SelfArgs) -> Result<SelfOutcome> {
     if !(1..=64).contains(&args.leaf_size) {
         return Err(Error::Usage(format!("--leaf-size must be 1..=64, got {}", args.leaf_size)));
     }
-    if let Some(out) = &args.output {
-        if let (Ok(a), Ok(b)) = (std::fs::canonicalize(out), std::fs::canonicalize(&args.file)) {
-            if a == b {
-                return Err(Error::Usage(format!(
-                    "-o {} is the input file; refusing to overwrite it",
-                    out.display()
-                )));
-            }
-        }
-    }
+    let outputs: Vec<crate::output::write::Named> = [("-o", &args.output), ("--junit", &args.junit)]
+        .into_iter()
+        .filter_map(|(f, p)| Some((f, p.as_deref()?)))
+        .collect();
+    crate::output::write::check_outputs(&outputs, &[&args.file])?;
     crate::cli::in_pool(args.threads, |threads| run_in_pool(args, threads))
 }
 
@@ -301,17 +296,21 @@ fn run_in_pool(args: &SelfArgs, threads: usize) -> Result<SelfOutcome> {
         }),
         warnings: warnings.clone(),
     });
-    let json = rep::to_json(&report);
+    let mut staged = crate::output::write::Staged::new();
     if let Some(path) = &args.junit {
-        crate::report::write_atomic(path, junit(&parts, &fail_on).as_bytes())?;
+        staged.stage(path, junit(&parts, &fail_on).as_bytes())?;
     }
     if let Some(path) = &args.output {
-        crate::report::write_atomic(path, json.as_bytes())?;
+        staged.stage_with(path, |w| {
+            serde_json::to_writer_pretty(&mut *w, &report)?;
+            std::io::Write::write_all(w, b"\n")
+        })?;
     }
+    staged.commit()?;
     let summary = rep::text(&report);
     let stdout = match args.format {
         None if args.output.is_some() => None,
-        None | Some(SelfFormat::Json) => Some(json),
+        None | Some(SelfFormat::Json) => Some(rep::to_json(&report)),
         Some(SelfFormat::Text) => Some(summary.clone()),
     };
     Ok(SelfOutcome { stdout, summary, warnings, exit_code: report.failed as u8, report: Box::new(report) })

@@ -571,3 +571,17 @@ fn regression_gltf_instanced_triangle_count_is_bounded() {
         &["glTF scene has 500000000 triangles after instancing, more than the 268435456 supported"],
     );
 }
+
+/// Issue 11 item 10: a one-line face of 24 MB (12 million indices) reached gigabytes and
+/// aborted with no file name; it is refused at the polygon cap, naming the file and line.
+#[test]
+fn regression_obj_huge_face_line_is_refused_naming_file_and_line() {
+    let dir = TempDir::new().unwrap();
+    let mut face = b"v 0 0 0\nv 1 0 0\nv 0 1 0\nf".to_vec();
+    for _ in 0..12_000_000 {
+        face.extend_from_slice(b" 1");
+    }
+    face.push(b'\n');
+    let file = write(&dir, "huge_face.obj", &face);
+    rejects_without_allocating(&file, &["line 4: face has more than 65536 vertices"]);
+}

@@ -21,6 +21,13 @@ use std::path::Path;
 use crate::error::{Error, Result};
 use crate::scene::mesh::Loaded;
 
+/// The most triangles one input may make (2^28, 4 GiB of triangles and part ids): a glTF scene
+/// after instancing, an OBJ file after fan triangulation. Checked before the triangles are
+/// allocated (glTF) or as they are made (OBJ).
+pub const MAX_TRIANGLES: usize = 1 << 28;
+
+pub use obj::MAX_FACE_VERTICES;
+
 mod gltf;
 mod gltf_data;
 mod obj;

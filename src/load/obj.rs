@@ -28,6 +28,14 @@ use super::{clip, drop_empty_objects, non_finite};
 use crate::error::{Error, Result};
 use crate::scene::mesh::{Loaded, Mesh, Object};
 
+/// The most vertices one face (polygon) may have: a larger one is refused with its line number
+/// before its indices are collected, so one huge `f` line cannot take the machine's memory.
+pub const MAX_FACE_VERTICES: usize = 1 << 16;
+
+/// The most triangles an OBJ file may make (faces fan-triangulated), counted while parsing;
+/// the same bound as a glTF scene's ([`crate::load::MAX_TRIANGLES`]).
+const MAX_TRIANGLES: usize = super::MAX_TRIANGLES;
+
 /// How many unrecognised lines are reported individually before summarising.
 const MAX_LINE_WARNINGS: usize = 10;
 
@@ -71,7 +79,7 @@ const IGNORED: &[&[u8]] = &[
 
 /// Parses OBJ `bytes`; see the module doc. Validation of the result is done by the caller too.
 pub(crate) fn load(path: &Path, bytes: &[u8]) -> Result<Loaded> {
-    Parser::new(path).run(bytes)
+    Parser::new(path, MAX_TRIANGLES).run(bytes)
 }
 
 struct Parser<'p> {
@@ -85,10 +93,12 @@ struct Parser<'p> {
     /// Positive indices beyond the vertices defined so far: (line, 1-based index).
     forward_refs: Vec<(usize, i64)>,
     face: Vec<u32>,
+    /// [`MAX_TRIANGLES`] (smaller in tests).
+    max_triangles: usize,
 }
 
 impl<'p> Parser<'p> {
-    fn new(path: &'p Path) -> Self {
+    fn new(path: &'p Path, max_triangles: usize) -> Self {
         Parser {
             path,
             mesh: Mesh { objects: vec![Object::default()], ..Default::default() },
@@ -98,6 +108,7 @@ impl<'p> Parser<'p> {
             skipped_elements: 0,
             forward_refs: Vec::new(),
             face: Vec::new(),
+            max_triangles,
         }
     }
 
@@ -199,6 +210,12 @@ impl<'p> Parser<'p> {
         face.clear();
         let defined = self.mesh.positions.len() as i64;
         while let Some((off, tok)) = tokens.next() {
+            if face.len() == MAX_FACE_VERTICES {
+                return Err(self.err(
+                    line,
+                    format!("face has more than {MAX_FACE_VERTICES} vertices, the most meshclash reads in one polygon"),
+                ));
+            }
             let v = tok.split(|&b| b == b'/').next().unwrap_or(tok);
             let idx = match plain_index(v) {
                 Some(i) => i,
@@ -239,6 +256,17 @@ impl<'p> Parser<'p> {
         if face.len() < 3 {
             return Err(self.err(line, format!("face has {} vertices (needs at least 3)", face.len())));
         }
+        let total = self.mesh.triangles.len() + face.len() - 2;
+        if total > self.max_triangles {
+            return Err(self.err(
+                line,
+                format!(
+                    "the faces so far make {total} triangles, more than the {} supported",
+                    self.max_triangles
+                ),
+            ));
+        }
+        self.mesh.triangles.reserve(face.len() - 2);
         for i in 1..face.len() - 1 {
             self.mesh.triangles.push([face[0], face[i], face[i + 1]]);
             self.mesh.tri_object.push(self.current);
@@ -386,6 +414,32 @@ mod tests {
         assert!(e.starts_with("test.obj: "), "{e}");
         assert!(!e.contains('\n'), "{e}");
         e
+    }
+
+    #[test]
+    fn regression_huge_face_is_refused_naming_line_and_limit() {
+        // Issue 11 item 10: one `f` line with tens of millions of indices reached 3.5 GB.
+        let mut src = b"v 0 0 0\nv 1 0 0\nv 0 1 0\n# big\nf".to_vec();
+        for _ in 0..MAX_FACE_VERTICES {
+            src.extend_from_slice(b" 1");
+        }
+        let at_cap = ok(&[src.clone(), b"\n".to_vec()].concat());
+        assert_eq!(at_cap.mesh.triangles.len(), MAX_FACE_VERTICES - 2);
+        src.extend_from_slice(b" 2 3\n");
+        let e = err(&src);
+        assert!(e.contains("line 5: face has more than 65536 vertices"), "{e}");
+    }
+
+    #[test]
+    fn fan_triangles_count_against_the_triangle_cap_while_parsing() {
+        let src = b"v 0 0 0\nv 1 0 0\nv 0 1 0\nv 1 1 0\nf 1 2 3\nf 1 2 3 4 1 2\nf 1 2 3\n";
+        let p = path();
+        let l = Parser::new(&p, 6).run(src).unwrap();
+        assert_eq!(l.mesh.triangles.len(), 6);
+        let e = Parser::new(&p, 4).run(src).unwrap_err().to_string();
+        assert!(e.contains("line 6: the faces so far make 5 triangles, more than the 4 supported"), "{e}");
+        let e = Parser::new(&p, 6).run(&[&src[..], b"f 1 2 3\n"].concat()).unwrap_err().to_string();
+        assert!(e.contains("line 8:"), "{e}");
     }
 
     #[test]

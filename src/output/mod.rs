@@ -17,7 +17,7 @@ pub mod write;
 use crate::check::query::ClashResult;
 use crate::error::{Error, Result};
 use crate::report::baseline;
-use crate::report::{self, Report};
+use crate::report::Report;
 use crate::scene::mesh::Mesh;
 use clap::CommandFactory;
 use std::path::PathBuf;
@@ -151,7 +151,7 @@ pub fn man_page() -> String {
     String::from_utf8_lossy(&out).into_owned()
 }
 
-/// Complete the report after [`report::build`] and write the side files: finding ids (always),
+/// Complete the report after [`crate::report::build`] and write the side files: finding ids (always),
 /// the baseline comparison and `--fail-on new` (with `--baseline`), the JUnit file and the GLB.
 /// Sets `rep.failed` for `--fail-on new`. `meshes` are the two placed inputs the result was
 /// computed on.
@@ -160,6 +160,7 @@ pub fn finish(
     rep: &mut Report,
     result: &ClashResult,
     meshes: [&Mesh; 2],
+    staged: &mut write::Staged,
 ) -> Result<()> {
     let findings = baseline::findings(&result.pairs, meshes[0], meshes[1]);
     baseline::assign_ids(rep, &findings);
@@ -172,10 +173,10 @@ pub fn finish(
         rep.failed = rep.baseline.as_ref().is_some_and(baseline::fails_on_new);
     }
     if let Some(path) = &opts.junit {
-        report::write_atomic(path, junit::from_report(rep).as_bytes())?;
+        staged.stage(path, junit::from_report(rep).as_bytes())?;
     }
     if let Some(path) = &opts.export_glb {
-        report::write_atomic(path, &glb::export(rep, meshes[0], meshes[1]))?;
+        staged.stage(path, &glb::export(rep, meshes[0], meshes[1]))?;
     }
     if let Some(path) = &opts.html {
         report::write_atomic(path, html::export(rep, result, meshes[0], meshes[1]).as_bytes())?;
@@ -186,14 +187,69 @@ pub fn finish(
     Ok(())
 }
 
-/// What goes to stdout for `opts.format`, given the finished report and its JSON. With no
-/// `--format` and the report written to a file (`report_to_file`), nothing. Text is uncoloured
-/// (the binary re-renders it in colour on a terminal).
-pub fn stdout_for(opts: &OutputOptions, rep: &Report, json: &str, report_to_file: bool) -> Option<String> {
+/// What goes to stdout for `opts.format`, given the finished report: (text, whether the JSON
+/// report goes to stdout). The JSON is not rendered here: the binary streams it with
+/// [`write_report_json`]. With no `--format` and the report written to a file
+/// (`report_to_file`), nothing. Text is uncoloured (the binary re-renders it in colour on a
+/// terminal).
+pub fn stdout_for(opts: &OutputOptions, rep: &Report, report_to_file: bool) -> (Option<String>, bool) {
     match opts.format {
-        None if report_to_file => None,
-        None | Some(Format::Json) => Some(json.to_string()),
-        Some(Format::Text) => Some(text::render(rep, false)),
-        Some(Format::Junit) => Some(junit::from_report(rep)),
+        None if report_to_file => (None, false),
+        None | Some(Format::Json) => (None, true),
+        Some(Format::Text) => (Some(text::render(rep, false)), false),
+        Some(Format::Junit) => (Some(junit::from_report(rep)), false),
+    }
+}
+
+/// The report as pretty JSON with a trailing newline, streamed to `w` (the same bytes as
+/// [`crate::report::to_json`], never the whole text in memory).
+pub fn write_report_json(w: &mut dyn std::io::Write, rep: &Report) -> std::io::Result<()> {
+    serde_json::to_writer_pretty(&mut *w, rep).map_err(std::io::Error::from)?;
+    w.write_all(b"\n")
+}
+
+/// Every output of the two-file or scene command, checked against its inputs before the run
+/// ([`write::check_outputs`]). The baseline is not an input here: it is read whole before any
+/// output is written, so `--baseline r.json -o r.json` updates a baseline in place.
+pub fn check_outputs(cfg: &crate::cli::Config) -> Result<()> {
+    let mut outputs: Vec<write::Named> = Vec::new();
+    if let Some(p) = &cfg.output {
+        outputs.push(("-o", p));
+    }
+    if let Some(p) = &cfg.outputs.junit {
+        outputs.push(("--junit", p));
+    }
+    if let Some(p) = &cfg.outputs.export_glb {
+        outputs.push(("--export-glb", p));
+    }
+    write::check_outputs(&outputs, &input_paths(cfg))
+}
+
+/// The mesh files a configuration reads (in scene mode, the one file).
+pub fn input_paths(cfg: &crate::cli::Config) -> Vec<&std::path::Path> {
+    let skip = usize::from(cfg.selection.scene);
+    cfg.inputs[skip..].iter().map(|i| i.path.as_path()).collect()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn streamed_json_is_byte_identical() {
+        use clap::Parser;
+        let m = |f: &str| format!("{}/meshes/{f}", env!("CARGO_MANIFEST_DIR"));
+        let args = crate::cli::Args::try_parse_from([
+            "meshclash".to_string(),
+            m("fcl_env.obj"),
+            m("fcl_rob.obj"),
+            "--no-timings".into(),
+        ])
+        .unwrap();
+        let out = crate::cli::run(&args.into_config().unwrap()).unwrap();
+        assert!(out.json_stdout && out.stdout.is_none());
+        let mut streamed = Vec::new();
+        write_report_json(&mut streamed, &out.report).unwrap();
+        assert_eq!(String::from_utf8(streamed).unwrap(), crate::report::to_json(&out.report));
     }
 }

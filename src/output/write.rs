@@ -1,33 +1,181 @@
-//! The one place outputs reach the file system (issue 11, items 1-2).
+//! The one place outputs reach the file system (issue 11).
 //!
 //! Rules, for every output (`-o`, `--junit`, `--export-glb`, and any added later):
+//! - **checked before any work** ([`check_outputs`]): an output that is one of the inputs (the
+//!   same file after following symlinks, or a hard link to it: same device and inode) or
+//!   another output of the same run is refused; an output that is a directory, or whose
+//!   directory is missing or not writable, is refused;
+//! - **all or nothing** ([`Staged`]): every output of a run goes to its own temporary first, and
+//!   the temporaries are renamed over their targets only once all of them were written; a run
+//!   that fails leaves no output behind (its temporaries are deleted);
 //! - an existing path that is not a regular file (a device such as `/dev/null`, a FIFO, a
-//!   socket) is written directly, never renamed over;
+//!   socket) is written directly, never renamed over (it cannot be staged: it is written when
+//!   its content is ready, before the other outputs are committed);
 //! - a symlink is followed and its *target* is replaced atomically; the link stays a link;
-//! - otherwise the bytes go to a temporary with an unpredictable name created with `O_EXCL`
-//!   (the `tempfile` crate) in the target's directory, synced, then renamed over the target, so
-//!   a planted symlink at a guessable temporary name is never followed.
+//! - temporaries get unpredictable names, created with `O_EXCL` (the `tempfile` crate) in the
+//!   target's directory, are synced, then renamed, so a planted symlink at a guessable temporary
+//!   name is never followed.
+//!
+//! Content is streamed into the temporary through a buffer ([`Staged::stage_with`]): a report
+//! is never held whole in memory as text.
 
 use crate::error::{Error, Result};
-use std::io::Write;
+use std::io::{BufWriter, Write};
+use std::os::unix::fs::MetadataExt;
 use std::path::{Path, PathBuf};
 
 /// Writes `bytes` to `path` completely or not at all (regular files), or directly (devices,
-/// FIFOs, sockets). Errors name `path`.
+/// FIFOs, sockets). Errors name `path`. One output on its own: a run with several outputs
+/// stages them all in one [`Staged`].
 pub fn write_file(path: &Path, bytes: &[u8]) -> Result<()> {
-    let err = |e: std::io::Error| Error::Output { path: path.to_path_buf(), msg: e.to_string() };
-    let target = resolve(path).map_err(err)?;
-    match std::fs::metadata(&target) {
-        Ok(m) if !m.is_file() && !m.is_dir() => {
-            let mut f = std::fs::OpenOptions::new().write(true).open(&target).map_err(err)?;
-            return f.write_all(bytes).and_then(|_| f.flush()).map_err(err);
+    let mut s = Staged::new();
+    s.stage(path, bytes)?;
+    s.commit()
+}
+
+fn out_err(path: &Path) -> impl Fn(std::io::Error) -> Error + '_ {
+    move |e| Error::Output { path: path.to_path_buf(), msg: e.to_string() }
+}
+
+/// Outputs written to temporaries, renamed over their targets by [`Staged::commit`]. Dropping
+/// a `Staged` without committing deletes the temporaries: nothing is left behind.
+#[derive(Debug, Default)]
+pub struct Staged {
+    pending: Vec<(PathBuf, tempfile::NamedTempFile)>,
+}
+
+impl Staged {
+    /// Nothing staged yet.
+    pub fn new() -> Self {
+        Staged::default()
+    }
+
+    /// Stage `bytes` for `path`.
+    pub fn stage(&mut self, path: &Path, bytes: &[u8]) -> Result<()> {
+        self.stage_with(path, |w| w.write_all(bytes))
+    }
+
+    /// Stage the bytes `fill` writes (through a buffer) for `path`. A path that is an existing
+    /// device, FIFO or socket is written directly, now.
+    pub fn stage_with(
+        &mut self,
+        path: &Path,
+        fill: impl FnOnce(&mut dyn Write) -> std::io::Result<()>,
+    ) -> Result<()> {
+        let err = out_err(path);
+        let target = match target(path).map_err(&err)? {
+            Target::Directory => {
+                return Err(Error::Output { path: path.to_path_buf(), msg: "is a directory".into() })
+            }
+            Target::Direct => {
+                let f = std::fs::OpenOptions::new().write(true).truncate(true).open(path).map_err(&err)?;
+                let mut w = BufWriter::new(f);
+                return fill(&mut w).and_then(|_| w.flush()).map_err(&err);
+            }
+            Target::Replace(t) => t,
+        };
+        // Mode 0666 less the umask, as for any new file (tempfile's default is 0600).
+        let mode = std::os::unix::fs::PermissionsExt::from_mode(0o666);
+        let mut tmp =
+            tempfile::Builder::new().permissions(mode).tempfile_in(dir_of(&target)).map_err(&err)?;
+        {
+            let mut w = BufWriter::new(tmp.as_file_mut());
+            fill(&mut w).and_then(|_| w.flush()).map_err(&err)?;
         }
+        tmp.as_file().sync_all().map_err(&err)?;
+        self.pending.push((target, tmp));
+        Ok(())
+    }
+
+    /// Rename every temporary over its target, in the order staged.
+    pub fn commit(self) -> Result<()> {
+        for (target, tmp) in self.pending {
+            tmp.persist(&target).map_err(|e| out_err(&target)(e.error))?;
+        }
+        Ok(())
+    }
+}
+
+/// How an output path is written.
+enum Target {
+    /// An existing directory: refused.
+    Directory,
+    /// Opened and written in place: an existing device, FIFO or socket (also through a
+    /// symlink, e.g. `/dev/stdout` on a pipe), or a file reached through `/proc` or `/dev`
+    /// (`/dev/stdout` redirected to a file: renaming over it would leave the shell's descriptor
+    /// on the old file).
+    Direct,
+    /// Staged in a temporary and renamed over this path (the final target of any symlinks).
+    Replace(PathBuf),
+}
+
+fn target(path: &Path) -> std::io::Result<Target> {
+    match std::fs::metadata(path) {
+        Ok(m) if m.is_dir() => return Ok(Target::Directory),
+        Ok(m) if !m.is_file() => return Ok(Target::Direct),
         _ => {}
     }
-    let dir = target.parent().filter(|d| !d.as_os_str().is_empty()).unwrap_or(Path::new("."));
-    let mut tmp = tempfile::NamedTempFile::new_in(dir).map_err(err)?;
-    tmp.write_all(bytes).and_then(|_| tmp.as_file().sync_all()).map_err(err)?;
-    tmp.persist(&target).map_err(|e| err(e.error))?;
+    let t = resolve(path)?;
+    if t.starts_with("/proc") || t.starts_with("/dev") {
+        return Ok(Target::Direct);
+    }
+    Ok(Target::Replace(t))
+}
+
+/// The directory a temporary for `target` goes in.
+fn dir_of(target: &Path) -> &Path {
+    target.parent().filter(|d| !d.as_os_str().is_empty()).unwrap_or(Path::new("."))
+}
+
+/// One output to check: the flag that names it (`-o`, `--junit`, …) and its path.
+pub type Named<'a> = (&'a str, &'a Path);
+
+/// Checks every output of a run before the run starts (the rules in the module doc). `inputs`
+/// are the files the run reads (a missing one is skipped: loading it will report it).
+pub fn check_outputs(outputs: &[Named], inputs: &[&Path]) -> Result<()> {
+    let id = |m: &std::fs::Metadata| (m.dev(), m.ino());
+    let inputs: Vec<((u64, u64), &Path)> =
+        inputs.iter().filter_map(|p| std::fs::metadata(p).ok().map(|m| (id(&m), *p))).collect();
+    let mut seen: Vec<((u64, u64), &str)> = Vec::new();
+    for &(flag, path) in outputs {
+        let fail = |msg: String| Error::Output { path: path.to_path_buf(), msg };
+        let target = match target(path).map_err(|e| fail(e.to_string()))? {
+            Target::Directory => return Err(fail(format!("{flag} names a directory"))),
+            Target::Direct => path.to_path_buf(),
+            Target::Replace(t) => t,
+        };
+        match std::fs::metadata(&target) {
+            Ok(m) => {
+                if let Some((_, input)) = inputs.iter().find(|(i, _)| *i == id(&m)) {
+                    return Err(fail(format!(
+                        "{flag} names the input {} (the same file); refusing to overwrite an input",
+                        input.display()
+                    )));
+                }
+                if let Some((_, other)) = seen.iter().find(|(i, _)| *i == id(&m)) {
+                    return Err(fail(format!("{flag} names the same file as {other}")));
+                }
+                if !m.is_file() {
+                    continue; // a device, FIFO or socket: written directly (and may repeat)
+                }
+                seen.push((id(&m), flag));
+                if target.starts_with("/proc") || target.starts_with("/dev") {
+                    continue; // written in place
+                }
+            }
+            Err(e) if e.kind() == std::io::ErrorKind::NotFound => {}
+            Err(e) => return Err(fail(e.to_string())),
+        }
+        let dir = dir_of(&target);
+        match std::fs::metadata(dir) {
+            Ok(m) if m.is_dir() => {}
+            Ok(_) => return Err(fail(format!("{} is not a directory", dir.display()))),
+            Err(e) => return Err(fail(format!("directory {}: {e}", dir.display()))),
+        }
+        // Writable: the only honest test is to create (and at once delete) a temporary there.
+        tempfile::NamedTempFile::new_in(dir)
+            .map_err(|e| fail(format!("directory {} is not writable: {e}", dir.display())))?;
+    }
     Ok(())
 }
 
@@ -48,6 +196,46 @@ fn resolve(path: &Path) -> std::io::Result<PathBuf> {
         }
     }
     Err(std::io::Error::other("too many levels of symbolic links"))
+}
+
+/// Writes what `fill` writes to the process's standard output (for the binary: the library
+/// itself never prints), through a buffer, and reports how it went: `Ok(true)` written,
+/// `Ok(false)` the reader went away (a broken pipe: quiet, as `head` expects), `Err` any other
+/// failure (a full disk or `/dev/full`, a closed stdout).
+///
+/// A closed standard output (`>&-`) is detected: the Rust runtime reopens a closed descriptor 1
+/// on `/dev/null` (read-write) at start-up, so every write would "succeed" and the report would
+/// be lost with exit code 0. A shell's `>/dev/null` opens it write-only and stays allowed.
+pub fn to_stdout(fill: impl FnOnce(&mut dyn Write) -> std::io::Result<()>) -> std::io::Result<bool> {
+    use std::os::fd::AsFd;
+    let stdout = std::io::stdout();
+    let mut lock = stdout.lock();
+    lock.flush()?;
+    if stdout_was_closed(&lock) {
+        return Err(std::io::Error::other("standard output is closed"));
+    }
+    let file = std::fs::File::from(lock.as_fd().try_clone_to_owned()?);
+    let mut w = BufWriter::with_capacity(1 << 16, file);
+    match fill(&mut w).and_then(|_| w.flush()) {
+        Ok(()) => Ok(true),
+        Err(e) if e.kind() == std::io::ErrorKind::BrokenPipe => Ok(false),
+        Err(e) => Err(e),
+    }
+}
+
+/// Whether descriptor 1 is the `/dev/null` the runtime opened read-write for a closed stdout.
+fn stdout_was_closed(fd: &impl std::os::fd::AsFd) -> bool {
+    let Ok(flags) = rustix::fs::fcntl_getfl(fd) else {
+        return true; // not even a descriptor
+    };
+    if !flags.contains(rustix::fs::OFlags::RDWR) {
+        return false;
+    }
+    let (Ok(ours), Ok(null)) = (rustix::fs::fstat(fd), std::fs::metadata("/dev/null")) else {
+        return false;
+    };
+    (rustix::fs::FileType::from_raw_mode(ours.st_mode) == rustix::fs::FileType::CharacterDevice)
+        && ours.st_rdev == null.rdev()
 }
 
 #[cfg(test)]
@@ -85,5 +273,92 @@ mod tests {
         write_file(&d.path().join("r.json"), b"report").unwrap();
         assert_eq!(std::fs::read(&victim).unwrap(), b"keep");
         assert_eq!(std::fs::read(d.path().join("r.json")).unwrap(), b"report");
+    }
+
+    fn names(d: &Path) -> Vec<String> {
+        let mut v: Vec<String> =
+            std::fs::read_dir(d).unwrap().map(|e| e.unwrap().file_name().to_string_lossy().into()).collect();
+        v.sort();
+        v
+    }
+
+    #[test]
+    fn staged_outputs_appear_only_on_commit_and_vanish_on_drop() {
+        let d = tempfile::tempdir().unwrap();
+        let (j, r) = (d.path().join("j.xml"), d.path().join("r.json"));
+        let mut s = Staged::new();
+        s.stage(&j, b"<x/>").unwrap();
+        s.stage_with(&r, |w| w.write_all(b"{}")).unwrap();
+        assert!(!j.exists() && !r.exists());
+        s.commit().unwrap();
+        assert_eq!(names(d.path()), ["j.xml", "r.json"]);
+        let mut s = Staged::new();
+        s.stage(&d.path().join("other.xml"), b"<x/>").unwrap();
+        drop(s); // a run that failed after staging
+        assert_eq!(names(d.path()), ["j.xml", "r.json"]);
+    }
+
+    #[test]
+    fn a_failing_fill_leaves_nothing() {
+        let d = tempfile::tempdir().unwrap();
+        let r = d.path().join("r.json");
+        let e = Staged::new().stage_with(&r, |_| Err(std::io::Error::other("boom"))).unwrap_err();
+        assert!(e.to_string().contains("boom"), "{e}");
+        assert!(names(d.path()).is_empty());
+    }
+
+    #[test]
+    fn output_that_is_an_input_is_refused_through_symlink_and_hard_link() {
+        let d = tempfile::tempdir().unwrap();
+        let input = d.path().join("a.obj");
+        std::fs::write(&input, b"v 0 0 0\n").unwrap();
+        let link = d.path().join("link.json");
+        std::os::unix::fs::symlink(&input, &link).unwrap();
+        let hard = d.path().join("hard.json");
+        std::fs::hard_link(&input, &hard).unwrap();
+        let dotted = d.path().join(".").join("a.obj");
+        for out in [&input, &link, &hard, &dotted] {
+            let e = check_outputs(&[("-o", out)], &[&input]).unwrap_err().to_string();
+            assert!(e.contains("names the input") && e.contains("a.obj"), "{}: {e}", out.display());
+        }
+        check_outputs(&[("-o", &d.path().join("r.json"))], &[&input]).unwrap();
+    }
+
+    #[test]
+    fn two_outputs_naming_one_file_are_refused() {
+        let d = tempfile::tempdir().unwrap();
+        let r = d.path().join("r.json");
+        std::fs::write(&r, b"old").unwrap();
+        let e = check_outputs(&[("-o", &r), ("--junit", &r)], &[]).unwrap_err().to_string();
+        assert!(e.contains("--junit names the same file as -o"), "{e}");
+    }
+
+    #[test]
+    fn dev_stdout_on_a_pipe_is_written_in_place() {
+        // A symlink chain to a pipe (`/dev/stdout` -> `/proc/self/fd/1` -> `pipe:[N]`) must not
+        // be resolved to a path to rename over.
+        let d = tempfile::tempdir().unwrap();
+        let fifo = d.path().join("f");
+        assert!(std::process::Command::new("mkfifo").arg(&fifo).status().unwrap().success());
+        let link = d.path().join("out.json");
+        std::os::unix::fs::symlink(&fifo, &link).unwrap();
+        check_outputs(&[("-o", &link)], &[]).unwrap();
+        let reader = std::thread::spawn({
+            let fifo = fifo.clone();
+            move || std::fs::read(fifo).unwrap()
+        });
+        write_file(&link, b"through").unwrap();
+        assert_eq!(reader.join().unwrap(), b"through");
+        assert!(std::fs::symlink_metadata(&link).unwrap().file_type().is_symlink());
+    }
+
+    #[test]
+    fn missing_directory_and_directory_targets_are_refused() {
+        let d = tempfile::tempdir().unwrap();
+        let e = check_outputs(&[("-o", &d.path().join("missing/r.json"))], &[]).unwrap_err().to_string();
+        assert!(e.contains("missing"), "{e}");
+        let e = check_outputs(&[("--junit", d.path())], &[]).unwrap_err().to_string();
+        assert!(e.contains("directory"), "{e}");
+        check_outputs(&[("-o", Path::new("/dev/null"))], &[]).unwrap();
     }
 }
