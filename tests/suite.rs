@@ -36,6 +36,8 @@ mod outputs;
 mod parry_oracle;
 #[path = "part_pairs.rs"]
 mod part_pairs;
+#[path = "safety.rs"]
+mod safety;
 #[path = "self_clash.rs"]
 mod self_clash;
 #[path = "tri_tri_oracle.rs"]
