@@ -179,10 +179,10 @@ pub fn finish(
         staged.stage(path, &glb::export(rep, meshes[0], meshes[1]))?;
     }
     if let Some(path) = &opts.html {
-        report::write_atomic(path, html::export(rep, result, meshes[0], meshes[1]).as_bytes())?;
+        staged.stage(path, html::export(rep, result, meshes[0], meshes[1]).as_bytes())?;
     }
     if let Some((path, topics)) = &opts.bcf {
-        report::write_atomic(path, &bcf::export(rep, result, meshes[0], meshes[1], *topics))?;
+        staged.stage(path, &bcf::export(rep, result, meshes[0], meshes[1], *topics))?;
     }
     Ok(())
 }
@@ -221,6 +221,12 @@ pub fn check_outputs(cfg: &crate::cli::Config) -> Result<()> {
     }
     if let Some(p) = &cfg.outputs.export_glb {
         outputs.push(("--export-glb", p));
+    }
+    if let Some(p) = &cfg.outputs.html {
+        outputs.push(("--html", p));
+    }
+    if let Some((p, _)) = &cfg.outputs.bcf {
+        outputs.push(("--bcf", p));
     }
     write::check_outputs(&outputs, &input_paths(cfg))
 }
