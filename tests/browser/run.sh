@@ -28,8 +28,10 @@ shots="$out/shots"
 mkdir -p "$shots"
 
 # check NAME ROWS -- meshclash arguments...   (ROWS: expected table rows, or - for any)
+pages=0
 check() {
   name=$1; rows=$2; shift 3
+  pages=$((pages + 1))
   set +e
   "$MESHCLASH" "$@" -q --no-timings --html "$out/$name.html" -o "$out/$name.json"
   code=$?
@@ -56,4 +58,4 @@ if [ "$update_docs" = 1 ]; then
   done
   echo "screenshots copied to docs/img/"
 fi
-echo "browser test: all passed"
+echo "browser: $pages passed, 0 failed"
