@@ -66,7 +66,7 @@ fn a_clean_cube_is_clear_closed_and_positive() {
     let (r, code) = run(&obj(dir.path(), "cube.obj", &CUBE_V, &cube_faces()), &[]);
     assert_eq!(code, 0);
     assert_eq!(r.schema, "meshclash.self/1");
-    assert_eq!((r.verdict.as_str(), r.failed), ("clear", false));
+    assert_eq!((r.verdict.name(), r.failed), ("clear", false));
     assert_eq!((r.summary.crossing_pairs, r.summary.touching_pairs, r.summary.open_parts), (0, 0, 0));
     let h = &r.parts[0].health;
     assert!(h.closed);
@@ -91,10 +91,10 @@ fn a_folded_strip_fails_with_its_crossing_pairs_listed() {
     let path = obj(dir.path(), "strip.obj", &v, &f);
     let (r, code) = run(&path, &[]);
     assert_eq!(code, 1);
-    assert_eq!((r.verdict.as_str(), r.failed_on.clone()), ("clash", vec!["self-clash".to_string()]));
+    assert_eq!((r.verdict.name(), r.failed_on.clone()), ("clash", vec!["self-clash".to_string()]));
     assert_eq!((r.summary.crossing_pairs, r.summary.touching_pairs), (2, 2));
     let listed: Vec<(u32, u32, &str, &str)> =
-        r.pairs.iter().map(|p| (p.a, p.b, p.kind.as_str(), p.contact.as_deref().unwrap())).collect();
+        r.pairs.iter().map(|p| (p.a, p.b, p.kind.name(), p.contact.unwrap().name())).collect();
     assert_eq!(
         listed,
         [

@@ -23,3 +23,45 @@ fn text_summary_names_volumes_overlap_instead_of_undecided() {
     assert!(text.contains("containment: the closed parts' volumes overlap"), "{text}");
     assert!(!text.contains("undecided"), "{text}");
 }
+
+/// glTF node translations were read as f32: a part placed at x = 0.1000000015 landed on the
+/// f32 value of 0.1, exactly where the other part ends, and was reported touching. The JSON
+/// number is now read as f64, so the report gives the exact f64 gap (~9.88e-12) and `clear`.
+#[test]
+fn gltf_node_translation_not_f32_exact_gives_the_f64_gap_not_touching() {
+    use base64::Engine as _;
+    let dir = tempfile::tempdir().unwrap();
+    let mut bin: Vec<u8> =
+        [0f32, 0., 0., 1., 0., 0., 0., 1., 0.].iter().flat_map(|x| x.to_le_bytes()).collect();
+    bin.extend([0u16, 1, 2, 0].iter().flat_map(|i| i.to_le_bytes()));
+    let gltf = format!(
+        r#"{{"asset":{{"version":"2.0"}},
+  "buffers":[{{"byteLength":44,"uri":"data:application/octet-stream;base64,{}"}}],
+  "bufferViews":[{{"buffer":0,"byteLength":36}},{{"buffer":0,"byteOffset":36,"byteLength":6}}],
+  "accessors":[{{"bufferView":0,"componentType":5126,"count":3,"type":"VEC3","min":[0,0,0],"max":[1,1,0]}},
+    {{"bufferView":1,"componentType":5123,"count":3,"type":"SCALAR"}}],
+  "meshes":[{{"primitives":[{{"attributes":{{"POSITION":0}},"indices":1}}]}}],
+  "nodes":[{{"mesh":0,"translation":[0.1000000015,0,0]}}]}}"#,
+        base64::engine::general_purpose::STANDARD.encode(&bin)
+    );
+    let a = dir.path().join("a.gltf");
+    std::fs::write(&a, gltf).unwrap();
+    // B: a triangle in the plane x = f32(0.1), across A's edge x = 0.1000000015, y in [0, 1]
+    let c = 0.1f32 as f64;
+    let b = dir.path().join("b.obj");
+    std::fs::write(&b, format!("v {c:?} -1 -1\nv {c:?} 3 -1\nv {c:?} 0.5 2\nf 1 2 3\n")).unwrap();
+    let out = Command::cargo_bin("meshclash")
+        .unwrap()
+        .arg(&a)
+        .arg(&b)
+        .args(["--no-timings", "--fail-on", "touching"])
+        .output()
+        .unwrap();
+    assert_eq!(out.status.code(), Some(0), "{}", String::from_utf8_lossy(&out.stderr));
+    let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    assert_eq!(v["verdict"], "clear");
+    let gap = 0.1000000015f64 - c;
+    assert!((9.8e-12..9.9e-12).contains(&gap));
+    assert_eq!(v["summary"]["min_distance"].as_f64(), Some(gap));
+    assert_eq!(v["summary"]["touching_pairs"], 0);
+}
