@@ -581,8 +581,8 @@ pub struct Outcome {
     pub stdout: Option<String>,
     /// Lines for stderr (warnings).
     pub warnings: Vec<String>,
-    /// 0 or 1.
-    pub exit_code: u8,
+    /// [`crate::error::ExitCode::Ok`] or [`crate::error::ExitCode::Findings`].
+    pub exit_code: crate::error::ExitCode,
     /// The finished report (for the human summary on a terminal).
     pub report: Box<report::Report>,
 }
@@ -615,7 +615,7 @@ fn run_in_pool(cfg: &Config, threads: usize, progress: &(dyn Fn(Phase) + Sync)) 
         report::write_atomic(path, json.as_bytes())?;
     }
     let stdout = crate::output::stdout_for(&cfg.outputs, &rep, &json, cfg.output.is_some());
-    let exit_code = rep.failed as u8;
+    let exit_code = crate::error::ExitCode::from_failed(rep.failed);
     Ok(Outcome { stdout, warnings, exit_code, report: Box::new(rep) })
 }
 

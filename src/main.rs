@@ -2,6 +2,7 @@
 
 use clap::Parser;
 use meshclash::cli::{self, Args};
+use meshclash::error::ExitCode as Code;
 use meshclash::output::progress::{self, Spinner};
 use meshclash::output::{text, Format};
 use std::io::{IsTerminal, Write};
@@ -11,11 +12,11 @@ fn main() -> ExitCode {
     let args = match Args::try_parse() {
         Ok(a) => a,
         Err(e) if e.use_stderr() => {
-            // Usage errors: one line, exit 2, like every other error.
+            // Usage errors: clap's whole message (the missing argument, the allowed values, the
+            // "did you mean" tip), under the one prefix every error has; exit 2.
             let msg = e.to_string();
-            let first = msg.lines().next().unwrap_or("bad arguments");
-            eprintln!("meshclash: {} (see --help)", first.trim_start_matches("error: ").trim());
-            return ExitCode::from(2);
+            eprintln!("meshclash: error: {}", msg.trim_start_matches("error: ").trim_end());
+            return Code::Error.into();
         }
         Err(e) => {
             let _ = e.print(); // --help, --version
@@ -37,7 +38,7 @@ fn main() -> ExitCode {
                 Ok(t) => t,
                 Err(e) => {
                     eprintln!("meshclash: error: {e}");
-                    return ExitCode::from(e.exit_code());
+                    return e.exit_code().into();
                 }
             },
         };
@@ -80,15 +81,15 @@ fn main() -> ExitCode {
                 if let Err(e) = so.write_all(json.as_bytes()).and_then(|_| so.flush()) {
                     if e.kind() != std::io::ErrorKind::BrokenPipe {
                         eprintln!("meshclash: error: cannot write to stdout: {e}");
-                        return ExitCode::from(2);
+                        return Code::Error.into();
                     }
                 }
             }
-            ExitCode::from(out.exit_code)
+            out.exit_code.into()
         }
         Err(e) => {
             eprintln!("meshclash: error: {e}");
-            ExitCode::from(e.exit_code())
+            e.exit_code().into()
         }
     }
 }
@@ -133,7 +134,7 @@ fn clash_set(set: meshclash::clash_set::ClashSetArgs) -> ExitCode {
         }
         Err(e) => {
             eprintln!("meshclash: error: {e}");
-            ExitCode::from(e.exit_code())
+            e.exit_code().into()
         }
     }
 }
@@ -144,7 +145,7 @@ fn print_stdout(text: &str) -> ExitCode {
     match so.write_all(text.as_bytes()).and_then(|_| so.flush()) {
         Err(e) if e.kind() != std::io::ErrorKind::BrokenPipe => {
             eprintln!("meshclash: error: cannot write to stdout: {e}");
-            ExitCode::from(2)
+            Code::Error.into()
         }
         _ => ExitCode::SUCCESS,
     }
@@ -171,7 +172,7 @@ fn self_check(args: meshclash::self_cmd::SelfArgs) -> ExitCode {
         }
         Err(e) => {
             eprintln!("meshclash: error: {e}");
-            ExitCode::from(e.exit_code())
+            e.exit_code().into()
         }
     }
 }

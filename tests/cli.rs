@@ -146,7 +146,10 @@ fn error_line(args: &[&str]) -> String {
     assert_eq!(out.status.code(), Some(2), "args {args:?}");
     assert!(out.stdout.is_empty());
     let err = String::from_utf8(out.stderr).unwrap();
-    assert_eq!(err.lines().count(), 1, "one line: {err}");
+    // One error, under the one prefix; a usage error found by clap keeps clap's whole message
+    // (allowed values, tips) on the lines after it.
+    assert!(err.starts_with("meshclash: error: "), "{err}");
+    assert_eq!(err.matches("error:").count(), 1, "one error: {err}");
     err
 }
 

@@ -65,3 +65,28 @@ fn gltf_node_translation_not_f32_exact_gives_the_f64_gap_not_touching() {
     assert_eq!(v["summary"]["min_distance"].as_f64(), Some(gap));
     assert_eq!(v["summary"]["touching_pairs"], 0);
 }
+
+fn usage_error(args: &[&str]) -> String {
+    let out = Command::cargo_bin("meshclash").unwrap().args(args).output().unwrap();
+    assert_eq!(out.status.code(), Some(2), "{args:?}");
+    assert!(out.stdout.is_empty());
+    String::from_utf8(out.stderr).unwrap()
+}
+
+/// Usage errors kept only clap's first line: the allowed values of `--fail-on` and the "did you
+/// mean" tip were cut off. Every error now starts with `meshclash: error:`.
+#[test]
+fn usage_errors_keep_allowed_values_and_did_you_mean_under_one_prefix() {
+    let e = usage_error(&["a.obj", "b.obj", "--fail-on", "clashes"]);
+    assert!(e.starts_with("meshclash: error: invalid value 'clashes' for '--fail-on"), "{e}");
+    assert!(e.contains("clash, touching, clearance, never, new"), "{e}");
+    let e = usage_error(&["a.obj", "b.obj", "--clearence", "1"]);
+    assert!(e.starts_with("meshclash: error: "), "{e}");
+    assert!(e.contains("--clearance"), "the did-you-mean tip is kept: {e}");
+    let e = usage_error(&["a.obj"]);
+    assert!(e.starts_with("meshclash: error: "), "{e}");
+    assert!(e.contains("<B>"), "the missing argument is named: {e}");
+    // a non-clap error has the same prefix
+    let e = usage_error(&["a.obj", "b.obj", "--leaf-size", "0"]);
+    assert!(e.starts_with("meshclash: error: "), "{e}");
+}
