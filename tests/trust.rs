@@ -90,3 +90,40 @@ fn usage_errors_keep_allowed_values_and_did_you_mean_under_one_prefix() {
     let e = usage_error(&["a.obj", "b.obj", "--leaf-size", "0"]);
     assert!(e.starts_with("meshclash: error: "), "{e}");
 }
+
+fn text_of(args: &[&std::ffi::OsStr]) -> String {
+    let out = Command::cargo_bin("meshclash")
+        .unwrap()
+        .args(args)
+        .args(["--format", "text", "--no-timings"])
+        .env("NO_COLOR", "1")
+        .output()
+        .unwrap();
+    assert!(matches!(out.status.code(), Some(0 | 1)), "{}", String::from_utf8_lossy(&out.stderr));
+    String::from_utf8(out.stdout).unwrap()
+}
+
+/// Scene-mode summaries said nothing about parts; a scene with no candidate part pairs said
+/// "an input has no triangles"; `--first-hit` counts did not say they are lower bounds.
+#[test]
+fn text_summary_names_clashing_part_pairs_candidates_and_first_hit_lower_bounds() {
+    let dir = tempfile::tempdir().unwrap();
+    // three parts: `bolt` crosses `plate`; `far` is far from both
+    let scene = dir.path().join("scene.obj");
+    std::fs::write(
+        &scene,
+        "o plate\nv 0 0 0\nv 4 0 0\nv 0 4 0\nf 1 2 3\n\
+         o bolt\nv 1 1 -1\nv 1.2 1 1\nv 1 1.2 1\nf 4 5 6\n\
+         o far\nv 100 0 0\nv 101 0 0\nv 100 1 0\nf 7 8 9\n",
+    )
+    .unwrap();
+    let t = text_of(&["scene".as_ref(), scene.as_os_str()]);
+    assert!(t.contains("1 clashing part pair:\n    plate x bolt  (1 crossing)"), "{t}");
+    // only `far` selected against nothing near it: no candidate part pairs
+    let t = text_of(&["scene".as_ref(), scene.as_os_str(), "--select-a".as_ref(), "far".as_ref()]);
+    assert!(!t.contains("an input has no triangles"), "{t}");
+    assert!(t.contains("closest: none (no candidate part pairs"), "{t}");
+    // --first-hit: lower bounds
+    let t = text_of(&["scene".as_ref(), scene.as_os_str(), "--first-hit".as_ref()]);
+    assert!(t.contains("at least 1 crossing") && t.contains("lower bounds"), "{t}");
+}
