@@ -597,7 +597,7 @@ pub fn summary(doc: &ClashSetReport) -> String {
             s,
             "{}: {} {} (--fail-on {}): {} crossing, {} touching, {} clearance pairs",
             c.name,
-            r.verdict.to_uppercase(),
+            r.verdict.name().to_uppercase(),
             if r.failed { "FAILED" } else { "passed" },
             r.settings.fail_on,
             m.crossing_pairs,

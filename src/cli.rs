@@ -594,8 +594,8 @@ pub struct Outcome {
     pub json_stdout: bool,
     /// Lines for stderr (warnings).
     pub warnings: Vec<String>,
-    /// 0 or 1.
-    pub exit_code: u8,
+    /// [`crate::error::ExitCode::Ok`] or [`crate::error::ExitCode::Findings`].
+    pub exit_code: crate::error::ExitCode,
     /// The finished report (for the human summary on a terminal).
     pub report: Box<report::Report>,
 }
@@ -630,7 +630,7 @@ fn run_in_pool(cfg: &Config, threads: usize, progress: &(dyn Fn(Phase) + Sync)) 
     }
     staged.commit()?;
     let (stdout, json_stdout) = crate::output::stdout_for(&cfg.outputs, &rep, cfg.output.is_some());
-    let exit_code = rep.failed as u8;
+    let exit_code = crate::error::ExitCode::from_failed(rep.failed);
     Ok(Outcome { stdout, json_stdout, warnings, exit_code, report: Box::new(rep) })
 }
 

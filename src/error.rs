@@ -32,9 +32,10 @@ impl Error {
         Error::Input { path: path.to_path_buf(), msg: msg.into() }
     }
 
-    /// The process exit code for this error (always 2: bad input, I/O or usage).
-    pub fn exit_code(&self) -> u8 {
-        2
+    /// The process exit code for this error (always [`ExitCode::Error`]: bad input, I/O or
+    /// usage).
+    pub fn exit_code(&self) -> ExitCode {
+        ExitCode::Error
     }
 }
 
@@ -55,6 +56,39 @@ impl std::error::Error for Error {}
 /// Messages from third-party parsers may span lines; the contract is one line.
 fn one_line(s: &str) -> String {
     s.split_whitespace().collect::<Vec<_>>().join(" ")
+}
+
+/// The process exit codes, the contract with CI scripts.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum ExitCode {
+    /// 0: nothing at or above `--fail-on`.
+    Ok = 0,
+    /// 1: findings at or above `--fail-on`.
+    Findings = 1,
+    /// 2: bad input, I/O or usage error.
+    Error = 2,
+}
+
+impl ExitCode {
+    /// [`ExitCode::Findings`] if the run failed its `--fail-on`, else [`ExitCode::Ok`].
+    pub fn from_failed(failed: bool) -> Self {
+        if failed {
+            ExitCode::Findings
+        } else {
+            ExitCode::Ok
+        }
+    }
+
+    /// The number.
+    pub fn code(self) -> u8 {
+        self as u8
+    }
+}
+
+impl From<ExitCode> for std::process::ExitCode {
+    fn from(c: ExitCode) -> Self {
+        std::process::ExitCode::from(c.code())
+    }
 }
 
 /// Shorthand for results in this crate.

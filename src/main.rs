@@ -2,6 +2,7 @@
 
 use clap::Parser;
 use meshclash::cli::{self, Args};
+use meshclash::error::ExitCode as Code;
 use meshclash::output::progress::{self, Spinner};
 use meshclash::output::write;
 use meshclash::output::{text, Format};
@@ -12,11 +13,11 @@ fn main() -> ExitCode {
     let args = match Args::try_parse() {
         Ok(a) => a,
         Err(e) if e.use_stderr() => {
-            // Usage errors: one line, exit 2, like every other error.
+            // Usage errors: clap's whole message (the missing argument, the allowed values, the
+            // "did you mean" tip), under the one prefix every error has; exit 2.
             let msg = e.to_string();
-            let first = msg.lines().next().unwrap_or("bad arguments");
-            eprintln!("meshclash: {} (see --help)", first.trim_start_matches("error: ").trim());
-            return ExitCode::from(2);
+            eprintln!("meshclash: error: {}", msg.trim_start_matches("error: ").trim_end());
+            return Code::Error.into();
         }
         Err(e) => {
             let _ = e.print(); // --help, --version
@@ -75,13 +76,13 @@ fn main() -> ExitCode {
             };
             if let Err(e) = written {
                 eprintln!("meshclash: error: cannot write to stdout: {e}");
-                return ExitCode::from(2);
+                return Code::Error.into();
             }
-            ExitCode::from(out.exit_code)
+            out.exit_code.into()
         }
         Err(e) => {
             eprintln!("meshclash: error: {e}");
-            ExitCode::from(e.exit_code())
+            e.exit_code().into()
         }
     }
 }
@@ -126,7 +127,7 @@ fn clash_set(set: meshclash::clash_set::ClashSetArgs) -> ExitCode {
         }
         Err(e) => {
             eprintln!("meshclash: error: {e}");
-            ExitCode::from(e.exit_code())
+            e.exit_code().into()
         }
     }
 }
@@ -136,7 +137,7 @@ fn print_stdout(text: &str) -> ExitCode {
     match write::to_stdout(|w| w.write_all(text.as_bytes())) {
         Err(e) => {
             eprintln!("meshclash: error: cannot write to stdout: {e}");
-            ExitCode::from(2)
+            Code::Error.into()
         }
         Ok(_) => ExitCode::SUCCESS,
     }
@@ -163,7 +164,7 @@ fn self_check(args: meshclash::self_cmd::SelfArgs) -> ExitCode {
         }
         Err(e) => {
             eprintln!("meshclash: error: {e}");
-            ExitCode::from(e.exit_code())
+            e.exit_code().into()
         }
     }
 }

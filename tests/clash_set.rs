@@ -102,11 +102,11 @@ fn each_check_reports_exactly_what_its_command_line_reports() {
     // robot clash; the six dowels of pins.glb stand apart; multibody's two blocks are 0.507
     // apart, so copies 1000 up are far beyond contact but within a 2000 clearance.
     let [env, dowels, multi] = [&doc.checks[0].report, &doc.checks[1].report, &doc.checks[2].report];
-    assert_eq!((env.verdict.as_str(), env.failed, env.pairs.len()), ("clash", true, 20));
+    assert_eq!((env.verdict.name(), env.failed, env.pairs.len()), ("clash", true, 20));
     assert!(env.pairs_truncated);
-    assert_eq!((dowels.verdict.as_str(), dowels.failed), ("clear", false));
+    assert_eq!((dowels.verdict.name(), dowels.failed), ("clear", false));
     assert_eq!(dowels.assembly.mode, "parts");
-    assert_eq!((multi.verdict.as_str(), multi.failed), ("clearance", false));
+    assert_eq!((multi.verdict.name(), multi.failed), ("clearance", false));
 }
 
 #[test]

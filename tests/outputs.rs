@@ -284,7 +284,7 @@ fn fail_on_new_counts_new_containment_and_needs_a_baseline() {
     let out = bin().args([&a, &inside, "-q", "--fail-on", "new", "--baseline"]).arg(&base).output().unwrap();
     assert_eq!(out.status.code(), Some(1));
     let r = report(&out.stdout);
-    assert_eq!(r.summary.contained.as_deref(), Some("b_in_a"));
+    assert_eq!(r.summary.contained.map(|c| c.name()), Some("b_in_a"));
     let b = r.baseline.unwrap();
     assert!(b.new_containment);
     assert_eq!(b.new_crossing, 0);

@@ -22,10 +22,10 @@ mod extremes;
 mod fcl_reference;
 #[path = "gltf_ext.rs"]
 mod gltf_ext;
-#[path = "html.rs"]
-mod html;
 #[path = "hostile.rs"]
 mod hostile;
+#[path = "html.rs"]
+mod html;
 #[path = "layers.rs"]
 mod layers;
 #[path = "obj_vs_tobj.rs"]

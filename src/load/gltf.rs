@@ -16,7 +16,11 @@
 //! - **Scene**: the default scene, else the first scene, else every root node (a node that is
 //!   nobody's child). The hierarchy is walked iteratively; a node with two parents, a cycle,
 //!   or more than [`MAX_DEPTH`] levels is an error. World = parent × local, computed in f64
-//!   (the node `matrix`, or translation × rotation (normalised quaternion) × scale).
+//!   (the node `matrix`, or translation × rotation (normalised quaternion) × scale). Every node
+//!   `matrix`/`translation`/`rotation`/`scale` number is read from the JSON as f64 (the decimal
+//!   correctly rounded once to f64; the `gltf` crate's own copy is f32, which would move a part
+//!   by up to half an f32 ulp of its placement). Binary accessor data (`KHR_mesh_quantization`
+//!   positions, `EXT_mesh_gpu_instancing` attributes) is used as stored.
 //! - **Primitives**: modes TRIANGLES, TRIANGLE_STRIP (triangle `i` is `(i, i+1, i+2)`, with the
 //!   last two swapped for odd `i` to keep the winding) and TRIANGLE_FAN (`(0, i+1, i+2)`),
 //!   indexed (u8/u16/u32) or not. POINTS/LINES/LINE_LOOP/LINE_STRIP are skipped with a warning.
@@ -65,7 +69,8 @@ use ::gltf::{Accessor, Document};
 use glam::{DMat4, DQuat, DVec3};
 
 use super::gltf_data::{
-    load_buffers, parse_document, parse_extensions, split_glb, Extensions, GpuInstancing, Reader,
+    load_buffers, parse_document, parse_extensions, split_glb, Extensions, GpuInstancing, NodeTransform,
+    Reader,
 };
 use crate::error::{Error, Result};
 use crate::scene::mesh::{Loaded, Mesh, Object};
@@ -379,7 +384,8 @@ fn traverse(
         chain.truncate(depth - 1);
         chain.push(i);
         let node = &nodes[i];
-        let world = parent_world * local_matrix(path, node)?;
+        let exact = ext.transforms.get(i).and_then(Option::as_ref);
+        let world = parent_world * local_matrix(path, node, exact)?;
         if !world.is_finite() {
             return Err(err(format!("glTF node {i}: world transform is not finite (overflow)")));
         }
@@ -428,32 +434,43 @@ fn find_cycle(parent: &[Option<usize>]) -> Option<usize> {
     None
 }
 
-/// The node's local matrix in f64.
-fn local_matrix(path: &Path, node: &::gltf::Node) -> Result<DMat4> {
+/// The node's local matrix in f64, from the numbers of the JSON read as f64 (`exact`, from
+/// [`Extensions::transforms`]); the `gltf` crate's f32 copy only when that is missing.
+fn local_matrix(path: &Path, node: &::gltf::Node, exact: Option<&NodeTransform>) -> Result<DMat4> {
     let bad = |what: &str| Error::input(path, format!("glTF node {} has {what}", node.index()));
-    match node.transform() {
-        Transform::Matrix { matrix } => {
-            let cols = matrix.map(|c| c.map(f64::from));
-            if cols.iter().flatten().any(|x| !x.is_finite()) {
+    let widened;
+    let transform = match exact {
+        Some(t) => t,
+        None => {
+            widened = match node.transform() {
+                Transform::Matrix { matrix } => {
+                    let cols = matrix.map(|c| c.map(f64::from));
+                    NodeTransform::Matrix(std::array::from_fn(|k| cols[k / 4][k % 4]))
+                }
+                Transform::Decomposed { translation: t, rotation: r, scale: s } => {
+                    NodeTransform::Trs { t: t.map(f64::from), r: r.map(f64::from), s: s.map(f64::from) }
+                }
+            };
+            &widened
+        }
+    };
+    match transform {
+        NodeTransform::Matrix(m) => {
+            if m.iter().any(|x| !x.is_finite()) {
                 return Err(bad("a non-finite matrix"));
             }
-            Ok(DMat4::from_cols_array_2d(&cols))
+            Ok(DMat4::from_cols_array(m))
         }
-        Transform::Decomposed { translation: t, rotation: r, scale: s } => {
-            let all = t.iter().chain(&r).chain(&s);
-            if all.map(|&x| f64::from(x)).any(|x| !x.is_finite()) {
+        NodeTransform::Trs { t, r, s } => {
+            if t.iter().chain(r).chain(s).any(|x| !x.is_finite()) {
                 return Err(bad("a non-finite translation, rotation or scale"));
             }
-            let q = DQuat::from_xyzw(r[0].into(), r[1].into(), r[2].into(), r[3].into());
+            let q = DQuat::from_array(*r);
             let len = q.length();
             if len == 0.0 || !len.is_finite() {
                 return Err(bad("a zero rotation quaternion"));
             }
-            Ok(DMat4::from_scale_rotation_translation(
-                DVec3::new(s[0].into(), s[1].into(), s[2].into()),
-                q / len,
-                DVec3::new(t[0].into(), t[1].into(), t[2].into()),
-            ))
+            Ok(DMat4::from_scale_rotation_translation(DVec3::from_array(*s), q / len, DVec3::from_array(*t)))
         }
     }
 }

@@ -206,10 +206,13 @@ pub(crate) struct GpuInstancing {
 pub(crate) struct Extensions {
     /// By node index; `None` for nodes without `EXT_mesh_gpu_instancing`.
     pub instancing: Vec<Option<GpuInstancing>>,
+    /// By node index: the local transform read as f64 from the JSON.
+    pub transforms: Vec<Option<NodeTransform>>,
 }
 
 /// Serde view of the parts of the glTF JSON the `gltf` crate (without its `extensions`
-/// feature) drops; every other member is skipped unparsed.
+/// feature) drops or rounds (node transforms, which it stores as f32); every other member is
+/// skipped unparsed.
 #[derive(serde::Deserialize, Default)]
 #[serde(default)]
 struct ExtRoot {
@@ -220,6 +223,51 @@ struct ExtRoot {
 #[serde(default)]
 struct ExtNode {
     extensions: Option<ExtNodeExtensions>,
+    /// The node transform as the JSON writes it, in f64 (the `gltf` crate keeps f32).
+    matrix: Option<Vec<f64>>,
+    translation: Option<Vec<f64>>,
+    rotation: Option<Vec<f64>>,
+    scale: Option<Vec<f64>>,
+}
+
+/// A node's local transform as written in the JSON, every number read as f64 (serde_json
+/// parses JSON numbers correctly rounded to f64; the `gltf` crate rounds them again to f32,
+/// which moves a part by up to half an f32 ulp of its translation).
+#[derive(Debug, Clone, PartialEq)]
+pub(crate) enum NodeTransform {
+    /// `matrix`: 16 numbers, column-major (it wins over translation/rotation/scale, as in the
+    /// `gltf` crate).
+    Matrix([f64; 16]),
+    /// `translation`, `rotation` (x, y, z, w), `scale`; missing members are the identity.
+    Trs {
+        /// Translation.
+        t: [f64; 3],
+        /// Rotation quaternion (x, y, z, w), as written (not normalised).
+        r: [f64; 4],
+        /// Scale.
+        s: [f64; 3],
+    },
+}
+
+impl ExtNode {
+    /// The f64 transform; None if a member has the wrong length (the `gltf` crate's
+    /// validation has already refused such files).
+    fn transform(&self) -> Option<NodeTransform> {
+        fn arr<const N: usize>(v: &Option<Vec<f64>>, default: [f64; N]) -> Option<[f64; N]> {
+            match v {
+                None => Some(default),
+                Some(v) => v.as_slice().try_into().ok(),
+            }
+        }
+        if let Some(m) = &self.matrix {
+            return m.as_slice().try_into().ok().map(NodeTransform::Matrix);
+        }
+        Some(NodeTransform::Trs {
+            t: arr(&self.translation, [0.0; 3])?,
+            r: arr(&self.rotation, [0.0, 0.0, 0.0, 1.0])?,
+            s: arr(&self.scale, [1.0; 3])?,
+        })
+    }
 }
 
 #[derive(serde::Deserialize, Default)]
@@ -239,6 +287,7 @@ pub(crate) fn parse_extensions(path: &Path, json: &[u8], accessors: usize) -> Re
         .map_err(|e| Error::input(path, format!("invalid glTF JSON: {e}")))?;
     let mut out = Extensions::default();
     for (i, node) in root.nodes.into_iter().enumerate() {
+        out.transforms.push(node.transform());
         let gpu = match node.extensions.and_then(|e| e.gpu_instancing) {
             Some(v) => Some(gpu_instancing(path, i, &v, accessors)?),
             None => None,

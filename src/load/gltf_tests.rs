@@ -978,3 +978,28 @@ fn mutated_extension_documents_never_panic() {
         }
     }
 }
+
+/// Node transforms were read through the `gltf` crate as f32: `0.1000000015` became the f32
+/// value of 0.1 and `1000.0000000001` became 1000, moving the part.
+#[test]
+fn node_transforms_are_read_as_f64_not_f32() {
+    let t = 0.1000000015f64;
+    assert_eq!(t as f32 as f64, 0.1f32 as f64, "the test needs a value f32 rounds away");
+    let l = ok(&tri_doc(r#""nodes":[{"mesh":0,"translation":[0.1000000015,0,0]}]"#));
+    assert_eq!(l.mesh.positions[0], DVec3::new(t, 0.0, 0.0));
+    // matrix: column-major, a ×1000.0000000001 scale and a translation that f32 cannot hold
+    let l = ok(&tri_doc(
+        r#""nodes":[{"mesh":0,"matrix":[1000.0000000001,0,0,0, 0,1,0,0, 0,0,1,0, 0.1000000015,0,0,1]}]"#,
+    ));
+    assert_eq!(l.mesh.positions[1], DVec3::new(1000.0000000001 + t, 0.0, 0.0));
+    // rotation and scale: f64 too (the quaternion normalised in f64)
+    let l =
+        ok(&tri_doc(r#""nodes":[{"mesh":0,"scale":[1.0000000001,1,1],"rotation":[0,0,0,1.0000000001]}]"#));
+    assert_eq!(l.mesh.positions[1].x, 1.0000000001);
+    // a parent's f64 translation composes with the child's in f64
+    let l = ok(&tri_doc(
+        r#""nodes":[{"children":[1],"translation":[0.1000000015,0,0]},{"mesh":0,"translation":[0,0.1000000015,0]}],
+        "scenes":[{"nodes":[0]}]"#,
+    ));
+    assert_eq!(l.mesh.positions[0], DVec3::new(t, t, 0.0));
+}

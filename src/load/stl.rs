@@ -55,6 +55,36 @@ fn contains_ignore_case(hay: &[u8], needle: &[u8]) -> bool {
     hay.windows(needle.len()).any(|w| w.eq_ignore_ascii_case(needle))
 }
 
+/// What a file that is not STL looks like, from its first bytes: a known binary magic number,
+/// or text that reads as OBJ or glTF JSON.
+fn looks_like(bytes: &[u8]) -> Option<&'static str> {
+    const MAGIC: [(&[u8], &str); 7] = [
+        (b"\x89PNG\r\n\x1a\n", "PNG"),
+        (b"glTF", "GLB (binary glTF)"),
+        (b"\xff\xd8\xff", "JPEG"),
+        (b"PK\x03\x04", "ZIP"),
+        (b"\x1f\x8b", "gzip"),
+        (b"%PDF", "PDF"),
+        (b"ply", "PLY"),
+    ];
+    if let Some((_, kind)) = MAGIC.iter().find(|(m, _)| bytes.starts_with(m)) {
+        return Some(kind);
+    }
+    let head = &bytes[..bytes.len().min(4096)];
+    let text = std::str::from_utf8(head).ok().or_else(|| {
+        // a multi-byte character cut at the end of the window
+        std::str::from_utf8(&head[..head.len().saturating_sub(3)]).ok()
+    })?;
+    let t = text.trim_start();
+    if t.starts_with('{') {
+        return Some("glTF JSON");
+    }
+    let obj = t.lines().map(str::trim_start).any(|l| {
+        ["v ", "vn ", "vt ", "f ", "o ", "g ", "mtllib ", "usemtl "].iter().any(|k| l.starts_with(k))
+    });
+    obj.then_some("OBJ")
+}
+
 /// Errors unless `bytes` is an exactly-sized binary STL or looks like ASCII STL.
 pub(crate) fn check_viable(path: &Path, bytes: &[u8]) -> Result<()> {
     if bytes.is_empty() {
@@ -62,6 +92,9 @@ pub(crate) fn check_viable(path: &Path, bytes: &[u8]) -> Result<()> {
     }
     if is_binary(bytes) || looks_ascii(bytes) {
         return Ok(());
+    }
+    if let Some(kind) = looks_like(bytes) {
+        return Err(Error::input(path, format!("not an STL file (looks like {kind})")));
     }
     let have = bytes.len();
     Err(Error::input(
@@ -452,5 +485,22 @@ mod tests {
             let zmax = l.mesh.positions.iter().map(|p| p.z).fold(f64::MIN, f64::max);
             assert!((255.0..257.0).contains(&zmin) && (281.0..282.5).contains(&zmax), "{zmin} {zmax}");
         }
+    }
+
+    /// A PNG, GLB or OBJ renamed `.stl` got "truncated binary STL: header declares 479199460
+    /// triangles"; it now says what the file looks like.
+    #[test]
+    fn not_an_stl_file_says_what_it_looks_like() {
+        let p = std::path::Path::new("x.stl");
+        let mut png = b"\x89PNG\r\n\x1a\n".to_vec();
+        png.resize(300, 7);
+        let e = check_viable(p, &png).unwrap_err().to_string();
+        assert_eq!(e, "x.stl: not an STL file (looks like PNG)");
+        let mut glb = b"glTF\x02\0\0\0".to_vec();
+        glb.resize(200, 0);
+        assert!(check_viable(p, &glb).unwrap_err().to_string().ends_with("(looks like GLB (binary glTF))"));
+        let mut obj = b"# exported\nmtllib a.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n".to_vec();
+        obj.resize(200, b' ');
+        assert!(check_viable(p, &obj).unwrap_err().to_string().ends_with("(looks like OBJ)"));
     }
 }

@@ -14,7 +14,7 @@
 //! Highlight and marker nodes are present only when they have something to show. Only the
 //! report's listed pairs are drawn (`--max-pairs`).
 
-use crate::report::Report;
+use crate::report::{Report, ReportPairKind};
 use crate::scene::mesh::Mesh;
 use glam::DVec3;
 use serde_json::{json, Value};
@@ -158,9 +158,9 @@ pub fn export(r: &Report, a: &Mesh, b: &Mesh) -> Vec<u8> {
     }
 
     for (kind, name, mat) in [
-        ("crossing", "crossing pairs", CROSSING),
-        ("touching", "touching pairs", TOUCHING),
-        ("clearance", "clearance pairs", CLEARANCE),
+        (ReportPairKind::Crossing, "crossing pairs", CROSSING),
+        (ReportPairKind::Touching, "touching pairs", TOUCHING),
+        (ReportPairKind::Clearance, "clearance pairs", CLEARANCE),
     ] {
         let pairs = r.pairs.iter().filter(|p| p.kind == kind);
         let ta: BTreeSet<u32> = pairs.clone().map(|p| p.a).collect();
@@ -189,7 +189,7 @@ pub fn export(r: &Report, a: &Mesh, b: &Mesh) -> Vec<u8> {
     let crossings: Vec<[f64; 3]> = r
         .pairs
         .iter()
-        .filter(|p| p.kind == "crossing")
+        .filter(|p| p.kind == ReportPairKind::Crossing)
         .filter_map(|p| p.segment.map(|[s, t]| [0, 1, 2].map(|k| (s[k] + t[k]) * 0.5)))
         .collect();
     if !crossings.is_empty() {

@@ -18,6 +18,7 @@
 use crate::check::query::{ClashResult, PairKind};
 use crate::geom::Aabb;
 use crate::report::Report;
+use crate::report::{ReportContainment, ReportVerdict};
 use crate::scene::mesh::Mesh;
 use base64::Engine;
 use glam::DVec3;
@@ -124,7 +125,7 @@ pub fn export(rep: &Report, result: &ClashResult, a: &Mesh, b: &Mesh) -> String 
     page(
         PageInput {
             title,
-            verdict: rep.verdict.clone(),
+            verdict: rep.verdict.name().to_string(),
             failed: rep.failed,
             units: rep.settings.units.clone(),
             up: if rep.inputs.a.format == "stl" { "z" } else { "y" }.into(),
@@ -220,11 +221,11 @@ pub fn clashes(rep: &Report, result: &ClashResult, a: &Mesh, b: &Mesh) -> Clashe
         if covered.contains(&(ka, kb)) {
             continue;
         }
-        let kind = match pp.contained.as_deref() {
-            Some("volumes_overlap") => "volumes overlap",
-            Some("undecided") | None => match pp.verdict.as_str() {
-                "clash" => "crossing",
-                v => v,
+        let kind = match pp.contained {
+            Some(ReportContainment::VolumesOverlap) => "volumes overlap",
+            Some(ReportContainment::Undecided) | None => match pp.verdict {
+                ReportVerdict::Clash => "crossing",
+                v => v.name(),
             },
             Some(_) => "contained",
         };
@@ -266,9 +267,9 @@ pub fn clashes(rep: &Report, result: &ClashResult, a: &Mesh, b: &Mesh) -> Clashe
     // other, decided for the inputs as a whole), so the page still shows where.
     if rows.is_empty() {
         if let Some(c) = &rep.closest {
-            let kind = match rep.summary.contained.as_deref() {
-                Some("volumes_overlap") => "volumes overlap",
-                Some("undecided") | None => "closest",
+            let kind = match rep.summary.contained {
+                Some(ReportContainment::VolumesOverlap) => "volumes overlap",
+                Some(ReportContainment::Undecided) | None => "closest",
                 Some(_) => "contained",
             };
             let (p, q) = (DVec3::from_array(c.a.point), DVec3::from_array(c.b.point));

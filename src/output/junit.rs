@@ -3,7 +3,7 @@
 //! list so part pairs can be added), with a `<failure>` when that case fails the run, whose
 //! message gives the counts and the first findings.
 
-use crate::report::Report;
+use crate::report::{Report, ReportPairKind, ReportVerdict};
 use std::fmt::Write;
 
 /// How many findings a failure lists.
@@ -121,7 +121,7 @@ pub fn cases(r: &Report) -> Vec<Case> {
     let worst = super::text::worst(r);
     let mut cases = vec![Case {
         name: format!("{} vs {}", r.inputs.a.path, r.inputs.b.path),
-        verdict: r.verdict.clone(),
+        verdict: r.verdict.name().into(),
         counts,
         findings: worst.iter().take(FIRST).map(|p| super::text::pair_line(r, p)).collect(),
         total: m.crossing_pairs + m.touching_pairs + m.clearance_pairs,
@@ -139,15 +139,11 @@ pub fn cases(r: &Report) -> Vec<Case> {
 /// One case per part pair with a finding (assemblies), after the whole-run case, so CI
 /// dashboards show which parts clash with which.
 fn part_pair_cases(r: &Report) -> Vec<Case> {
-    let fails = |verdict: &str, new_crossing: bool| -> bool {
-        let v = crate::report::verdict_from_name(verdict);
+    let fails = |verdict: ReportVerdict, new_crossing: bool| -> bool {
         match r.settings.fail_on.as_str() {
             "never" => false,
             "new" => new_crossing,
-            level => match (v, crate::report::verdict_from_name(level)) {
-                (Some(v), Some(l)) => v >= l,
-                _ => false,
-            },
+            level => crate::report::verdict_from_name(level).is_some_and(|l| verdict.verdict() >= l),
         }
     };
     r.part_pairs
@@ -163,7 +159,7 @@ fn part_pair_cases(r: &Report) -> Vec<Case> {
                 })
                 .collect();
             let new_crossing =
-                mine.iter().any(|p| p.kind == "crossing" && p.status.as_deref() == Some("new"));
+                mine.iter().any(|p| p.kind == ReportPairKind::Crossing && p.status.as_deref() == Some("new"));
             let mut counts = format!(
                 "{} crossing, {} touching, {} clearance pairs",
                 pp.crossing_pairs, pp.touching_pairs, pp.clearance_pairs
@@ -173,11 +169,11 @@ fn part_pair_cases(r: &Report) -> Vec<Case> {
             }
             Case {
                 name: format!("{} vs {}", pp.a_name, pp.b_name),
-                verdict: pp.verdict.clone(),
+                verdict: pp.verdict.name().into(),
                 counts,
                 findings: mine.iter().take(FIRST).map(|p| super::text::pair_line(r, p)).collect(),
                 total: pp.crossing_pairs + pp.touching_pairs + pp.clearance_pairs,
-                failed: fails(&pp.verdict, new_crossing),
+                failed: fails(pp.verdict, new_crossing),
                 time_s: 0.0,
                 output: String::new(),
             }

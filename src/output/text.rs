@@ -2,7 +2,7 @@
 //! whether the run failed, the two inputs, counts, the closest points, containment, the worst
 //! findings, the baseline comparison, timings and warnings. ANSI colours only when asked for.
 
-use crate::report::{PairReport, Report};
+use crate::report::{PairReport, Report, ReportContact, ReportContainment, ReportPairKind, ReportVerdict};
 use std::fmt::Write;
 
 /// How many findings the summary lists.
@@ -55,11 +55,11 @@ fn point(p: &[f64; 3]) -> String {
 }
 
 fn severity(p: &PairReport) -> (u8, f64) {
-    let rank = match (p.kind.as_str(), p.contact.as_deref()) {
-        ("crossing", _) => 0,
-        ("touching", Some("within_tolerance")) => 2,
-        ("touching", _) => 1,
-        _ => 3,
+    let rank = match (p.kind, p.contact) {
+        (ReportPairKind::Crossing, _) => 0,
+        (ReportPairKind::Touching, Some(ReportContact::WithinTolerance)) => 2,
+        (ReportPairKind::Touching, _) => 1,
+        (ReportPairKind::Clearance, _) => 3,
     };
     (rank, p.distance)
 }
@@ -144,22 +144,81 @@ fn units_line(r: &Report) -> Option<String> {
     Some(format!("units: {} ({}; {})", r.settings.units, side("A", ua), side("B", ub)))
 }
 
+/// What containment means, for a person.
+fn containment_text(c: ReportContainment) -> &'static str {
+    match c {
+        ReportContainment::AInB => "A lies inside B",
+        ReportContainment::BInA => "B lies inside A",
+        ReportContainment::APartlyInB => "part of A lies inside B",
+        ReportContainment::BPartlyInA => "part of B lies inside A",
+        ReportContainment::VolumesOverlap => {
+            "the closed parts' volumes overlap (faces in contact enclose shared volume)"
+        }
+        ReportContainment::Undecided => "undecided",
+    }
+}
+
+/// Why there is no closest pair.
+fn closest_none(r: &Report) -> &'static str {
+    if r.settings.first_hit {
+        "  closest: not computed (--first-hit)\n"
+    } else if r.assembly.mode == "parts" && r.assembly.candidate_part_pairs == 0 {
+        "  closest: none (no candidate part pairs: no two selected parts come within the search margin)\n"
+    } else {
+        "  closest: none (an input has no triangles)\n"
+    }
+}
+
+/// How many clashing part pairs the summary names.
+pub const WORST_PART_PAIRS: usize = 5;
+
+/// The part pairs with a clash (crossing or containment), when the inputs have more than one
+/// part on a side: their count and the worst few by name (most crossing pairs first, then
+/// containment, then by index).
+fn part_pairs(s: &mut String, c: &Paint, r: &Report) {
+    let multi = r.inputs.a.objects.len() > 1 || r.inputs.b.objects.len() > 1 || r.assembly.mode == "parts";
+    let mut clashing: Vec<&crate::report::PartPairReport> =
+        r.part_pairs.iter().filter(|p| p.verdict == ReportVerdict::Clash).collect();
+    if !multi || clashing.is_empty() {
+        return;
+    }
+    clashing.sort_by(|x, y| y.crossing_pairs.cmp(&x.crossing_pairs).then((x.a, x.b).cmp(&(y.a, y.b))));
+    let _ = writeln!(
+        s,
+        "  {} clashing part pair{}{}:",
+        c.p(RED, &clashing.len().to_string()),
+        if clashing.len() == 1 { "" } else { "s" },
+        if clashing.len() > WORST_PART_PAIRS {
+            format!(" (worst {WORST_PART_PAIRS})")
+        } else {
+            String::new()
+        }
+    );
+    for p in clashing.iter().take(WORST_PART_PAIRS) {
+        let mut what = format!("{} crossing", p.crossing_pairs);
+        if let Some(ct) = p.contained {
+            let _ = write!(what, ", {}", ct.name());
+        }
+        let _ = writeln!(s, "    {} x {}  ({what})", p.a_name, p.b_name);
+    }
+}
+
 /// The summary, several lines ending in a newline; coloured with ANSI escapes if `color`.
 pub fn render(r: &Report, color: bool) -> String {
     let c = Paint(color);
     let mut s = String::new();
-    let verdict_style = match r.verdict.as_str() {
-        "clash" => RED,
-        "touching" => ORANGE,
-        "clearance" => YELLOW,
-        _ => GREEN,
+    let verdict_style = match r.verdict {
+        ReportVerdict::Clash => RED,
+        ReportVerdict::Touching => ORANGE,
+        ReportVerdict::Clearance => YELLOW,
+        ReportVerdict::Clear => GREEN,
     };
     let outcome = if r.failed {
         c.p(RED, &format!("FAILED (--fail-on {})", r.settings.fail_on))
     } else {
         c.p(GREEN, &format!("passed (--fail-on {})", r.settings.fail_on))
     };
-    let _ = writeln!(s, "meshclash: {}  {}", c.p(verdict_style, &r.verdict.to_uppercase()), outcome);
+    let _ = writeln!(s, "meshclash: {}  {}", c.p(verdict_style, &r.verdict.name().to_uppercase()), outcome);
     for (name, i) in [("A", &r.inputs.a), ("B", &r.inputs.b)] {
         let _ = writeln!(
             s,
@@ -179,12 +238,20 @@ pub fn render(r: &Report, color: bool) -> String {
     let m = &r.summary;
     let _ = writeln!(
         s,
-        "  {} crossing, {} touching ({} within tolerance), {} clearance pairs{}",
+        "  {}{} crossing, {} touching ({} within tolerance), {} clearance pairs{}",
+        if r.settings.first_hit { "at least " } else { "" },
         c.p(if m.crossing_pairs > 0 { RED } else { BOLD }, &m.crossing_pairs.to_string()),
         c.p(if m.touching_pairs > 0 { ORANGE } else { BOLD }, &m.touching_pairs.to_string()),
         m.within_tolerance_pairs,
         c.p(if m.clearance_pairs > 0 { YELLOW } else { BOLD }, &m.clearance_pairs.to_string()),
-        if r.pairs_truncated { format!(" ({} listed)", r.pairs.len()) } else { String::new() }
+        if r.settings.first_hit {
+            " (--first-hit: counts are lower bounds, the search stopped at the first crossing pair)"
+                .to_string()
+        } else if r.pairs_truncated {
+            format!(" ({} listed)", r.pairs.len())
+        } else {
+            String::new()
+        }
     );
     match &r.closest {
         Some(cl) => {
@@ -200,33 +267,26 @@ pub fn render(r: &Report, color: bool) -> String {
                 point(&cl.b.point)
             );
         }
-        None => s.push_str("  closest: none (an input has no triangles)\n"),
+        None => s.push_str(closest_none(r)),
     }
-    if let Some(ct) = &m.contained {
-        let what = match ct.as_str() {
-            "a_in_b" => "A lies inside B",
-            "b_in_a" => "B lies inside A",
-            "a_partly_in_b" => "part of A lies inside B",
-            "b_partly_in_a" => "part of B lies inside A",
-            "volumes_overlap" => "the closed parts' volumes overlap (faces in contact enclose shared volume)",
-            _ => "undecided",
-        };
+    if let Some(ct) = m.contained {
         let why = m.contained_reason.as_deref().map(|w| format!(": {w}")).unwrap_or_default();
-        let style = if what == "undecided" { YELLOW } else { RED };
-        let _ = writeln!(s, "  containment: {}{why}", c.p(style, what));
+        let style = if ct.is_clash() { RED } else { YELLOW };
+        let _ = writeln!(s, "  containment: {}{why}", c.p(style, containment_text(ct)));
     }
+    part_pairs(&mut s, &c, r);
     let worst = worst(r);
     if !worst.is_empty() {
         let total = m.crossing_pairs + m.touching_pairs + m.clearance_pairs;
         let _ = writeln!(s, "  worst findings ({} of {total}):", worst.len().min(WORST));
         for p in worst.iter().take(WORST) {
-            let style = match p.kind.as_str() {
-                "crossing" => RED,
-                "touching" => ORANGE,
-                _ => YELLOW,
+            let style = match p.kind {
+                ReportPairKind::Crossing => RED,
+                ReportPairKind::Touching => ORANGE,
+                ReportPairKind::Clearance => YELLOW,
             };
             let line = pair_line(r, p);
-            let (kind, rest) = line.split_at(p.kind.len());
+            let (kind, rest) = line.split_at(p.kind.name().len());
             let _ = writeln!(s, "    {}{rest}", c.p(style, kind));
         }
     }

@@ -21,7 +21,7 @@
 
 use crate::check::query::{PairFinding, PairKind};
 use crate::error::{Error, Result};
-use crate::report::Report;
+use crate::report::{Report, ReportContainment, ReportPairKind};
 use crate::scene::mesh::Mesh;
 use serde::{Deserialize, Serialize};
 use std::collections::{BTreeSet, HashMap, HashSet};
@@ -66,8 +66,8 @@ pub struct Baseline {
     pub path: String,
     /// Listed finding ids, each with whether any finding with that id was a crossing.
     pub ids: HashMap<String, bool>,
-    /// Its `summary.contained`.
-    pub contained: Option<String>,
+    /// Its `summary.contained` (a value this version does not know reads as none).
+    pub contained: Option<ReportContainment>,
     /// Its `pairs_truncated`.
     pub truncated: bool,
 }
@@ -146,9 +146,19 @@ pub fn parse(path: &str, bytes: &[u8]) -> std::result::Result<Baseline, String> 
     let v: serde_json::Value =
         serde_json::from_slice(bytes).map_err(|e| format!("baseline is not JSON: {e}"))?;
     // Any version of the report format will do: only ids, kinds and containment are read.
-    match v.get("schema").and_then(|s| s.as_str()) {
-        Some(s) if s.starts_with("meshclash.report/") => {}
-        other => return Err(format!("baseline is not a meshclash report (schema {other:?})")),
+    match v.get("schema") {
+        Some(serde_json::Value::String(s)) if s.starts_with("meshclash.report/") => {}
+        Some(serde_json::Value::String(s)) => {
+            let hint = if s.starts_with("meshclash.") {
+                " (--baseline takes a report of `meshclash A B` or `meshclash scene FILE`)"
+            } else {
+                ""
+            };
+            let s = crate::load::clip(s, 60);
+            return Err(format!("baseline is not a meshclash report: its schema is '{s}'{hint}"));
+        }
+        Some(_) => return Err("baseline is not a meshclash report: its \"schema\" is not a string".into()),
+        None => return Err("baseline is not a meshclash report: it has no \"schema\"".into()),
     }
     let pairs = v.get("pairs").and_then(|p| p.as_array()).ok_or("baseline has no pairs list")?;
     let mut ids = HashMap::new();
@@ -156,19 +166,20 @@ pub fn parse(path: &str, bytes: &[u8]) -> std::result::Result<Baseline, String> 
         let id = p.get("id").and_then(|s| s.as_str()).ok_or_else(|| {
             format!("baseline pair {i} has no id (written by an older meshclash? regenerate it)")
         })?;
-        let crossing = p.get("kind").and_then(|k| k.as_str()) == Some("crossing");
+        let kind = p.get("kind").and_then(|k| ReportPairKind::deserialize(k).ok());
+        let crossing = kind == Some(ReportPairKind::Crossing);
         *ids.entry(id.to_string()).or_insert(false) |= crossing;
     }
     Ok(Baseline {
         path: path.to_string(),
         ids,
-        contained: v.pointer("/summary/contained").and_then(|c| c.as_str()).map(str::to_string),
+        contained: v.pointer("/summary/contained").and_then(|c| ReportContainment::deserialize(c).ok()),
         truncated: v.get("pairs_truncated").and_then(|t| t.as_bool()).unwrap_or(false),
     })
 }
 
-fn is_containment_clash(c: Option<&str>) -> bool {
-    matches!(c, Some("a_in_b" | "b_in_a" | "a_partly_in_b" | "b_partly_in_a" | "volumes_overlap"))
+fn is_containment_clash(c: Option<ReportContainment>) -> bool {
+    c.is_some_and(ReportContainment::is_clash)
 }
 
 /// Mark the listed pairs `new`/`persistent` and add the `baseline` block. `findings` are all the
@@ -184,7 +195,7 @@ pub fn compare(rep: &mut Report, findings: &[Finding], base: &Baseline) {
         .filter(|f| f.kind == PairKind::Crossing && base.ids.get(&f.id) != Some(&true))
         .count() as u64;
     let resolved: BTreeSet<&String> = base.ids.keys().filter(|id| !now.contains(id.as_str())).collect();
-    let contained = rep.summary.contained.as_deref();
+    let contained = rep.summary.contained;
     rep.baseline = Some(BaselineReport {
         path: base.path.clone(),
         new: findings.len() as u64 - persistent,
@@ -192,7 +203,7 @@ pub fn compare(rep: &mut Report, findings: &[Finding], base: &Baseline) {
         resolved: resolved.len() as u64,
         resolved_ids: resolved.into_iter().cloned().collect(),
         new_crossing,
-        new_containment: is_containment_clash(contained) && base.contained.as_deref() != contained,
+        new_containment: is_containment_clash(contained) && base.contained != contained,
         complete: !base.truncated,
     });
 }
@@ -208,10 +219,16 @@ mod tests {
     #[test]
     fn volumes_overlap_counts_as_containment_clash_for_fail_on_new() {
         // Regression: a new `volumes_overlap` was not counted as new containment.
-        assert!(is_containment_clash(Some("volumes_overlap")));
-        assert!(is_containment_clash(Some("a_in_b")));
-        assert!(!is_containment_clash(Some("undecided")));
+        assert!(is_containment_clash(Some(ReportContainment::VolumesOverlap)));
+        assert!(is_containment_clash(Some(ReportContainment::AInB)));
+        assert!(!is_containment_clash(Some(ReportContainment::Undecided)));
         assert!(!is_containment_clash(None));
+        // and it is read back from a baseline as the containment it is
+        let b = parse(
+            "b.json",
+            br#"{"schema": "meshclash.report/2", "pairs": [], "summary": {"contained": "volumes_overlap"}}"#,
+        );
+        assert_eq!(b.unwrap().contained, Some(ReportContainment::VolumesOverlap));
     }
 
     use super::*;
@@ -259,6 +276,16 @@ mod tests {
             .unwrap_err()
             .contains("not a meshclash"));
         assert!(parse("x.json", b"not json").is_err());
+        // Regression: the schema was shown as `Some("meshclash.clash-set/1")`.
+        let e = parse("x.json", br#"{"schema": "meshclash.clash-set/1"}"#).unwrap_err();
+        assert_eq!(
+            e,
+            "baseline is not a meshclash report: its schema is 'meshclash.clash-set/1' (--baseline takes a \
+             report of `meshclash A B` or `meshclash scene FILE`)"
+        );
+        assert!(!e.contains("Some("), "{e}");
+        let e = parse("x.json", br#"{"pairs": []}"#).unwrap_err();
+        assert_eq!(e, "baseline is not a meshclash report: it has no \"schema\"");
         let ok = br#"{"schema": "meshclash.report/1", "pairs_truncated": true, "summary": {"contained": "a_in_b"},
             "pairs": [{"id": "01", "kind": "touching"}, {"id": "01", "kind": "crossing"}, {"id": "02", "kind": "touching"}]}"#;
         let b = parse("b.json", ok).unwrap();
@@ -266,6 +293,6 @@ mod tests {
         assert!(b.ids["01"]);
         assert!(!b.ids["02"]);
         assert!(b.truncated);
-        assert_eq!(b.contained.as_deref(), Some("a_in_b"));
+        assert_eq!(b.contained, Some(ReportContainment::AInB));
     }
 }

@@ -66,6 +66,197 @@ use std::path::Path;
 /// The schema identifier written in every report.
 pub const SCHEMA: &str = "meshclash.report/2";
 
+/// A verdict as written in reports (`clear` < `clearance` < `touching` < `clash`: the order is
+/// the severity, as [`Verdict`]'s).
+#[derive(
+    Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord, Hash, Serialize, Deserialize, schemars::JsonSchema,
+)]
+#[serde(rename_all = "snake_case")]
+pub enum ReportVerdict {
+    /// Nothing within the clearance.
+    Clear,
+    /// Some pair closer than the clearance.
+    Clearance,
+    /// Some pair touches (exactly, or within the touch tolerance), none crosses.
+    Touching,
+    /// Some pair crosses, or one part lies inside the other.
+    Clash,
+}
+
+impl ReportVerdict {
+    /// The name in the report.
+    pub fn name(self) -> &'static str {
+        self.verdict().name()
+    }
+
+    /// The engine's verdict.
+    pub fn verdict(self) -> Verdict {
+        match self {
+            ReportVerdict::Clear => Verdict::Clear,
+            ReportVerdict::Clearance => Verdict::Clearance,
+            ReportVerdict::Touching => Verdict::Touching,
+            ReportVerdict::Clash => Verdict::Clash,
+        }
+    }
+}
+
+impl From<Verdict> for ReportVerdict {
+    fn from(v: Verdict) -> Self {
+        match v {
+            Verdict::Clear => ReportVerdict::Clear,
+            Verdict::Clearance => ReportVerdict::Clearance,
+            Verdict::Touching => ReportVerdict::Touching,
+            Verdict::Clash => ReportVerdict::Clash,
+        }
+    }
+}
+
+/// A triangle pair's kind as written in reports.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize, Deserialize, schemars::JsonSchema)]
+#[serde(rename_all = "snake_case")]
+pub enum ReportPairKind {
+    /// The interiors cross: a real penetration.
+    Crossing,
+    /// They share points without crossing, or come within the touch tolerance.
+    Touching,
+    /// Closer than the clearance, not touching.
+    Clearance,
+}
+
+impl ReportPairKind {
+    /// The name in the report.
+    pub fn name(self) -> &'static str {
+        match self {
+            ReportPairKind::Crossing => "crossing",
+            ReportPairKind::Touching => "touching",
+            ReportPairKind::Clearance => "clearance",
+        }
+    }
+}
+
+impl From<crate::check::query::PairKind> for ReportPairKind {
+    fn from(k: crate::check::query::PairKind) -> Self {
+        use crate::check::query::PairKind;
+        match k {
+            PairKind::Crossing => ReportPairKind::Crossing,
+            PairKind::Touching => ReportPairKind::Touching,
+            PairKind::Clearance => ReportPairKind::Clearance,
+        }
+    }
+}
+
+/// The shape of a contact as written in reports.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize, Deserialize, schemars::JsonSchema)]
+#[serde(rename_all = "snake_case")]
+pub enum ReportContact {
+    /// They share exactly one point.
+    Point,
+    /// They share a segment of positive length (and are not coplanar).
+    Segment,
+    /// Coplanar and their interiors overlap (face-to-face contact, duplicated faces).
+    CoplanarArea,
+    /// Coplanar and they share only boundary points.
+    CoplanarBoundary,
+    /// They do not meet but come within the touch tolerance.
+    WithinTolerance,
+}
+
+impl ReportContact {
+    /// The name in the report.
+    pub fn name(self) -> &'static str {
+        match self {
+            ReportContact::Point => "point",
+            ReportContact::Segment => "segment",
+            ReportContact::CoplanarArea => "coplanar_area",
+            ReportContact::CoplanarBoundary => "coplanar_boundary",
+            ReportContact::WithinTolerance => "within_tolerance",
+        }
+    }
+}
+
+impl From<crate::narrow::tri_tri::Contact> for ReportContact {
+    fn from(c: crate::narrow::tri_tri::Contact) -> Self {
+        use crate::narrow::tri_tri::Contact;
+        match c {
+            Contact::Point => ReportContact::Point,
+            Contact::Segment => ReportContact::Segment,
+            Contact::CoplanarArea => ReportContact::CoplanarArea,
+            Contact::CoplanarBoundary => ReportContact::CoplanarBoundary,
+        }
+    }
+}
+
+/// Containment as written in reports (`summary.contained`, `part_pairs[].contained`); every
+/// value but `undecided` is a clash.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize, Deserialize, schemars::JsonSchema)]
+#[serde(rename_all = "snake_case")]
+pub enum ReportContainment {
+    /// Every component of A lies inside B.
+    AInB,
+    /// Every component of B lies inside A.
+    BInA,
+    /// Some components of A lie inside B, others outside.
+    APartlyInB,
+    /// Some components of B lie inside A, others outside.
+    BPartlyInA,
+    /// Surfaces only touch, but face-to-face contacts show the two solids share volume.
+    VolumesOverlap,
+    /// Could not decide (`contained_reason` says why).
+    Undecided,
+}
+
+impl ReportContainment {
+    /// The name in the report.
+    pub fn name(self) -> &'static str {
+        match self {
+            ReportContainment::AInB => "a_in_b",
+            ReportContainment::BInA => "b_in_a",
+            ReportContainment::APartlyInB => "a_partly_in_b",
+            ReportContainment::BPartlyInA => "b_partly_in_a",
+            ReportContainment::VolumesOverlap => "volumes_overlap",
+            ReportContainment::Undecided => "undecided",
+        }
+    }
+
+    /// Is this an interference (a clash)? Every value but `undecided`.
+    pub fn is_clash(self) -> bool {
+        self != ReportContainment::Undecided
+    }
+
+    /// The report value of the engine's containment (None for no containment).
+    pub fn of(c: &crate::check::containment::Containment) -> Option<Self> {
+        use crate::check::containment::Containment;
+        Some(match c {
+            Containment::None => return None,
+            Containment::AInB => ReportContainment::AInB,
+            Containment::BInA => ReportContainment::BInA,
+            Containment::APartlyInB => ReportContainment::APartlyInB,
+            Containment::BPartlyInA => ReportContainment::BPartlyInA,
+            Containment::VolumesOverlap => ReportContainment::VolumesOverlap,
+            Containment::Undecided(_) => ReportContainment::Undecided,
+        })
+    }
+}
+
+/// `Display` as the report name, and `==` against a report name (`r.verdict == "clash"`).
+macro_rules! wire_name {
+    ($($t:ty),*) => {$(
+        impl std::fmt::Display for $t {
+            fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+                f.write_str(self.name())
+            }
+        }
+
+        impl PartialEq<&str> for $t {
+            fn eq(&self, other: &&str) -> bool {
+                self.name() == *other
+            }
+        }
+    )*};
+}
+
+wire_name!(ReportVerdict, ReportPairKind, ReportContact, ReportContainment);
+
 /// The whole report.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize, schemars::JsonSchema)]
 #[serde(deny_unknown_fields)]
@@ -79,7 +270,7 @@ pub struct Report {
     /// The settings used.
     pub settings: SettingsReport,
     /// `clash`, `touching`, `clearance` or `clear`.
-    pub verdict: String,
+    pub verdict: ReportVerdict,
     /// True if the verdict is at or above `settings.fail_on` (the process exits 1).
     pub failed: bool,
     /// Counts (complete even when `pairs` is truncated).
@@ -214,7 +405,7 @@ pub struct PartPairReport {
     /// Name of part `b`.
     pub b_name: String,
     /// The pair's verdict.
-    pub verdict: String,
+    pub verdict: ReportVerdict,
     /// Crossing triangle pairs.
     pub crossing_pairs: u64,
     /// Touching triangle pairs.
@@ -224,7 +415,7 @@ pub struct PartPairReport {
     /// Minimum distance between the two parts, when computed.
     pub min_distance: Option<f64>,
     /// Containment between the two parts (a clash), or null.
-    pub contained: Option<String>,
+    pub contained: Option<ReportContainment>,
     /// The witness of `min_distance` (triangles are input indices, objects those of the parts).
     #[serde(default)]
     pub closest: Option<ClosestReport>,
@@ -261,12 +452,12 @@ pub fn assembly_view(
             b: pp.b,
             a_name: o.parts[pp.a].name.clone(),
             b_name: o.parts[pp.b].name.clone(),
-            verdict: pp.verdict.name().into(),
+            verdict: pp.verdict.into(),
             crossing_pairs: pp.counts.crossing,
             touching_pairs: pp.counts.touching,
             clearance_pairs: pp.counts.clearance,
             min_distance: pp.min_distance,
-            contained: pp.containment.name().map(str::to_string),
+            contained: ReportContainment::of(&pp.containment),
             closest: pp.closest.map(|c| {
                 let (pa, pb) = (&o.parts[pp.a], &o.parts[pp.b]);
                 ClosestReport {
@@ -497,7 +688,7 @@ pub struct Summary {
     /// The minimum distance between the two surfaces.
     pub min_distance: Option<f64>,
     /// `a_in_b`, `b_in_a`, `a_partly_in_b`, `b_partly_in_a` (all a clash), `undecided`, or null.
-    pub contained: Option<String>,
+    pub contained: Option<ReportContainment>,
     /// Why containment is `undecided`, else null.
     pub contained_reason: Option<String>,
 }
@@ -539,9 +730,9 @@ pub struct PairReport {
     /// Object of `b`.
     pub b_object: u32,
     /// `crossing`, `touching` or `clearance`.
-    pub kind: String,
+    pub kind: ReportPairKind,
     /// Contact shape, `within_tolerance`, or null for clearance pairs.
-    pub contact: Option<String>,
+    pub contact: Option<ReportContact>,
     /// 0 for exact contacts.
     pub distance: f64,
     /// Shared segment, or (tolerance/clearance pairs) the two closest points.
@@ -644,10 +835,10 @@ fn pair_report(p: &PairFinding, ca: &[u32], cb: &[u32]) -> PairReport {
         b: p.b,
         a_object: ca[p.a as usize],
         b_object: cb[p.b as usize],
-        kind: p.kind.name().to_string(),
+        kind: p.kind.into(),
         contact: match (p.contact, p.kind) {
-            (Some(c), _) => Some(c.name().to_string()),
-            (None, crate::check::query::PairKind::Touching) => Some("within_tolerance".to_string()),
+            (Some(c), _) => Some(c.into()),
+            (None, crate::check::query::PairKind::Touching) => Some(ReportContact::WithinTolerance),
             (None, _) => None,
         },
         distance: p.distance,
@@ -677,7 +868,7 @@ pub fn build(ctx: &Context, r: &ClashResult) -> Report {
             b: input_report(ib, &ctx.transforms[1], &infb, r.closed[1].unwrap_or(false)),
         },
         settings: ctx.settings.clone(),
-        verdict: r.verdict.name().to_string(),
+        verdict: r.verdict.into(),
         failed: ctx.failed,
         summary: Summary {
             crossing_pairs: r.counts.crossing,
@@ -685,7 +876,7 @@ pub fn build(ctx: &Context, r: &ClashResult) -> Report {
             within_tolerance_pairs: r.counts.within_tolerance,
             clearance_pairs: r.counts.clearance,
             min_distance: r.closest.map(|c| c.distance),
-            contained: r.containment.name().map(str::to_string),
+            contained: ReportContainment::of(&r.containment),
             contained_reason: match &r.containment {
                 crate::check::containment::Containment::Undecided(why) => Some(why.clone()),
                 _ => None,

@@ -43,7 +43,7 @@
 
 use crate::check::health::{Finding, Health};
 use crate::check::query::Input;
-use crate::report::{ObjectReport, PairReport, Tool};
+use crate::report::{ObjectReport, PairReport, ReportContact, ReportPairKind, ReportVerdict, Tool};
 use crate::self_cmd::{PartResult, SelfFailOn};
 use serde::{Deserialize, Serialize};
 
@@ -63,7 +63,7 @@ pub struct SelfReport {
     /// The settings used.
     pub settings: SelfSettings,
     /// `clash` (a crossing self-clash pair), `touching` (only touching ones) or `clear`.
-    pub verdict: String,
+    pub verdict: ReportVerdict,
     /// True if something in `settings.fail_on` was found (the process exits 1).
     pub failed: bool,
     /// The `fail_on` conditions that were met.
@@ -293,8 +293,8 @@ pub fn build(ctx: &Context) -> SelfReport {
             b: q.b,
             a_object: mesh.tri_object[q.a as usize],
             b_object: mesh.tri_object[q.b as usize],
-            kind: if q.hit.crossing { "crossing" } else { "touching" }.into(),
-            contact: Some(q.hit.contact.name().into()),
+            kind: if q.hit.crossing { ReportPairKind::Crossing } else { ReportPairKind::Touching },
+            contact: Some(q.hit.contact.into()),
             distance: 0.0,
             segment: q.hit.segment.map(|s| s.map(|p| p.to_array())),
             id: None,
@@ -319,11 +319,11 @@ pub fn build(ctx: &Context) -> SelfReport {
         inconsistent_winding_edges: sum(&|p| p.health.inconsistent_winding_edges.count),
     };
     let verdict = if crossing_pairs > 0 {
-        "clash"
+        ReportVerdict::Clash
     } else if touching_pairs > 0 {
-        "touching"
+        ReportVerdict::Touching
     } else {
-        "clear"
+        ReportVerdict::Clear
     };
     let names = |v: &[SelfFailOn]| v.iter().map(|f| f.name().to_string()).collect::<Vec<_>>();
     SelfReport {
@@ -348,7 +348,7 @@ pub fn build(ctx: &Context) -> SelfReport {
             first_n: ctx.first_n,
             threads: ctx.threads,
         },
-        verdict: verdict.into(),
+        verdict,
         failed: !ctx.failed_on.is_empty(),
         failed_on: names(ctx.failed_on),
         summary,
@@ -448,8 +448,14 @@ pub fn text(r: &SelfReport) -> String {
         let _ = writeln!(out, "  … and {} more parts with findings", listed.len() - 10);
     }
     for p in r.pairs.iter().take(5) {
-        let _ =
-            writeln!(out, "  pair {} × {}: {} ({})", p.a, p.b, p.kind, p.contact.as_deref().unwrap_or("-"));
+        let _ = writeln!(
+            out,
+            "  pair {} × {}: {} ({})",
+            p.a,
+            p.b,
+            p.kind,
+            p.contact.map_or("-", ReportContact::name)
+        );
     }
     out
 }
