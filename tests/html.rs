@@ -171,7 +171,7 @@ fn contained_part_gets_a_row_and_a_clear_run_the_closest_points() {
     let outer = boxes_obj(d.path(), "outer.obj", &[("outer", [0.0; 3], [10.0; 3])]);
     let inner = boxes_obj(d.path(), "inner.obj", &[("inner", [4.0; 3], [5.0; 3])]);
     let (_, v, rep) = run(d.path(), &[&outer, &inner]);
-    assert_eq!(rep.summary.contained.as_deref(), Some("b_in_a"));
+    assert_eq!(rep.summary.contained.map(|c| c.name()), Some("b_in_a"));
     let rows = v["rows"].as_array().unwrap();
     assert_eq!(rows.len(), 1);
     assert_eq!(rows[0]["kind"], "contained");

@@ -24,15 +24,15 @@
 
 use crate::bvh::traverse::{self, Tree};
 use crate::bvh::{BuildOptions, Bvh, Node};
+use crate::check::containment;
 use crate::check::containment::Containment;
 use crate::check::containment::Topology;
-use crate::check::query::{check_built_with, ClashResult, PairFinding, Settings, Verdict};
+use crate::check::query::{pair_phase, ClashResult, PairFinding, PairPhase, Settings, Verdict};
 use crate::geom::predicates::BoxMap;
 use crate::geom::{Aabb, DVec3};
 use crate::scene::mesh::{Mesh, Object, TriMesh};
 use rayon::prelude::*;
 use std::collections::HashMap;
-use std::sync::OnceLock;
 use std::time::Instant;
 
 /// One part of one input.
@@ -466,21 +466,37 @@ pub fn check_parts(
     };
     let build_ms = t0.elapsed().as_secs_f64() * 1e3;
     let t1 = Instant::now();
-    // Each part's topology is computed at most once, and only if a verdict of one of its pairs
-    // needs it (containment or volumes overlap).
-    let topology: Vec<OnceLock<Topology>> = (0..parts.len()).map(|_| OnceLock::new()).collect();
-    let part_pairs: Vec<PartPair> = candidates
+    // Three phases, so that no rayon worker ever blocks on another's lazy value: every pair's
+    // pairs and closest points; then the topology of each part some verdict needs (containment
+    // or volumes overlap), each part once; then containment and the verdicts.
+    let phases: Vec<(PairPhase, bool)> = candidates
         .par_iter()
         .map(|&(a, b)| {
-            let mut r = check_built_with(
-                &view(a),
-                &tree(a),
-                &topology[a],
-                &view(b),
-                &tree(b),
-                &topology[b],
-                settings,
-            );
+            let (va, vb, ta, tb) = (view(a), view(b), tree(a), tree(b));
+            let phase = pair_phase(&va, &ta, &vb, &tb, settings);
+            let needs = phase.needs_topology(&va, &ta, &vb, &tb, settings);
+            (phase, needs)
+        })
+        .collect();
+    let mut wanted = vec![false; parts.len()];
+    for (&(a, b), (_, needs)) in candidates.iter().zip(&phases) {
+        if *needs {
+            wanted[a] = true;
+            wanted[b] = true;
+        }
+    }
+    let topology: Vec<Option<Topology>> = (0..parts.len())
+        .into_par_iter()
+        .map(|i| wanted[i].then(|| containment::topology(&view(i))))
+        .collect();
+    let part_pairs: Vec<PartPair> = candidates
+        .par_iter()
+        .zip(phases.into_par_iter())
+        .map(|(&(a, b), (phase, needs))| {
+            let topo =
+                needs.then(|| (topology[a].as_ref().expect("wanted"), topology[b].as_ref().expect("wanted")));
+            let mut r = phase.finish(&view(a), &tree(a), &view(b), &tree(b), topo, settings);
+            r.closed = [topology[a].as_ref().map(|t| t.closed), topology[b].as_ref().map(|t| t.closed)];
             r.timings = Default::default();
             to_input_indices(&mut r, &parts[a], &parts[b]);
             PartPair { a, b, result: r }

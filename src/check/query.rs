@@ -426,6 +426,11 @@ where
 /// computed only if the verdict needs it — containment when no pair crosses and the boxes
 /// allow it, volumes overlap when faces touch — and kept in `topo_*` for other checks of the
 /// same part. [`ClashResult::closed`] says `None` for a side whose topology was not needed.
+///
+/// Call it from one thread per `topo_*` (the topology computation itself runs on rayon; an
+/// initialisation that blocked other rayon workers would serialise them). Assemblies use the
+/// phases directly: [`pair_phase`], then the topologies that [`PairPhase::needs_topology`]
+/// asks for, then [`PairPhase::finish`].
 pub fn check_built_with<A, TA, B, TB>(
     a: &A,
     ta: &TA,
@@ -441,7 +446,40 @@ where
     B: TriMesh + ?Sized,
     TB: Tree + ?Sized,
 {
-    let t1 = Instant::now();
+    let phase = pair_phase(a, ta, b, tb, settings);
+    let topo = if phase.needs_topology(a, ta, b, tb, settings) {
+        let (x, y) = rayon::join(
+            || topo_a.get_or_init(|| containment::topology(a)),
+            || topo_b.get_or_init(|| containment::topology(b)),
+        );
+        Some((x, y))
+    } else {
+        None
+    };
+    let closed = [topo_a.get().map(|t| t.closed), topo_b.get().map(|t| t.closed)];
+    let mut r = phase.finish(a, ta, b, tb, topo, settings);
+    r.closed = closed;
+    r
+}
+
+/// The first phase of a check: the pairs, their counts and the closest pair.
+#[derive(Debug, Clone)]
+pub struct PairPhase {
+    pairs: Vec<PairFinding>,
+    counts: Counts,
+    closest: Option<Closest>,
+    started: Instant,
+}
+
+/// Find every pair and the closest pair ([`PairPhase::finish`] adds containment and the verdict).
+pub fn pair_phase<A, TA, B, TB>(a: &A, ta: &TA, b: &B, tb: &TB, settings: &Settings) -> PairPhase
+where
+    A: TriMesh + ?Sized,
+    TA: Tree + ?Sized,
+    B: TriMesh + ?Sized,
+    TB: Tree + ?Sized,
+{
+    let started = Instant::now();
     let (pairs, stopped) = find_pairs(a, ta, b, tb, settings);
     let mut counts = Counts::default();
     for p in &pairs {
@@ -452,44 +490,74 @@ where
         None if stopped => None,
         None => closest_pair(a, ta, b, tb, settings.distance_error),
     };
-    let topology = || {
-        rayon::join(
-            || topo_a.get_or_init(|| containment::topology(a)),
-            || topo_b.get_or_init(|| containment::topology(b)),
-        )
-    };
-    let containment = if counts.crossing > 0 || settings.first_hit {
-        Containment::None // a crossing is a clash already (and first-hit stops looking)
-    } else if !containment::may_nest(a, ta, b, tb)
-        && !pairs.iter().any(|p| p.contact == Some(Contact::CoplanarArea))
+    PairPhase { pairs, counts, closest, started }
+}
+
+impl PairPhase {
+    /// Does the verdict need both sides' topology? Only when no pair crosses (and the search
+    /// was not cut short), and either box meets the other's vertices (nesting is possible) or
+    /// faces touch (volumes may overlap).
+    pub fn needs_topology<A, TA, B, TB>(&self, a: &A, ta: &TA, b: &B, tb: &TB, settings: &Settings) -> bool
+    where
+        A: TriMesh + ?Sized,
+        TA: Tree + ?Sized,
+        B: TriMesh + ?Sized,
+        TB: Tree + ?Sized,
     {
-        Containment::None // neither box meets the other's points, and no faces touch
-    } else {
-        let (ta_, tb_) = topology();
-        if volumes_overlap(a, ta_, b, tb_, &pairs) {
-            Containment::VolumesOverlap
+        self.counts.crossing == 0
+            && !settings.first_hit
+            && (self.pairs.iter().any(|p| p.contact == Some(Contact::CoplanarArea))
+                || containment::may_nest(a, ta, b, tb))
+    }
+
+    /// Containment (with both topologies when [`PairPhase::needs_topology`] said so, else
+    /// `None`) and the verdict. `closed` is left `None`: the caller knows what it computed.
+    pub fn finish<A, TA, B, TB>(
+        self,
+        a: &A,
+        ta: &TA,
+        b: &B,
+        tb: &TB,
+        topo: Option<(&containment::Topology, &containment::Topology)>,
+        settings: &Settings,
+    ) -> ClashResult
+    where
+        A: TriMesh + ?Sized,
+        TA: Tree + ?Sized,
+        B: TriMesh + ?Sized,
+        TB: Tree + ?Sized,
+    {
+        let PairPhase { pairs, counts, closest, started } = self;
+        let containment = match topo {
+            _ if counts.crossing > 0 || settings.first_hit => Containment::None,
+            None => Containment::None, // no nesting possible and no faces touch
+            Some((ta_, tb_)) => {
+                if volumes_overlap(a, ta_, b, tb_, &pairs) {
+                    Containment::VolumesOverlap
+                } else {
+                    containment::decide(a, ta, ta_, b, tb, tb_)
+                }
+            }
+        };
+        let verdict = if counts.crossing > 0 || containment.is_clash() {
+            Verdict::Clash
+        } else if counts.touching > 0 {
+            Verdict::Touching
+        } else if counts.clearance > 0 {
+            Verdict::Clearance
         } else {
-            containment::decide(a, ta, ta_, b, tb, tb_)
+            Verdict::Clear
+        };
+        ClashResult {
+            pairs,
+            counts,
+            closest,
+            verdict,
+            containment,
+            closed: [None, None],
+            trees: [ta.stats(), tb.stats()],
+            timings: Timings { build_ms: 0.0, query_ms: ms(started) },
         }
-    };
-    let verdict = if counts.crossing > 0 || containment.is_clash() {
-        Verdict::Clash
-    } else if counts.touching > 0 {
-        Verdict::Touching
-    } else if counts.clearance > 0 {
-        Verdict::Clearance
-    } else {
-        Verdict::Clear
-    };
-    ClashResult {
-        pairs,
-        counts,
-        closest,
-        verdict,
-        containment,
-        closed: [topo_a.get().map(|t| t.closed), topo_b.get().map(|t| t.closed)],
-        trees: [ta.stats(), tb.stats()],
-        timings: Timings { build_ms: 0.0, query_ms: ms(t1) },
     }
 }
 
