@@ -49,7 +49,7 @@ impl Oriented {
         }
         let len = nsum.length();
         // A patch whose normals mostly cancel gains nothing over a box.
-        if !(len > 0.25 * area) || !len.is_finite() {
+        if len.partial_cmp(&(0.25 * area)) != Some(std::cmp::Ordering::Greater) || !len.is_finite() {
             return None;
         }
         let n = nsum / len;
@@ -75,6 +75,7 @@ impl Oriented {
     /// every projection overlaps). Before rounding this is a lower bound on the distance between
     /// the two sets; subtract [`crate::geom::predicates::oriented_bound_margin`] before pruning.
     #[inline]
+    #[allow(clippy::needless_range_loop)] // the 3x3 index form reads as the matrix it is
     pub fn gap(&self, o: &Oriented) -> f64 {
         // c[i][j] = self.axes[i] · o.axes[j]
         let c = self.axes.map(|a| o.axes.map(|b| a.dot(b)));

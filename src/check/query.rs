@@ -724,11 +724,11 @@ where
             let (Some(oa), Some(ob)) = (cache_a.get(i), cache_b.get(j)) else {
                 return boxed;
             };
-            let gap = oa.gap(&ob);
+            let gap = oa.gap(ob);
             // The rectangle bound costs four triangle distances: worth it only where a prune
             // saves subtrees on both sides (measured on linked tori and 2CylinderEngine).
             let leafy = ta.nodes()[i as usize].is_leaf() || tb.nodes()[j as usize].is_leaf();
-            let fine = if shrink(gap - margin) > cut || leafy { gap } else { oa.swept_rect_bound(&ob, gap) };
+            let fine = if shrink(gap - margin) > cut || leafy { gap } else { oa.swept_rect_bound(ob, gap) };
             boxed.max(shrink(fine - margin))
         },
         slack,
