@@ -15,10 +15,10 @@
 
 use crate::bvh::traverse::Tree;
 use crate::bvh::{BuildOptions, Bvh, Node};
-use crate::check::assembly::{self, PartPairSummary, Selection};
+use crate::check::assembly::{self, Selection};
 use crate::check::containment::{self, Containment, Topology};
 use crate::check::query::{
-    self, Closest, DistanceError, Input, InputSpec, Mode, PairFinding, PairKind, Settings, Verdict,
+    self, Closest, DistanceError, Input, InputSpec, Mode, PairFinding, PairKind, Settings,
 };
 use crate::error::{Error, Result};
 use crate::geom::predicates::{self, BoxMap, Tolerances};
@@ -564,7 +564,7 @@ pub fn report_placed(a: &Placed, b: &Placed, opts: &Options) -> Result<Report> {
             let r = query::check_built(&a.mesh(), &a.tree(), &b.mesh(), &b.tree(), settings);
             let mut parts = assembly::parts_of(&sa.input.mesh, 0);
             parts.extend(assembly::parts_of(&sb.input.mesh, 1));
-            let part_pairs = group_by_part(&parts, &sa.input.mesh, &sb.input.mesh, &r);
+            let part_pairs = assembly::group_by_part(&parts, &sa.input.mesh, &sb.input.mesh, &r);
             let info = assembly::AssemblyInfo {
                 mode: "files",
                 selected: [1, 1],
@@ -577,41 +577,6 @@ pub fn report_placed(a: &Placed, b: &Placed, opts: &Options) -> Result<Report> {
         };
         finish_report(&sa, &sb, opts, threads, t0, outcome_of)
     })
-}
-
-/// Files mode: the pairs of a whole check grouped by the parts they fall in (as
-/// [`assembly::run`] groups them).
-fn group_by_part(
-    parts: &[assembly::Part],
-    a: &Mesh,
-    b: &Mesh,
-    r: &query::ClashResult,
-) -> Vec<PartPairSummary> {
-    let index: std::collections::HashMap<(u8, u32), usize> =
-        parts.iter().enumerate().map(|(i, p)| ((p.input, p.object), i)).collect();
-    let mut by: std::collections::BTreeMap<(usize, usize), PartPairSummary> = Default::default();
-    for p in &r.pairs {
-        let pa = index[&(0, a.tri_object[p.a as usize])];
-        let pb = index[&(1, b.tri_object[p.b as usize])];
-        let e = by.entry((pa, pb)).or_insert_with(|| PartPairSummary {
-            a: pa,
-            b: pb,
-            verdict: Verdict::Clear,
-            counts: Default::default(),
-            min_distance: None,
-            containment: Containment::None,
-            closest: None,
-            pairs: Vec::new(),
-        });
-        let v = e.counts.record(p);
-        e.verdict = e.verdict.max(v);
-        e.pairs.push((p.a, p.b));
-        if e.closest.is_none_or(|c| p.distance < c.distance) {
-            e.closest = Some(query::pair_witness(a, b, p));
-        }
-        e.min_distance = e.closest.map(|c| c.distance);
-    }
-    by.into_values().collect()
 }
 
 /// What [`collide`] finds between two placed meshes.

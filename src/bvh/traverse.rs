@@ -184,13 +184,23 @@ where
 
 /// One-tree walk: call `visit` on every triangle in a leaf whose box overlaps `query` (exact
 /// closed overlap), stopping early — and returning true — as soon as `visit` returns true.
-pub fn any_in_box<T: Tree + ?Sized>(tree: &T, query: &Aabb, mut visit: impl FnMut(u32) -> bool) -> bool {
+pub fn any_in_box<T: Tree + ?Sized>(tree: &T, query: &Aabb, visit: impl FnMut(u32) -> bool) -> bool {
+    any_where(tree, |b| b.overlaps(query), visit)
+}
+
+/// One-tree walk: call `visit` on every triangle in a leaf reached through nodes whose boxes
+/// pass `keep`, stopping early — and returning true — as soon as `visit` returns true.
+fn any_where<T: Tree + ?Sized>(
+    tree: &T,
+    keep: impl Fn(&Aabb) -> bool,
+    mut visit: impl FnMut(u32) -> bool,
+) -> bool {
     if tree.nodes().is_empty() {
         return false;
     }
     let mut stack = vec![0u32];
     while let Some(i) = stack.pop() {
-        if !tree.node_box(i).overlaps(query) {
+        if !keep(&tree.node_box(i)) {
             continue;
         }
         let node = &tree.nodes()[i as usize];
@@ -218,11 +228,8 @@ pub fn any_on_segment<T: Tree + ?Sized>(
     tree: &T,
     p: DVec3,
     q: DVec3,
-    mut visit: impl FnMut(u32) -> bool,
+    visit: impl FnMut(u32) -> bool,
 ) -> bool {
-    if tree.nodes().is_empty() {
-        return false;
-    }
     let d = q - p;
     let inv = DVec3::ONE / d; // ±inf on an axis with d = 0 (handled by position below)
     let seg_box = Aabb { min: p.min(q), max: p.max(q) };
@@ -244,22 +251,7 @@ pub fn any_on_segment<T: Tree + ?Sized>(
         }
         t0 <= t1
     };
-    let mut stack = vec![0u32];
-    while let Some(i) = stack.pop() {
-        if !touches(&tree.node_box(i)) {
-            continue;
-        }
-        let node = &tree.nodes()[i as usize];
-        if !node.is_leaf() {
-            stack.push(node.a);
-            stack.push(i + 1);
-            continue;
-        }
-        if tree.prims_of(node).iter().any(|&t| visit(t)) {
-            return true;
-        }
-    }
-    false
+    any_where(tree, touches, visit)
 }
 
 /// A candidate for [`min_pair`]: its distance and a key that breaks ties deterministically.

@@ -832,8 +832,9 @@ pub fn run(a: &Mesh, b: &Mesh, sel: &Selection, settings: &Settings) -> Result<O
     Ok(Outcome { result, parts: ar.parts, part_pairs, info })
 }
 
-/// File mode: group the pairs of a whole-file check by the parts they belong to.
-fn group_by_part(parts: &[Part], a: &Mesh, b: &Mesh, r: &ClashResult) -> Vec<PartPairSummary> {
+/// File mode: group the pairs of a whole-file check by the parts they belong to (also used by
+/// [`crate::api`], so both report files mode the same way).
+pub fn group_by_part(parts: &[Part], a: &Mesh, b: &Mesh, r: &ClashResult) -> Vec<PartPairSummary> {
     let index: HashMap<(u8, u32), usize> =
         parts.iter().enumerate().map(|(i, p)| ((p.input, p.object), i)).collect();
     let mut by: std::collections::BTreeMap<(usize, usize), PartPairSummary> = Default::default();
