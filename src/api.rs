@@ -13,7 +13,7 @@
 //! is exactly what a tree built on the world coordinates would give; only the tree statistics
 //! differ (they describe the prepared tree).
 
-use crate::bvh::traverse::Tree;
+use crate::bvh::traverse::{MappedTree, Tree};
 use crate::bvh::{BuildOptions, Bvh, Node};
 use crate::check::assembly::{self, Selection};
 use crate::check::containment::{self, Containment, Topology};
@@ -473,41 +473,6 @@ impl TriMesh for PlacedMesh<'_> {
     }
 }
 
-/// A placed mesh's tree as the walks see it: node boxes in world coordinates (the root box is
-/// the exact world box).
-#[derive(Debug, Clone, Copy)]
-pub struct PlacedTree<'a> {
-    bvh: &'a Bvh,
-    map: Option<&'a BoxMap>,
-    root: Aabb,
-}
-
-impl Tree for PlacedTree<'_> {
-    #[inline]
-    fn nodes(&self) -> &[Node] {
-        &self.bvh.nodes
-    }
-    #[inline]
-    fn node_box(&self, i: u32) -> Aabb {
-        match (self.map, i) {
-            (_, 0) => self.root,
-            (None, _) => self.bvh.nodes[i as usize].bounds,
-            (Some(m), _) => m.map_box(&self.bvh.nodes[i as usize].bounds),
-        }
-    }
-    #[inline]
-    fn prims_of(&self, n: &Node) -> &[u32] {
-        self.bvh.leaf_prims(n)
-    }
-    fn stats(&self) -> crate::bvh::Stats {
-        self.bvh.stats()
-    }
-    #[inline]
-    fn all_prims(&self) -> &[u32] {
-        &self.bvh.prims
-    }
-}
-
 impl Placed {
     /// The world coordinates.
     pub fn positions(&self) -> &[DVec3] {
@@ -520,13 +485,13 @@ impl Placed {
     }
 
     /// The tree view.
-    pub fn tree(&self) -> PlacedTree<'_> {
+    pub fn tree(&self) -> MappedTree<'_> {
         let (bvh, map) = match &self.tree {
             Mapping::Own => (&self.prepared.tree, None),
-            Mapping::Mapped(m) => (&self.prepared.tree, Some(m)),
+            Mapping::Mapped(m) => (&self.prepared.tree, Some(*m)),
             Mapping::Refit(t) => (t, None),
         };
-        PlacedTree { bvh, map, root: self.root }
+        MappedTree { bvh, map, root: self.root }
     }
 
     /// The exact world box.

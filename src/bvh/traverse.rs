@@ -13,7 +13,7 @@
 //! is mapped once per node pair opened.
 
 use crate::bvh::{Bvh, Node};
-use crate::geom::predicates;
+use crate::geom::predicates::{self, BoxMap};
 use crate::geom::{Aabb, DVec3};
 use rayon::prelude::*;
 use std::sync::atomic::{AtomicU64, Ordering};
@@ -78,6 +78,47 @@ impl Tree for Bvh {
     #[inline]
     fn all_prims(&self) -> &[u32] {
         &self.prims
+    }
+}
+
+/// A tree seen in another frame: a tree built over one instance's coordinates, its boxes
+/// mapped conservatively into this instance's world coordinates by the relative transform
+/// ([`BoxMap`]), or read as they are (`map: None`: the tree is this instance's own). The root
+/// box is always the instance's exact world box. Assemblies (instances of one glTF mesh) and
+/// prepared meshes placed under a transform walk their trees through it.
+#[derive(Debug, Clone, Copy)]
+pub struct MappedTree<'a> {
+    /// The tree.
+    pub bvh: &'a Bvh,
+    /// The map into this frame, if the tree was built in another.
+    pub map: Option<BoxMap>,
+    /// The exact box of this instance in this frame.
+    pub root: Aabb,
+}
+
+impl Tree for MappedTree<'_> {
+    #[inline]
+    fn nodes(&self) -> &[Node] {
+        &self.bvh.nodes
+    }
+    #[inline]
+    fn node_box(&self, i: u32) -> Aabb {
+        match (&self.map, i) {
+            (_, 0) => self.root,
+            (None, _) => self.bvh.nodes[i as usize].bounds,
+            (Some(m), _) => m.map_box(&self.bvh.nodes[i as usize].bounds),
+        }
+    }
+    #[inline]
+    fn prims_of(&self, n: &Node) -> &[u32] {
+        self.bvh.leaf_prims(n)
+    }
+    fn stats(&self) -> crate::bvh::Stats {
+        self.bvh.stats()
+    }
+    #[inline]
+    fn all_prims(&self) -> &[u32] {
+        &self.bvh.prims
     }
 }
 

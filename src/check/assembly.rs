@@ -22,7 +22,7 @@
 //! an affine image of the leader's (to rounding), or without node matrices, falls back to a
 //! refitted copy of the leader's tree (exact boxes, a copy of the nodes).
 
-use crate::bvh::traverse::{self, Tree};
+use crate::bvh::traverse::{self, MappedTree};
 use crate::bvh::{BuildOptions, Bvh, Node};
 use crate::check::containment;
 use crate::check::containment::Containment;
@@ -186,43 +186,6 @@ impl TriMesh for PartMesh<'_> {
             }
             None => (0..self.vertex_count() as u32).map(|v| self.vertex(v)).collect::<Vec<_>>().into(),
         }
-    }
-}
-
-/// A part's tree as the walks see it: a tree built over this part's own coordinates (exact
-/// boxes), or another instance's tree whose boxes are mapped conservatively into this part's
-/// world coordinates by the relative transform between the two instances ([`BoxMap`]). The
-/// root box is always the part's exact world box.
-#[derive(Debug, Clone, Copy)]
-struct PartTree<'a> {
-    bvh: &'a Bvh,
-    map: Option<BoxMap>,
-    root: Aabb,
-}
-
-impl Tree for PartTree<'_> {
-    #[inline]
-    fn nodes(&self) -> &[Node] {
-        &self.bvh.nodes
-    }
-    #[inline]
-    fn node_box(&self, i: u32) -> Aabb {
-        match (&self.map, i) {
-            (_, 0) => self.root,
-            (None, _) => self.bvh.nodes[i as usize].bounds,
-            (Some(m), _) => m.map_box(&self.bvh.nodes[i as usize].bounds),
-        }
-    }
-    #[inline]
-    fn prims_of(&self, n: &Node) -> &[u32] {
-        self.bvh.leaf_prims(n)
-    }
-    fn stats(&self) -> crate::bvh::Stats {
-        self.bvh.stats()
-    }
-    #[inline]
-    fn all_prims(&self) -> &[u32] {
-        &self.bvh.prims
     }
 }
 
@@ -441,8 +404,8 @@ pub fn check_parts(
     let tree = |i: usize| {
         let p = plan[i].expect("needed part has a plan");
         match &refits[i] {
-            Some(t) => PartTree { bvh: t, map: None, root: parts[i].bounds },
-            None => PartTree { bvh: &own[p.layout], map: maps[i], root: parts[i].bounds },
+            Some(t) => MappedTree { bvh: t, map: None, root: parts[i].bounds },
+            None => MappedTree { bvh: &own[p.layout], map: maps[i], root: parts[i].bounds },
         }
     };
     // Memory: what copying each needed part into its own sub-mesh (f64 positions, triangles,
