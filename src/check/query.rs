@@ -340,7 +340,7 @@ pub struct ClashResult {
     /// Whether one part hides inside the other (decided only when no triangles meet).
     pub containment: Containment,
     /// Whether each input is closed (see [`crate::check::containment::topology`]); `None` where
-    /// no verdict needed it ([`check_built_with`]).
+    /// no verdict needed it (assemblies: [`PairPhase::needs_topology`]).
     pub closed: [Option<bool>; 2],
     /// The two trees.
     pub trees: [TreeStats; 2],
@@ -405,8 +405,10 @@ where
     (pairs, stop.load(Ordering::Relaxed))
 }
 
-/// As [`check`], with both trees already built (assemblies reuse one tree for many pairs).
-/// Both inputs' topology is computed (the report states whether each input is closed).
+/// As [`check`], with both trees already built. Both inputs' topology is computed (the report
+/// states whether each input is closed); containment reads it only when the verdict needs it
+/// ([`PairPhase::needs_topology`]). Assemblies run the phases themselves ([`pair_phase`], each
+/// needed part's topology once, [`PairPhase::finish`]).
 pub fn check_built<A, TA, B, TB>(a: &A, ta: &TA, b: &B, tb: &TB, settings: &Settings) -> ClashResult
 where
     A: TriMesh + ?Sized,
@@ -414,51 +416,12 @@ where
     B: TriMesh + ?Sized,
     TB: Tree + ?Sized,
 {
-    let (topo_a, topo_b) = (OnceLock::new(), OnceLock::new());
-    let _ = rayon::join(
-        || topo_a.get_or_init(|| containment::topology(a)),
-        || topo_b.get_or_init(|| containment::topology(b)),
-    );
-    check_built_with(a, ta, &topo_a, b, tb, &topo_b, settings)
-}
-
-/// As [`check_built`], with each side's topology (closedness, components, merged vertices)
-/// computed only if the verdict needs it — containment when no pair crosses and the boxes
-/// allow it, volumes overlap when faces touch — and kept in `topo_*` for other checks of the
-/// same part. [`ClashResult::closed`] says `None` for a side whose topology was not needed.
-///
-/// Call it from one thread per `topo_*` (the topology computation itself runs on rayon; an
-/// initialisation that blocked other rayon workers would serialise them). Assemblies use the
-/// phases directly: [`pair_phase`], then the topologies that [`PairPhase::needs_topology`]
-/// asks for, then [`PairPhase::finish`].
-pub fn check_built_with<A, TA, B, TB>(
-    a: &A,
-    ta: &TA,
-    topo_a: &OnceLock<containment::Topology>,
-    b: &B,
-    tb: &TB,
-    topo_b: &OnceLock<containment::Topology>,
-    settings: &Settings,
-) -> ClashResult
-where
-    A: TriMesh + ?Sized,
-    TA: Tree + ?Sized,
-    B: TriMesh + ?Sized,
-    TB: Tree + ?Sized,
-{
+    // The report states whether each input is closed, so file mode always computes both.
+    let (topo_a, topo_b) = rayon::join(|| containment::topology(a), || containment::topology(b));
     let phase = pair_phase(a, ta, b, tb, settings);
-    let topo = if phase.needs_topology(a, ta, b, tb, settings) {
-        let (x, y) = rayon::join(
-            || topo_a.get_or_init(|| containment::topology(a)),
-            || topo_b.get_or_init(|| containment::topology(b)),
-        );
-        Some((x, y))
-    } else {
-        None
-    };
-    let closed = [topo_a.get().map(|t| t.closed), topo_b.get().map(|t| t.closed)];
-    let mut r = phase.finish(a, ta, b, tb, topo, settings);
-    r.closed = closed;
+    let needs = phase.needs_topology(a, ta, b, tb, settings);
+    let mut r = phase.finish(a, ta, b, tb, needs.then_some((&topo_a, &topo_b)), settings);
+    r.closed = [Some(topo_a.closed), Some(topo_b.closed)];
     r
 }
 
