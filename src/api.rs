@@ -632,8 +632,7 @@ where
     TB: Tree + ?Sized,
 {
     let tol = Tolerances::default();
-    let (na, nb) = (ta.nodes(), tb.nodes());
-    if na.is_empty() || nb.is_empty() {
+    if ta.is_empty() || tb.is_empty() {
         return None;
     }
     let mut stack = vec![(0u32, 0u32, ta.node_box(0), tb.node_box(0))];
@@ -641,13 +640,12 @@ where
         if !tol.boxes_may_meet(&bi, &bj) {
             continue;
         }
-        let (x, y) = (&na[i as usize], &nb[j as usize]);
-        let open_a = match (x.is_leaf(), y.is_leaf()) {
+        let open_a = match (ta.is_leaf(i), tb.is_leaf(j)) {
             (true, true) => {
-                for &s in ta.prims_of(x) {
+                for &s in ta.leaf_prims(i) {
                     let ts = a.triangle(s);
                     let bs = Aabb::of_triangle(&ts);
-                    for &t in tb.prims_of(y) {
+                    for &t in tb.leaf_prims(j) {
                         let tt = b.triangle(t);
                         if !tol.boxes_may_meet(&bs, &Aabb::of_triangle(&tt)) {
                             continue;
@@ -672,11 +670,11 @@ where
             (false, false) => bi.half_area() >= bj.half_area(),
         };
         if open_a {
-            for c in [x.a, i + 1] {
+            for c in ta.children(i).into_iter().rev() {
                 stack.push((c, j, ta.node_box(c), bj));
             }
         } else {
-            for c in [y.a, j + 1] {
+            for c in tb.children(j).into_iter().rev() {
                 stack.push((i, c, bi, tb.node_box(c)));
             }
         }

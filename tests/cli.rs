@@ -270,7 +270,8 @@ fn a_part_hidden_inside_another_is_a_clash() {
     let r = parse(&out.stdout);
     assert_eq!(r.verdict, "clash");
     assert_eq!(r.summary.contained.map(|c| c.name()), Some("a_in_b"));
-    assert!(r.inputs.a.closed && r.inputs.b.closed);
+    // Containment needed both sides' topology, so closedness was computed and reported.
+    assert_eq!((r.inputs.a.closed, r.inputs.b.closed), (Some(true), Some(true)));
     assert!(r.pairs.is_empty());
     assert_eq!(r.summary.min_distance, Some(4.0));
     let out = bin().args([&outer, &inner]).output().unwrap();
@@ -289,6 +290,9 @@ fn a_part_hidden_inside_another_is_a_clash() {
     let apart = cube_obj(dir.path(), "apart.obj", [20.0; 3], [21.0; 3]);
     let r = parse(&bin().args([&apart, &outer]).output().unwrap().stdout);
     assert_eq!((r.verdict.name(), r.summary.contained.map(|c| c.name())), ("clear", None));
+    // Boxes that cannot nest and faces that do not touch: no verdict needs an inside, so
+    // closedness is not computed (null in the report), not guessed.
+    assert_eq!((r.inputs.a.closed, r.inputs.b.closed), (None, None));
 }
 
 #[test]
@@ -300,7 +304,7 @@ fn open_container_makes_containment_undecided() {
     let open: String = text.lines().filter(|l| *l != "f 5 6 8 7").map(|l| format!("{l}\n")).collect();
     std::fs::write(&outer, open).unwrap();
     let r = parse(&bin().args([&inner, &outer]).output().unwrap().stdout);
-    assert!(!r.inputs.b.closed);
+    assert_eq!(r.inputs.b.closed, Some(false));
     assert_eq!(r.summary.contained.map(|c| c.name()), Some("undecided"));
     assert!(r.summary.contained_reason.unwrap().contains("not closed"));
     assert_eq!(r.verdict, "clear");

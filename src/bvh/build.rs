@@ -131,6 +131,9 @@ struct Topo {
 /// Build over `n` triangles whose exact boxes `tri_box` returns (called twice per triangle:
 /// once to make the items, once for the leaf boxes).
 pub(super) fn build(n: usize, tri_box: impl Fn(u32) -> Aabb + Sync, opts: BuildOptions) -> Bvh {
+    if n <= PAR_THRESHOLD {
+        return build_sequential(n, tri_box, opts);
+    }
     let opts = BuildOptions { leaf_size: opts.leaf_size.clamp(1, 255), ..opts };
     if n == 0 {
         return Bvh { nodes: Vec::new(), prims: Vec::new() };
@@ -166,6 +169,46 @@ pub(super) fn build(n: usize, tri_box: impl Fn(u32) -> Aabb + Sync, opts: BuildO
         .collect();
     drop(topo);
     fill_interior(&mut nodes, 0, 0);
+    Bvh { nodes, prims }
+}
+
+/// [`build`] on the calling thread alone (no rayon task is spawned or waited for, so it may run
+/// inside a lock that other rayon tasks wait on: the lazy cells of [`super::lazy`]). The same
+/// decisions as [`build`], so the same tree.
+pub(super) fn build_sequential(n: usize, tri_box: impl Fn(u32) -> Aabb, opts: BuildOptions) -> Bvh {
+    let opts = BuildOptions { leaf_size: opts.leaf_size.clamp(1, 255), ..opts };
+    if n == 0 {
+        return Bvh { nodes: Vec::new(), prims: Vec::new() };
+    }
+    let n32 = u32::try_from(n).expect("triangle count fits in u32");
+    let stride = (n / 4096).max(1);
+    let origin = (0..n32).step_by(stride).fold(Aabb::EMPTY, |b, i| b.union(tri_box(i))).center();
+    let mut items: Vec<Item> = (0..n32).map(|i| Item::new(&tri_box(i), origin, i)).collect();
+    let cb = items.chunks(PAR_BIN_CHUNK).map(centre_bounds).fold(Box32::EMPTY, |mut a, b| {
+        a.union(&b);
+        a
+    });
+    let topo = sequential(opts, &mut items, cb, 0);
+    let prims: Vec<u32> = items.iter().map(Item::idx).collect();
+    drop(items);
+    let mut nodes: Vec<Node> = topo
+        .iter()
+        .map(|t| {
+            let bounds = if t.count > 0 {
+                let range = t.a as usize..(t.a + t.count) as usize;
+                prims[range].iter().fold(Aabb::EMPTY, |b, &p| b.union(tri_box(p)))
+            } else {
+                Aabb::EMPTY
+            };
+            Node { bounds, a: t.a, count: t.count }
+        })
+        .collect();
+    for i in (0..nodes.len()).rev() {
+        if !nodes[i].is_leaf() {
+            let r = nodes[i].a as usize;
+            nodes[i].bounds = nodes[i + 1].bounds.union(nodes[r].bounds);
+        }
+    }
     Bvh { nodes, prims }
 }
 

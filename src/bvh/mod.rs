@@ -9,6 +9,7 @@
 //! of the centroid bounds and equal counts (object median).
 
 mod build;
+pub mod lazy;
 pub mod slab;
 pub mod traverse;
 mod validate;
@@ -99,6 +100,9 @@ pub struct Stats {
     pub sah_cost: f64,
     /// Bytes of nodes + prim indices.
     pub bytes: usize,
+    /// Cells left to be built on first use ([`lazy::LazyBvh`]), each counted above as one leaf;
+    /// 0 for a tree built whole.
+    pub cells: usize,
 }
 
 impl Bvh {
@@ -125,6 +129,22 @@ impl Bvh {
     #[inline]
     pub fn leaf_prims(&self, n: &Node) -> &[u32] {
         &self.prims[n.a as usize..(n.a + n.count) as usize]
+    }
+
+    /// The triangles below node `i`: one contiguous run of [`Bvh::prims`] (leaves are stored in
+    /// depth-first order).
+    pub fn subtree_prims(&self, i: u32) -> &[u32] {
+        let nodes = &self.nodes;
+        let mut first = i as usize;
+        while !nodes[first].is_leaf() {
+            first += 1;
+        }
+        let mut last = i as usize;
+        while !nodes[last].is_leaf() {
+            last = nodes[last].a as usize;
+        }
+        let (s, e) = (nodes[first].a as usize, (nodes[last].a + nodes[last].count) as usize);
+        &self.prims[s..e]
     }
 
     /// Check every invariant: each triangle exactly once, leaves non-empty and at most

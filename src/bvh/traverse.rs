@@ -12,7 +12,7 @@
 //! (`crate::check::assembly`), and the walk carries each node's mapped box on its stack so that a box
 //! is mapped once per node pair opened.
 
-use crate::bvh::{Bvh, Node};
+use crate::bvh::Bvh;
 use crate::geom::predicates::{self, BoxMap};
 use crate::geom::{Aabb, DVec3};
 use rayon::prelude::*;
@@ -21,37 +21,30 @@ use std::sync::atomic::{AtomicU64, Ordering};
 /// How many independent sub-walks the root pair is split into (fixed, for determinism).
 const SEED_TASKS: usize = 256;
 
-/// A tree as the walks see it.
+/// A tree as the walks see it: node ids, starting at the root 0, with their boxes in the
+/// walk's frame. A [`Bvh`] is its own frame and its ids are its node indices; a
+/// [`crate::bvh::lazy::LazyBvh`] builds nodes when a walk first asks for a node's children.
 pub trait Tree: Sync {
-    /// The nodes, depth-first (see [`Bvh`]).
-    fn nodes(&self) -> &[Node];
+    /// True for a tree with no nodes.
+    fn is_empty(&self) -> bool;
+    /// Is node `i` a leaf?
+    fn is_leaf(&self, i: u32) -> bool;
+    /// The two children of interior node `i`.
+    fn children(&self, i: u32) -> [u32; 2];
     /// The box of node `i` in the walk's frame: it contains every triangle below the node (as
     /// the leaf closures see them).
     fn node_box(&self, i: u32) -> Aabb;
-    /// The triangles of leaf `n`.
-    fn prims_of(&self, n: &Node) -> &[u32];
+    /// The triangles of leaf `i`.
+    fn leaf_prims(&self, i: u32) -> &[u32];
+    /// Every triangle below node `i`.
+    fn subtree_prims(&self, i: u32) -> &[u32];
+    /// One more than the largest node id (for tables indexed by node).
+    fn id_bound(&self) -> usize;
     /// Size and quality of the underlying tree.
     fn stats(&self) -> crate::bvh::Stats;
-    /// Every triangle index, grouped by leaf in depth-first order (so the triangles below any
-    /// node are one contiguous run: [`Tree::subtree_prims`]).
-    fn all_prims(&self) -> &[u32];
-    /// The triangles below node `i` (a contiguous run of [`Tree::all_prims`]).
-    fn subtree_prims(&self, i: u32) -> &[u32] {
-        let nodes = self.nodes();
-        let mut first = i as usize;
-        while !nodes[first].is_leaf() {
-            first += 1;
-        }
-        let mut last = i as usize;
-        while !nodes[last].is_leaf() {
-            last = nodes[last].a as usize;
-        }
-        let (s, e) = (nodes[first].a as usize, (nodes[last].a + nodes[last].count) as usize);
-        &self.all_prims()[s..e]
-    }
     /// The root box (empty for an empty tree).
     fn root_box(&self) -> Aabb {
-        if self.nodes().is_empty() {
+        if self.is_empty() {
             Aabb::EMPTY
         } else {
             self.node_box(0)
@@ -61,23 +54,33 @@ pub trait Tree: Sync {
 
 impl Tree for Bvh {
     #[inline]
-    fn nodes(&self) -> &[Node] {
-        &self.nodes
+    fn is_empty(&self) -> bool {
+        self.nodes.is_empty()
+    }
+    #[inline]
+    fn is_leaf(&self, i: u32) -> bool {
+        self.nodes[i as usize].is_leaf()
+    }
+    #[inline]
+    fn children(&self, i: u32) -> [u32; 2] {
+        [i + 1, self.nodes[i as usize].a]
     }
     #[inline]
     fn node_box(&self, i: u32) -> Aabb {
         self.nodes[i as usize].bounds
     }
     #[inline]
-    fn prims_of(&self, n: &Node) -> &[u32] {
-        self.leaf_prims(n)
+    fn leaf_prims(&self, i: u32) -> &[u32] {
+        Bvh::leaf_prims(self, &self.nodes[i as usize])
+    }
+    fn subtree_prims(&self, i: u32) -> &[u32] {
+        Bvh::subtree_prims(self, i)
+    }
+    fn id_bound(&self) -> usize {
+        self.nodes.len()
     }
     fn stats(&self) -> crate::bvh::Stats {
         Bvh::stats(self)
-    }
-    #[inline]
-    fn all_prims(&self) -> &[u32] {
-        &self.prims
     }
 }
 
@@ -86,39 +89,56 @@ impl Tree for Bvh {
 /// ([`BoxMap`]), or read as they are (`map: None`: the tree is this instance's own). The root
 /// box is always the instance's exact world box. Assemblies (instances of one glTF mesh) and
 /// prepared meshes placed under a transform walk their trees through it.
-#[derive(Debug, Clone, Copy)]
-pub struct MappedTree<'a> {
+#[derive(Debug)]
+pub struct MappedTree<'a, T: ?Sized = Bvh> {
     /// The tree.
-    pub bvh: &'a Bvh,
+    pub bvh: &'a T,
     /// The map into this frame, if the tree was built in another.
     pub map: Option<BoxMap>,
     /// The exact box of this instance in this frame.
     pub root: Aabb,
 }
 
-impl Tree for MappedTree<'_> {
+impl<T: ?Sized> Clone for MappedTree<'_, T> {
+    fn clone(&self) -> Self {
+        *self
+    }
+}
+impl<T: ?Sized> Copy for MappedTree<'_, T> {}
+
+impl<T: Tree + ?Sized> Tree for MappedTree<'_, T> {
     #[inline]
-    fn nodes(&self) -> &[Node] {
-        &self.bvh.nodes
+    fn is_empty(&self) -> bool {
+        self.bvh.is_empty()
+    }
+    #[inline]
+    fn is_leaf(&self, i: u32) -> bool {
+        self.bvh.is_leaf(i)
+    }
+    #[inline]
+    fn children(&self, i: u32) -> [u32; 2] {
+        self.bvh.children(i)
     }
     #[inline]
     fn node_box(&self, i: u32) -> Aabb {
         match (&self.map, i) {
             (_, 0) => self.root,
-            (None, _) => self.bvh.nodes[i as usize].bounds,
-            (Some(m), _) => m.map_box(&self.bvh.nodes[i as usize].bounds),
+            (None, _) => self.bvh.node_box(i),
+            (Some(m), _) => m.map_box(&self.bvh.node_box(i)),
         }
     }
     #[inline]
-    fn prims_of(&self, n: &Node) -> &[u32] {
-        self.bvh.leaf_prims(n)
+    fn leaf_prims(&self, i: u32) -> &[u32] {
+        self.bvh.leaf_prims(i)
+    }
+    fn subtree_prims(&self, i: u32) -> &[u32] {
+        self.bvh.subtree_prims(i)
+    }
+    fn id_bound(&self) -> usize {
+        self.bvh.id_bound()
     }
     fn stats(&self) -> crate::bvh::Stats {
         self.bvh.stats()
-    }
-    #[inline]
-    fn all_prims(&self) -> &[u32] {
-        &self.bvh.prims
     }
 }
 
@@ -127,8 +147,8 @@ type Entry = (u32, u32, Aabb, Aabb);
 
 /// Which node of a pair to open: the larger, never a leaf. `None` when both are leaves.
 #[inline]
-fn open_a(a: &Node, ba: &Aabb, b: &Node, bb: &Aabb) -> Option<bool> {
-    match (a.is_leaf(), b.is_leaf()) {
+fn open_a(a_leaf: bool, ba: &Aabb, b_leaf: bool, bb: &Aabb) -> Option<bool> {
+    match (a_leaf, b_leaf) {
         (true, true) => None,
         (true, false) => Some(false),
         (false, true) => Some(true),
@@ -140,11 +160,12 @@ fn open_a(a: &Node, ba: &Aabb, b: &Node, bb: &Aabb) -> Option<bool> {
 #[inline]
 fn children<A: Tree + ?Sized, B: Tree + ?Sized>(ta: &A, tb: &B, e: &Entry) -> Option<[Entry; 2]> {
     let &(i, j, ba, bb) = e;
-    let (a, b) = (&ta.nodes()[i as usize], &tb.nodes()[j as usize]);
-    Some(if open_a(a, &ba, b, &bb)? {
-        [(i + 1, j, ta.node_box(i + 1), bb), (a.a, j, ta.node_box(a.a), bb)]
+    Some(if open_a(ta.is_leaf(i), &ba, tb.is_leaf(j), &bb)? {
+        let [l, r] = ta.children(i);
+        [(l, j, ta.node_box(l), bb), (r, j, ta.node_box(r), bb)]
     } else {
-        [(i, j + 1, ba, tb.node_box(j + 1)), (i, b.a, ba, tb.node_box(b.a))]
+        let [l, r] = tb.children(j);
+        [(i, l, ba, tb.node_box(l)), (i, r, ba, tb.node_box(r))]
     })
 }
 
@@ -154,7 +175,7 @@ fn seed<A: Tree + ?Sized, B: Tree + ?Sized>(
     tb: &B,
     keep: &dyn Fn(&Aabb, &Aabb) -> bool,
 ) -> Vec<Entry> {
-    if ta.nodes().is_empty() || tb.nodes().is_empty() {
+    if ta.is_empty() || tb.is_empty() {
         return Vec::new();
     }
     let root = (0, 0, ta.node_box(0), tb.node_box(0));
@@ -204,10 +225,7 @@ where
             let mut stack = vec![*s];
             while let Some(e) = stack.pop() {
                 match children(ta, tb, &e) {
-                    None => {
-                        let (a, b) = (&ta.nodes()[e.0 as usize], &tb.nodes()[e.1 as usize]);
-                        leaf(ta.prims_of(a), tb.prims_of(b), &mut out);
-                    }
+                    None => leaf(ta.leaf_prims(e.0), tb.leaf_prims(e.1), &mut out),
                     Some(kids) => {
                         for k in kids.iter().rev() {
                             if boxes_meet(&k.2, &k.3) {
@@ -236,7 +254,7 @@ fn any_where<T: Tree + ?Sized>(
     keep: impl Fn(&Aabb) -> bool,
     mut visit: impl FnMut(u32) -> bool,
 ) -> bool {
-    if tree.nodes().is_empty() {
+    if tree.is_empty() {
         return false;
     }
     let mut stack = vec![0u32];
@@ -244,13 +262,13 @@ fn any_where<T: Tree + ?Sized>(
         if !keep(&tree.node_box(i)) {
             continue;
         }
-        let node = &tree.nodes()[i as usize];
-        if !node.is_leaf() {
-            stack.push(node.a);
-            stack.push(i + 1);
+        if !tree.is_leaf(i) {
+            let [l, r] = tree.children(i);
+            stack.push(r);
+            stack.push(l);
             continue;
         }
-        if tree.prims_of(node).iter().any(|&t| visit(t)) {
+        if tree.leaf_prims(i).iter().any(|&t| visit(t)) {
             return true;
         }
     }
@@ -374,9 +392,8 @@ where
                 }
                 match children(ta, tb, &e) {
                     None => {
-                        let (a, b) = (&ta.nodes()[e.0 as usize], &tb.nodes()[e.1 as usize]);
                         let cur = f64::from_bits(best.load(Ordering::Relaxed));
-                        if let Some(c) = leaf(ta.prims_of(a), tb.prims_of(b), cur + slack) {
+                        if let Some(c) = leaf(ta.leaf_prims(e.0), tb.leaf_prims(e.1), cur + slack) {
                             best.fetch_min(c.distance.to_bits(), Ordering::Relaxed);
                             if mine.as_ref().is_none_or(|m| better(&c, m)) {
                                 mine = Some(c);

@@ -72,7 +72,7 @@ pub(super) fn validate(bvh: &Bvh, tri_boxes: &[Aabb], leaf_size: u32) -> Result<
 
 pub(super) fn stats(bvh: &Bvh) -> Stats {
     let bytes = bvh.nodes.len() * std::mem::size_of::<super::Node>() + bvh.prims.len() * 4;
-    let mut s = Stats { nodes: bvh.nodes.len(), leaves: 0, depth: 0, sah_cost: 0.0, bytes };
+    let mut s = Stats { nodes: bvh.nodes.len(), leaves: 0, depth: 0, sah_cost: 0.0, bytes, cells: 0 };
     let Some(root) = bvh.nodes.first() else {
         return s;
     };

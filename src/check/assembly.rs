@@ -789,7 +789,7 @@ pub fn run(a: &Mesh, b: &Mesh, sel: &Selection, settings: &Settings) -> Result<O
         verdict,
         containment,
         closed: [None, None],
-        trees: [crate::bvh::Stats { nodes: 0, leaves: 0, depth: 0, sah_cost: 0.0, bytes: 0 }; 2],
+        trees: [crate::bvh::Stats { nodes: 0, leaves: 0, depth: 0, sah_cost: 0.0, bytes: 0, cells: 0 }; 2],
         timings: crate::check::query::Timings { build_ms: ar.build_ms, query_ms: ar.query_ms },
     };
     Ok(Outcome { result, parts: ar.parts, part_pairs, info })

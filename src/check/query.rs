@@ -4,9 +4,10 @@
 //! Every candidate pair is classified exactly ([`crate::narrow::tri_tri`]); distances (for tolerance
 //! bands, clearance and the closest pair) are f64 closed forms ([`crate::narrow::distance`]).
 
+use crate::bvh::lazy::LazyBvh;
 use crate::bvh::slab::{self, Oriented};
 use crate::bvh::traverse::{self, Candidate, Tree};
-use crate::bvh::{self, BuildOptions, Bvh};
+use crate::bvh::{self, BuildOptions};
 use crate::check::containment::{self, Containment};
 use crate::error::{Error, Result};
 use crate::geom::predicates::{self, Tolerances};
@@ -351,7 +352,7 @@ pub struct ClashResult {
 /// Run the check on two meshes in world coordinates.
 pub fn check(a: &Mesh, b: &Mesh, settings: &Settings) -> ClashResult {
     let t0 = Instant::now();
-    let (ta, tb) = rayon::join(|| Bvh::build(a, settings.bvh), || Bvh::build(b, settings.bvh));
+    let (ta, tb) = rayon::join(|| LazyBvh::new(a, settings.bvh), || LazyBvh::new(b, settings.bvh));
     let build_ms = ms(t0);
     let mut r = check_built(a, &ta, b, &tb, settings);
     r.timings.build_ms = build_ms;
@@ -405,10 +406,10 @@ where
     (pairs, stop.load(Ordering::Relaxed))
 }
 
-/// As [`check`], with both trees already built. Both inputs' topology is computed (the report
-/// states whether each input is closed); containment reads it only when the verdict needs it
-/// ([`PairPhase::needs_topology`]). Assemblies run the phases themselves ([`pair_phase`], each
-/// needed part's topology once, [`PairPhase::finish`]).
+/// As [`check`], with both trees already built. The topology of the inputs (closedness, for
+/// containment and face-to-face volume overlap) is computed only when the verdict needs it
+/// ([`PairPhase::needs_topology`]); `closed` is `None` otherwise. Assemblies run the same phases
+/// themselves ([`pair_phase`], each needed part's topology once, [`PairPhase::finish`]).
 pub fn check_built<A, TA, B, TB>(a: &A, ta: &TA, b: &B, tb: &TB, settings: &Settings) -> ClashResult
 where
     A: TriMesh + ?Sized,
@@ -416,11 +417,12 @@ where
     B: TriMesh + ?Sized,
     TB: Tree + ?Sized,
 {
-    // The report states whether each input is closed, so file mode always computes both.
-    let (topo_a, topo_b) = rayon::join(|| containment::topology(a), || containment::topology(b));
     let phase = pair_phase(a, ta, b, tb, settings);
-    let needs = phase.needs_topology(a, ta, b, tb, settings);
-    let mut r = phase.finish(a, ta, b, tb, needs.then_some((&topo_a, &topo_b)), settings);
+    if !phase.needs_topology(a, ta, b, tb, settings) {
+        return phase.finish(a, ta, b, tb, None, settings);
+    }
+    let (topo_a, topo_b) = rayon::join(|| containment::topology(a), || containment::topology(b));
+    let mut r = phase.finish(a, ta, b, tb, Some((&topo_a, &topo_b)), settings);
     r.closed = [Some(topo_a.closed), Some(topo_b.closed)];
     r
 }
@@ -622,20 +624,30 @@ pub const ORIENTED_MAX_TRIANGLES: usize = 64;
 
 /// Oriented bounds of one tree's nodes, computed on first use and shared by every thread of a
 /// search (each is a function of its node alone, so the order of computation does not matter).
+/// The slots come in chunks allocated on first use, so a lazy tree's wide id range costs only
+/// what the search touches.
 struct OrientedCache<'a, M: TriMesh + ?Sized, T: Tree + ?Sized> {
     mesh: &'a M,
     tree: &'a T,
-    slots: Vec<OnceLock<Option<Box<Oriented>>>>,
+    chunks: Vec<OnceLock<Box<[Slot]>>>,
 }
+
+type Slot = OnceLock<Option<Box<Oriented>>>;
+
+/// Node ids per chunk of [`OrientedCache`] slots.
+const ORIENTED_CHUNK_SHIFT: u32 = 8;
 
 impl<'a, M: TriMesh + ?Sized, T: Tree + ?Sized> OrientedCache<'a, M, T> {
     fn new(mesh: &'a M, tree: &'a T) -> Self {
-        OrientedCache { mesh, tree, slots: (0..tree.nodes().len()).map(|_| OnceLock::new()).collect() }
+        let n = tree.id_bound().div_ceil(1 << ORIENTED_CHUNK_SHIFT);
+        OrientedCache { mesh, tree, chunks: (0..n).map(|_| OnceLock::new()).collect() }
     }
 
     #[inline]
     fn get(&self, i: u32) -> Option<&Oriented> {
-        self.slots[i as usize]
+        let chunk = self.chunks[(i >> ORIENTED_CHUNK_SHIFT) as usize]
+            .get_or_init(|| (0..1 << ORIENTED_CHUNK_SHIFT).map(|_| OnceLock::new()).collect());
+        chunk[(i & ((1 << ORIENTED_CHUNK_SHIFT) - 1)) as usize]
             .get_or_init(|| {
                 let prims = self.tree.subtree_prims(i);
                 if prims.len() > ORIENTED_MAX_TRIANGLES {
@@ -690,7 +702,7 @@ where
             let gap = oa.gap(ob);
             // The rectangle bound costs four triangle distances: worth it only where a prune
             // saves subtrees on both sides (measured on linked tori and 2CylinderEngine).
-            let leafy = ta.nodes()[i as usize].is_leaf() || tb.nodes()[j as usize].is_leaf();
+            let leafy = ta.is_leaf(i) || tb.is_leaf(j);
             let fine = if shrink(gap - margin) > cut || leafy { gap } else { oa.swept_rect_bound(ob, gap) };
             boxed.max(shrink(fine - margin))
         },

@@ -229,7 +229,11 @@ pub fn render(r: &Report, color: bool) -> String {
             i.triangles,
             i.objects.len(),
             if i.objects.len() == 1 { "" } else { "s" },
-            if i.closed { ", closed" } else { "" }
+            match i.closed {
+                Some(true) => ", closed",
+                Some(false) => ", open",
+                None => "",
+            }
         );
     }
     if let Some(line) = units_line(r) {

@@ -34,7 +34,7 @@
 //!              "contact": "point|segment|coplanar_area|coplanar_boundary|within_tolerance" | null,
 //!              "distance", "segment": [[x,y,z],[x,y,z]] | null}],
 //!   "pairs_truncated": bool,
-//!   "bvh": {"a": {"nodes", "leaves", "depth", "sah_cost", "bytes"}, "b": {...}},
+//!   "bvh": {"a": {"nodes", "leaves", "depth", "sah_cost", "bytes", "cells"}, "b": {...}},
 //!   "assembly": {"mode": "files|parts", "selected": [a, b], "candidate_part_pairs",
 //!                "built_parts": n | null, "sah_builds": n | null,
 //!                "shared_trees"?: n, "memory_saved_bytes"?: n},
@@ -580,7 +580,10 @@ pub struct InputReport {
     pub degenerate_triangles: usize,
     /// Every edge of its non-degenerate triangles is shared by exactly two of them (after
     /// merging exactly coincident vertices): it bounds a volume and can contain the other part.
-    pub closed: bool,
+    /// `null`: not computed, because no verdict needed it (a crossing decides the verdict
+    /// alone, and parts whose boxes cannot nest and whose faces do not touch need no inside);
+    /// `meshclash self FILE` always reports it.
+    pub closed: Option<bool>,
     /// Objects in file order.
     pub objects: Vec<ObjectReport>,
     /// World bounds (after the transform).
@@ -770,6 +773,12 @@ pub struct TreeReport {
     pub sah_cost: f64,
     /// Bytes.
     pub bytes: usize,
+    /// Cells: subtrees of at most a thousand-odd triangles that are built only when a walk first
+    /// opens them. The figures above describe the tree built up front, each cell counted as one
+    /// leaf (which cells a run opens depends on the walk, so they are not counted). 0 for a
+    /// tree built whole (scenes' part trees).
+    #[serde(default)]
+    pub cells: usize,
 }
 
 /// Phase times.
@@ -809,7 +818,12 @@ fn v3(p: DVec3) -> [f64; 3] {
     p.to_array()
 }
 
-fn input_report(input: &Input, m: &DMat4, info: &crate::check::query::MeshInfo, closed: bool) -> InputReport {
+fn input_report(
+    input: &Input,
+    m: &DMat4,
+    info: &crate::check::query::MeshInfo,
+    closed: Option<bool>,
+) -> InputReport {
     let Aabb { min, max } = info.bounds;
     InputReport {
         path: input.path.display().to_string(),
@@ -826,7 +840,14 @@ fn input_report(input: &Input, m: &DMat4, info: &crate::check::query::MeshInfo, 
 }
 
 fn tree_report(s: &TreeStats) -> TreeReport {
-    TreeReport { nodes: s.nodes, leaves: s.leaves, depth: s.depth, sah_cost: s.sah_cost, bytes: s.bytes }
+    TreeReport {
+        nodes: s.nodes,
+        leaves: s.leaves,
+        depth: s.depth,
+        sah_cost: s.sah_cost,
+        bytes: s.bytes,
+        cells: s.cells,
+    }
 }
 
 fn pair_report(p: &PairFinding, ca: &[u32], cb: &[u32]) -> PairReport {
@@ -864,8 +885,8 @@ pub fn build(ctx: &Context, r: &ClashResult) -> Report {
         schema: SCHEMA.to_string(),
         tool: Tool::this(),
         inputs: Inputs {
-            a: input_report(ia, &ctx.transforms[0], &infa, r.closed[0].unwrap_or(false)),
-            b: input_report(ib, &ctx.transforms[1], &infb, r.closed[1].unwrap_or(false)),
+            a: input_report(ia, &ctx.transforms[0], &infa, r.closed[0]),
+            b: input_report(ib, &ctx.transforms[1], &infb, r.closed[1]),
         },
         settings: ctx.settings.clone(),
         verdict: r.verdict.into(),
