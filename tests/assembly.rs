@@ -333,7 +333,10 @@ fn non_uniform_scaled_instance_touches_exactly_and_misses_by_one_ulp() {
     assert!(m.pairs.is_empty());
     assert_eq!(m.verdict, Verdict::Clear);
     assert_eq!(m.containment, meshclash::check::containment::Containment::None);
-    assert_eq!(m.closest.unwrap().distance, ulp);
+    // A clear part pair's distance is searched only as far as it could be the scene's minimum:
+    // other pairs touch here (minimum 0), so it is not searched at all; the clearance run
+    // below lists it, and with it the exact 2^-52 gap.
+    assert!(m.closest.is_none_or(|c| c.distance == ulp));
 
     let p = &pairs[&key("lead", "partner")];
     assert_eq!((p.counts.crossing, p.verdict), (0, Verdict::Touching));

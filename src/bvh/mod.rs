@@ -88,7 +88,7 @@ pub struct Bvh {
 }
 
 /// Size and quality figures of a tree.
-#[derive(Debug, Clone, Copy, PartialEq)]
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
 pub struct Stats {
     /// Number of nodes.
     pub nodes: usize,

@@ -16,7 +16,8 @@ use crate::bvh::Bvh;
 use crate::geom::predicates::{self, BoxMap};
 use crate::geom::{Aabb, DVec3};
 use rayon::prelude::*;
-use std::sync::atomic::{AtomicU64, Ordering};
+pub use std::sync::atomic::AtomicU64;
+use std::sync::atomic::Ordering;
 
 /// How many independent sub-walks the root pair is split into (fixed, for determinism).
 const SEED_TASKS: usize = 256;
@@ -367,8 +368,33 @@ where
     D: Fn(&mut S, u32, &Aabb, u32, &Aabb, f64) -> f64 + Sync,
     L: Fn(&[u32], &[u32], f64) -> Option<Candidate<R>> + Sync,
 {
-    // Best distance so far, as f64 bits (order-preserving for non-negative values).
     let best = AtomicU64::new(f64::INFINITY.to_bits());
+    min_pair_shared(ta, tb, new_state, lower_bound, slack, leaf, &best)
+}
+
+/// As [`min_pair_with`], pruning against a best distance shared with other searches (`best`:
+/// the f64 bits of a non-negative distance, order-preserving; lowered as candidates are
+/// found). Candidates farther than `best` plus `slack` are never evaluated, so the result is
+/// `None` when nothing in these trees can come within it; when some searches share one
+/// `best`, the minimum of their results is the minimum over all of them, and its (distance,
+/// key) does not depend on the order in which they run.
+pub fn min_pair_shared<R, S, A, B, N, D, L>(
+    ta: &A,
+    tb: &B,
+    new_state: N,
+    lower_bound: D,
+    slack: f64,
+    leaf: L,
+    best: &AtomicU64,
+) -> Option<Candidate<R>>
+where
+    R: Send + Copy,
+    A: Tree + ?Sized,
+    B: Tree + ?Sized,
+    N: Fn() -> S + Sync,
+    D: Fn(&mut S, u32, &Aabb, u32, &Aabb, f64) -> f64 + Sync,
+    L: Fn(&[u32], &[u32], f64) -> Option<Candidate<R>> + Sync,
+{
     let bound = |best: &AtomicU64| f64::from_bits(best.load(Ordering::Relaxed)) + slack;
     let mut seed_state = new_state();
     let mut seeds: Vec<(f64, Entry)> = seed(ta, tb, &|_, _| true)
@@ -381,13 +407,13 @@ where
         .par_iter()
         .map(|&(lb, e)| {
             let mut mine: Option<Candidate<R>> = None;
-            if lb > bound(&best) {
+            if lb > bound(best) {
                 return None;
             }
             let mut state = new_state();
             let mut stack = vec![(lb, e)];
             while let Some((lb, e)) = stack.pop() {
-                if lb > bound(&best) {
+                if lb > bound(best) {
                     continue;
                 }
                 match children(ta, tb, &e) {
@@ -401,12 +427,12 @@ where
                         }
                     }
                     Some(kids) => {
-                        let cut = bound(&best);
+                        let cut = bound(best);
                         let d = kids.map(|k| lower_bound(&mut state, k.0, &k.2, k.1, &k.3, cut));
                         // Push the farther first so the nearer is opened first.
                         let order = if d[0] <= d[1] { [1, 0] } else { [0, 1] };
                         for k in order {
-                            if d[k] <= bound(&best) {
+                            if d[k] <= bound(best) {
                                 stack.push((d[k], kids[k]));
                             }
                         }

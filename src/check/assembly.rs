@@ -22,12 +22,15 @@
 //! an affine image of the leader's (to rounding), or without node matrices, falls back to a
 //! refitted copy of the leader's tree (exact boxes, a copy of the nodes).
 
+use crate::bvh::traverse::AtomicU64;
 use crate::bvh::traverse::{self, MappedTree};
 use crate::bvh::{BuildOptions, Bvh, Node};
 use crate::check::containment;
 use crate::check::containment::Containment;
 use crate::check::containment::Topology;
-use crate::check::query::{pair_phase, ClashResult, PairFinding, PairPhase, Settings, Verdict};
+use crate::check::query::{
+    closest_pair_within, pair_walk, ClashResult, PairFinding, PairPhase, Settings, Verdict,
+};
 use crate::geom::predicates::BoxMap;
 use crate::geom::{Aabb, DVec3};
 use crate::scene::mesh::{Mesh, Object, TriMesh};
@@ -242,7 +245,10 @@ pub struct PartPair {
     pub a: usize,
     /// Index into [`AssemblyResult::parts`] (the B side).
     pub b: usize,
-    /// The check of the two parts; triangle indices are those of the input meshes.
+    /// The check of the two parts; triangle indices are those of the input meshes. A pair with
+    /// a finding (listed in the report) has its closest points; a clear pair has them only if
+    /// it could be the scene's closest (its `closest` is `None` when a pair at least as close
+    /// was known: see [`check_parts`]).
     pub result: ClashResult,
 }
 
@@ -436,7 +442,7 @@ pub fn check_parts(
         .par_iter()
         .map(|&(a, b)| {
             let (va, vb, ta, tb) = (view(a), view(b), tree(a), tree(b));
-            let phase = pair_phase(&va, &ta, &vb, &tb, settings);
+            let phase = pair_walk(&va, &ta, &vb, &tb, settings);
             let needs = phase.needs_topology(&va, &ta, &vb, &tb, settings);
             (phase, needs)
         })
@@ -452,15 +458,49 @@ pub fn check_parts(
         .into_par_iter()
         .map(|i| wanted[i].then(|| containment::topology(&view(i))))
         .collect();
-    let part_pairs: Vec<PartPair> = candidates
+    let mut finished: Vec<(ClashResult, bool)> = candidates
         .par_iter()
         .zip(phases.into_par_iter())
         .map(|(&(a, b), (phase, needs))| {
             let topo =
                 needs.then(|| (topology[a].as_ref().expect("wanted"), topology[b].as_ref().expect("wanted")));
+            let pending = phase.closest_pending();
             let mut r = phase.finish(&view(a), &tree(a), &view(b), &tree(b), topo, settings);
             r.closed = [topology[a].as_ref().map(|t| t.closed), topology[b].as_ref().map(|t| t.closed)];
             r.timings = Default::default();
+            (r, pending)
+        })
+        .collect();
+    // Distances. A part pair with a finding is listed with its closest points: searched in full.
+    // A clear pair's distance shows only through the scene's minimum, so it is searched only as
+    // far as it could be that minimum: all clear pairs share one bound, starting at the least
+    // distance already known (0 as soon as any pair touches or crosses: then no clear pair,
+    // whose exact distance is positive, can be the minimum and none is searched).
+    let listed = |r: &ClashResult| r.verdict != Verdict::Clear || r.containment != Containment::None;
+    let closest_of = |&(a, b): &(usize, usize)| {
+        let (va, vb, ta, tb) = (view(a), view(b), tree(a), tree(b));
+        move |best: &AtomicU64| closest_pair_within(&va, &ta, &vb, &tb, settings.distance_error, best)
+    };
+    finished.par_iter_mut().zip(candidates.par_iter()).filter(|((r, p), _)| *p && listed(r)).for_each(
+        |((r, pending), pair)| {
+            r.closest = closest_of(pair)(&AtomicU64::new(f64::INFINITY.to_bits()));
+            *pending = false;
+        },
+    );
+    let known =
+        finished.iter().filter_map(|(r, _)| r.closest.map(|c| c.distance)).fold(f64::INFINITY, f64::min);
+    if known > 0.0 {
+        let shared = AtomicU64::new(known.to_bits());
+        finished.par_iter_mut().zip(candidates.par_iter()).filter(|((_, p), _)| *p).for_each(
+            |((r, _), pair)| {
+                r.closest = closest_of(pair)(&shared);
+            },
+        );
+    }
+    let part_pairs: Vec<PartPair> = finished
+        .into_iter()
+        .zip(&candidates)
+        .map(|((mut r, _), &(a, b))| {
             to_input_indices(&mut r, &parts[a], &parts[b]);
             PartPair { a, b, result: r }
         })
@@ -789,7 +829,7 @@ pub fn run(a: &Mesh, b: &Mesh, sel: &Selection, settings: &Settings) -> Result<O
         verdict,
         containment,
         closed: [None, None],
-        trees: [crate::bvh::Stats { nodes: 0, leaves: 0, depth: 0, sah_cost: 0.0, bytes: 0, cells: 0 }; 2],
+        trees: Default::default(),
         timings: crate::check::query::Timings { build_ms: ar.build_ms, query_ms: ar.query_ms },
     };
     Ok(Outcome { result, parts: ar.parts, part_pairs, info })

@@ -343,7 +343,8 @@ pub struct ClashResult {
     /// Whether each input is closed (see [`crate::check::containment::topology`]); `None` where
     /// no verdict needed it (assemblies: [`PairPhase::needs_topology`]).
     pub closed: [Option<bool>; 2],
-    /// The two trees.
+    /// The two trees ([`check_built`]; zero for part pairs of an assembly, whose report has no
+    /// per-tree figures).
     pub trees: [TreeStats; 2],
     /// Phase times.
     pub timings: Timings,
@@ -418,12 +419,15 @@ where
     TB: Tree + ?Sized,
 {
     let phase = pair_phase(a, ta, b, tb, settings);
-    if !phase.needs_topology(a, ta, b, tb, settings) {
-        return phase.finish(a, ta, b, tb, None, settings);
-    }
-    let (topo_a, topo_b) = rayon::join(|| containment::topology(a), || containment::topology(b));
-    let mut r = phase.finish(a, ta, b, tb, Some((&topo_a, &topo_b)), settings);
-    r.closed = [Some(topo_a.closed), Some(topo_b.closed)];
+    let mut r = if phase.needs_topology(a, ta, b, tb, settings) {
+        let (topo_a, topo_b) = rayon::join(|| containment::topology(a), || containment::topology(b));
+        let mut r = phase.finish(a, ta, b, tb, Some((&topo_a, &topo_b)), settings);
+        r.closed = [Some(topo_a.closed), Some(topo_b.closed)];
+        r
+    } else {
+        phase.finish(a, ta, b, tb, None, settings)
+    };
+    r.trees = [ta.stats(), tb.stats()];
     r
 }
 
@@ -433,11 +437,32 @@ pub struct PairPhase {
     pairs: Vec<PairFinding>,
     counts: Counts,
     closest: Option<Closest>,
+    /// No pair met exactly and the walk ran to the end: the closest pair is still to find.
+    pending: bool,
     started: Instant,
 }
 
 /// Find every pair and the closest pair ([`PairPhase::finish`] adds containment and the verdict).
 pub fn pair_phase<A, TA, B, TB>(a: &A, ta: &TA, b: &B, tb: &TB, settings: &Settings) -> PairPhase
+where
+    A: TriMesh + ?Sized,
+    TA: Tree + ?Sized,
+    B: TriMesh + ?Sized,
+    TB: Tree + ?Sized,
+{
+    let mut phase = pair_walk(a, ta, b, tb, settings);
+    if phase.pending {
+        phase.closest = closest_pair(a, ta, b, tb, settings.distance_error);
+        phase.pending = false;
+    }
+    phase
+}
+
+/// As [`pair_phase`] without the distance search: the closest pair is known only when some pair
+/// meets exactly (a shared point); otherwise [`PairPhase::closest_pending`] says it is still to
+/// find, and the caller decides whether it needs it (a scene needs a clear part pair's distance
+/// only when it could be the scene's minimum: [`closest_pair_within`]).
+pub fn pair_walk<A, TA, B, TB>(a: &A, ta: &TA, b: &B, tb: &TB, settings: &Settings) -> PairPhase
 where
     A: TriMesh + ?Sized,
     TA: Tree + ?Sized,
@@ -450,15 +475,18 @@ where
     for p in &pairs {
         counts.record(p);
     }
-    let closest = match pairs.iter().find(|p| p.contact.is_some()) {
-        Some(p) => Some(contact_witness(a, b, p)),
-        None if stopped => None,
-        None => closest_pair(a, ta, b, tb, settings.distance_error),
-    };
-    PairPhase { pairs, counts, closest, started }
+    let closest = pairs.iter().find(|p| p.contact.is_some()).map(|p| contact_witness(a, b, p));
+    let pending = closest.is_none() && !stopped;
+    PairPhase { pairs, counts, closest, pending, started }
 }
 
 impl PairPhase {
+    /// True when no pair met exactly and the walk was not cut short: the closest pair has not
+    /// been searched for yet.
+    pub fn closest_pending(&self) -> bool {
+        self.pending
+    }
+
     /// Does the verdict need both sides' topology? Only when no pair crosses (and the search
     /// was not cut short), and either box meets the other's vertices (nesting is possible) or
     /// faces touch (volumes may overlap).
@@ -492,7 +520,7 @@ impl PairPhase {
         B: TriMesh + ?Sized,
         TB: Tree + ?Sized,
     {
-        let PairPhase { pairs, counts, closest, started } = self;
+        let PairPhase { pairs, counts, closest, started, .. } = self;
         let containment = match topo {
             _ if counts.crossing > 0 || settings.first_hit => Containment::None,
             None => Containment::None, // no nesting possible and no faces touch
@@ -520,7 +548,7 @@ impl PairPhase {
             verdict,
             containment,
             closed: [None, None],
-            trees: [ta.stats(), tb.stats()],
+            trees: Default::default(),
             timings: Timings { build_ms: 0.0, query_ms: ms(started) },
         }
     }
@@ -674,6 +702,28 @@ where
     B: TriMesh + ?Sized,
     TB: Tree + ?Sized,
 {
+    closest_pair_within(a, ta, b, tb, err, &traverse::AtomicU64::new(f64::INFINITY.to_bits()))
+}
+
+/// As [`closest_pair`], but only pairs that could come within `best` (the f64 bits of a
+/// distance, shared with other searches and lowered by each) are evaluated: `None` when none
+/// can. Searches of several part pairs sharing one `best` find the minimum over all of them
+/// (the same (distance, triangle pair) as searching each whole), each pruning by what the
+/// others found.
+pub fn closest_pair_within<A, TA, B, TB>(
+    a: &A,
+    ta: &TA,
+    b: &B,
+    tb: &TB,
+    err: DistanceError,
+    shared_best: &traverse::AtomicU64,
+) -> Option<Closest>
+where
+    A: TriMesh + ?Sized,
+    TA: Tree + ?Sized,
+    B: TriMesh + ?Sized,
+    TB: Tree + ?Sized,
+{
     let scale = ta.root_box().max_abs().max(tb.root_box().max_abs());
     let slack = predicates::distance_rounding_slack(scale);
     let margin = predicates::oriented_bound_margin(scale);
@@ -687,7 +737,7 @@ where
         }
     };
     let (cache_a, cache_b) = (OrientedCache::new(a, ta), OrientedCache::new(b, tb));
-    let best = traverse::min_pair_with(
+    let best = traverse::min_pair_shared(
         ta,
         tb,
         || (),
@@ -730,6 +780,7 @@ where
             }
             best
         },
+        shared_best,
     )?;
     Some(Closest { distance: best.distance, a: (best.key.0, best.data.0), b: (best.key.1, best.data.1) })
 }
