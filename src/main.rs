@@ -4,9 +4,8 @@
 
 mod app;
 
-use app::args::{self as cli, Args};
+use app::args as cli;
 use app::{clash_set, progress, run, self_cmd};
-use clap::Parser;
 use meshclash::error::ExitCode as Code;
 use meshclash::output::text;
 use meshclash::output::write;
@@ -15,7 +14,9 @@ use std::io::IsTerminal;
 use std::process::ExitCode;
 
 fn main() -> ExitCode {
-    let args = match Args::try_parse() {
+    // Help wraps to the terminal's width, or to 100 columns when stdout is not a terminal.
+    let width = (!std::io::stdout().is_terminal()).then_some(100);
+    let args = match cli::parse(width) {
         Ok(a) => a,
         Err(e) if e.use_stderr() => {
             // Usage errors: clap's whole message (the missing argument, the allowed values, the
@@ -35,17 +36,22 @@ fn main() -> ExitCode {
     if let Some(cli::Command::SelfCheck(s)) = args.command {
         return self_check(s);
     }
-    if let Some(cmd) = &args.command {
+    if let Some(cmd) = args.command.as_ref().filter(|c| !matches!(c, cli::Command::Scene(_))) {
         // `schema`, `completions <shell>`, `man`: generated text on stdout; `bench`: forwarded.
         let text = match cmd {
             cli::Command::Output(c) => app::man::render(c),
-            cli::Command::ClashSet(_) | cli::Command::SelfCheck(_) => unreachable!("handled above"),
+            cli::Command::ClashSet(_) | cli::Command::SelfCheck(_) | cli::Command::Scene(_) => {
+                unreachable!("handled above")
+            }
             cli::Command::Bench(b) => return bench_forward(&b.args),
         };
         return print_stdout(&text);
     }
-    let quiet = args.quiet;
-    let format = args.outputs.format;
+    let flags = match &args.command {
+        Some(cli::Command::Scene(s)) => &s.check,
+        _ => &args.check,
+    };
+    let (quiet, format) = (flags.quiet, flags.outputs.format);
     let (stdout_tty, stderr_tty) = (std::io::stdout().is_terminal(), std::io::stderr().is_terminal());
     let color = std::env::var_os("NO_COLOR").is_none_or(|v| v.is_empty());
     // Progress and the human summary only for a person at a terminal, never in pipes or CI logs.

@@ -27,9 +27,18 @@ pub struct Args {
     /// Second mesh (B).
     #[arg(required = true)]
     pub b: Option<PathBuf>,
-    /// `schema`, `completions <shell>` or `man` instead of a check.
+    /// `scene`, `clash-set`, `self`, `schema`, `completions <shell>`, `man` or `bench` instead of
+    /// a two-file check.
     #[command(subcommand)]
     pub command: Option<Command>,
+    /// The check's flags (shared with `scene`).
+    #[command(flatten)]
+    pub check: CheckArgs,
+}
+
+/// The flags of a check (two files, or `scene FILE`).
+#[derive(Debug, Clone, clap::Args)]
+pub struct CheckArgs {
     /// Write the report to FILE (atomically) instead of stdout.
     #[arg(short, long, value_name = "FILE")]
     pub output: Option<PathBuf>,
@@ -141,10 +150,24 @@ pub struct Args {
     pub quiet: bool,
 }
 
+/// `meshclash scene FILE`: one file's parts against each other.
+#[derive(Debug, Clone, clap::Args)]
+pub struct SceneArgs {
+    /// The file whose parts are checked (glTF nodes, OBJ objects or groups, STL solids).
+    #[arg(value_name = "FILE")]
+    pub file: PathBuf,
+    /// The check's flags (as for two files; `-a` flags name the file).
+    #[command(flatten)]
+    pub check: CheckArgs,
+}
+
 /// Subcommands instead of a check: the generated-text ones of [`TextCommand`], and
 /// `bench`.
 #[derive(Debug, clap::Subcommand)]
 pub enum Command {
+    /// Check the parts of one file against each other (all against all, or --select-a
+    /// against --select-b); the check's flags apply (`./scene` names a file called scene).
+    Scene(SceneArgs),
     /// `schema`, `completions <shell>`, `man`.
     #[command(flatten)]
     Output(TextCommand),
@@ -541,4 +564,55 @@ pub enum SelfFormat {
     Json,
     /// A summary for a person.
     Text,
+}
+
+/// Parse the process's arguments: [`hoist_subcommand`] first, then clap, with help wrapped to
+/// `width` columns (None: the terminal's width).
+pub fn parse(width: Option<usize>) -> std::result::Result<Args, clap::Error> {
+    use clap::{CommandFactory, FromArgMatches};
+    let argv = hoist_subcommand(std::env::args_os().collect());
+    let mut cmd = Args::command();
+    if let Some(w) = width {
+        cmd = cmd.term_width(w);
+    }
+    let mut matches = cmd.try_get_matches_from_mut(argv)?;
+    Args::from_arg_matches_mut(&mut matches).map_err(|e| e.format(&mut cmd))
+}
+
+/// `meshclash --threads 1 clash-set x.json` means `meshclash clash-set --threads 1 x.json`:
+/// when the first positional argument is a subcommand's name and flags of the main command come
+/// before it, the name moves to the front (the subcommand then parses those flags as its own, or
+/// says which one it does not take). Flag values are skipped using the clap definition, so a
+/// file called `self` given to `-o` stays a value.
+pub fn hoist_subcommand(mut argv: Vec<std::ffi::OsString>) -> Vec<std::ffi::OsString> {
+    use clap::CommandFactory;
+    let cmd = Args::command();
+    let takes_value = |a: &clap::Arg| a.get_action().takes_values();
+    let mut i = 1;
+    while i < argv.len() {
+        let Some(t) = argv[i].to_str() else { break };
+        if t == "--" {
+            break;
+        }
+        if let Some(long) = t.strip_prefix("--") {
+            if !long.contains('=')
+                && cmd.get_arguments().any(|a| a.get_long() == Some(long) && takes_value(a))
+            {
+                i += 1;
+            }
+        } else if t.len() > 1 && t.starts_with('-') {
+            let c = t[1..].chars().next();
+            if t.chars().count() == 2 && cmd.get_arguments().any(|a| a.get_short() == c && takes_value(a)) {
+                i += 1;
+            }
+        } else {
+            if i > 1 && cmd.get_subcommands().any(|s| s.get_name() == t) {
+                let name = argv.remove(i);
+                argv.insert(1, name);
+            }
+            break;
+        }
+        i += 1;
+    }
+    argv
 }

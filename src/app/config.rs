@@ -1,6 +1,6 @@
 //! Validation of the parsed command line into a [`Config`] (the library never sees clap).
 
-use super::args::{Args, BvhArg, FailOnArg, ModeArg, Unit};
+use super::args::{Args, BvhArg, CheckArgs, Command, FailOnArg, ModeArg, Unit};
 use glam::{DMat4, DVec3, DVec4};
 use meshclash::bvh::{BuildOptions, Strategy};
 use meshclash::check::query::{DistanceError, FailOn, InputSpec, Mode, Settings};
@@ -215,13 +215,28 @@ pub fn parse_tolerance(flag: &str, s: &str) -> Result<Tol> {
 }
 
 impl Args {
-    /// Validate into a [`Config`].
+    /// Validate into a [`Config`] (a two-file check, or `scene FILE`).
     pub fn into_config(self) -> Result<Config> {
+        match self.command {
+            // Scene mode: input A is the word `scene`, input B the file (as the report has it).
+            Some(Command::Scene(s)) => s.check.into_config(Some(PathBuf::from("scene")), Some(s.file), true),
+            // The word `scene` in place of A is scene mode too (`meshclash -- scene FILE`, and
+            // the clash-set runner's argv); `./scene` names a file so called.
+            _ => {
+                let scene = self.a.as_deref() == Some(std::path::Path::new("scene"));
+                self.check.into_config(self.a, self.b, scene)
+            }
+        }
+    }
+}
+
+impl CheckArgs {
+    /// Validate the flags of a check of `a` against `b` (`scene_mode`: `b`'s parts against
+    /// each other).
+    pub fn into_config(self, a: Option<PathBuf>, b: Option<PathBuf>, scene_mode: bool) -> Result<Config> {
         if !(1..=64).contains(&self.leaf_size) {
             return Err(Error::Usage(format!("--leaf-size must be 1..=64, got {}", self.leaf_size)));
         }
-        // `meshclash scene FILE`: the word `scene` in place of A (use `./scene` for a file so named).
-        let scene_mode = self.a.as_deref() == Some(std::path::Path::new("scene"));
         if scene_mode && self.cross_check.is_some() {
             return Err(Error::Usage("--cross-check works on two files, not with scene".into()));
         }
@@ -249,11 +264,11 @@ impl Args {
         Ok(Config {
             inputs: [
                 InputSpec {
-                    path: self.a.ok_or_else(|| Error::Usage("missing mesh A".into()))?,
+                    path: a.ok_or_else(|| Error::Usage("missing mesh A".into()))?,
                     transform: placement('a', &self.transform_a, &self.translate_a)?,
                 },
                 InputSpec {
-                    path: self.b.ok_or_else(|| Error::Usage("missing mesh B".into()))?,
+                    path: b.ok_or_else(|| Error::Usage("missing mesh B".into()))?,
                     transform: placement('b', &self.transform_b, &self.translate_b)?,
                 },
             ],
