@@ -167,7 +167,7 @@ pub struct SceneArgs {
 pub enum Command {
     /// Check the parts of one file against each other (all against all, or --select-a
     /// against --select-b); the check's flags apply (`./scene` names a file called scene).
-    Scene(SceneArgs),
+    Scene(Box<SceneArgs>),
     /// `schema`, `completions <shell>`, `man`.
     #[command(flatten)]
     Output(TextCommand),
