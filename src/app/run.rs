@@ -83,6 +83,23 @@ fn load_with_units(
     Ok((input, units))
 }
 
+/// The input whose file a selection error names: A's when A's selection (`--select-a`,
+/// `--exclude`) leaves no part (the side checked first), else B's; in scene mode the one file.
+fn problem_side(cfg: &Config, a: &meshclash::scene::mesh::Mesh) -> usize {
+    use meshclash::check::assembly::{glob_match, parts_of};
+    let sel = &cfg.selection;
+    let kept = |name: &str| {
+        (sel.select_a.is_empty() || sel.select_a.iter().any(|g| glob_match(g, name)))
+            && !sel.exclude.iter().any(|g| glob_match(g, name))
+    };
+    let a_empty = !parts_of(a, 0).iter().any(|p| kept(&p.name));
+    if !sel.scene && a_empty {
+        0
+    } else {
+        1
+    }
+}
+
 /// Check one configuration and return the finished report (with finding ids, the baseline
 /// comparison, and the JUnit and GLB files of `cfg.outputs` written), without writing the report
 /// itself: the single command and every check of a clash set go through here.
@@ -132,7 +149,7 @@ pub fn check_staged(
     }
     progress(Phase::Check);
     let outcome = meshclash::check::assembly::run(&a.mesh, &b.mesh, &cfg.selection, &settings)
-        .map_err(|e| Error::input(&cfg.inputs[1].path, e))?;
+        .map_err(|e| Error::input(&cfg.inputs[problem_side(cfg, &a.mesh)].path, e))?;
     let assembly = report::assembly_view(&outcome, cfg.max_pairs);
     let result = outcome.result;
     let failed = cfg.fail_on.fails(result.verdict);
