@@ -13,14 +13,14 @@
 //! al. 1999). [`check::query`] orchestrates and returns plain result structs ([`check`] also has
 //! assemblies of parts, containment, clash regions and the parry cross-check); [`report`] turns them into the JSON
 //! wire format (with [`report::baseline`]: stable finding ids); [`output`] renders text, JUnit
-//! and GLB. The library never prints.
+//! and GLB. The library never prints; the command line (clap, the spinner, validation into a
+//! configuration, the `clash-set` and `self` runners) is the binary's own module tree
+//! (`src/main.rs` and `src/app/`).
 #![deny(missing_docs)]
 
 pub mod api;
 pub mod bvh;
 pub mod check;
-pub mod clash_set;
-pub mod cli;
 pub mod error;
 pub mod geom;
 pub mod load;
@@ -28,7 +28,6 @@ pub mod narrow;
 pub mod output;
 pub mod report;
 pub mod scene;
-pub mod self_cmd;
 #[cfg(any(test, feature = "testing"))]
 pub mod testing;
 

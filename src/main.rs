@@ -1,16 +1,22 @@
-//! The `meshclash` binary: parse, run, print, exit. All logic is in the library.
+//! The `meshclash` binary: parse, run, print, exit. The app layer (clap definitions, validation
+//! into a `Config`, running it, the `clash-set` and `self` runners, the spinner) is [`app`]; the
+//! checks, reports and outputs are in the library.
 
-use clap::Parser;
-use meshclash::cli::{self, Args};
+mod app;
+
+use app::args as cli;
+use app::{clash_set, progress, run, self_cmd};
 use meshclash::error::ExitCode as Code;
-use meshclash::output::progress::{self, Spinner};
+use meshclash::output::text;
 use meshclash::output::write;
-use meshclash::output::{text, Format};
+use progress::Spinner;
 use std::io::IsTerminal;
 use std::process::ExitCode;
 
 fn main() -> ExitCode {
-    let args = match Args::try_parse() {
+    // Help wraps to the terminal's width, or to 100 columns when stdout is not a terminal.
+    let width = (!std::io::stdout().is_terminal()).then_some(100);
+    let args = match cli::parse(width) {
         Ok(a) => a,
         Err(e) if e.use_stderr() => {
             // Usage errors: clap's whole message (the missing argument, the allowed values, the
@@ -25,22 +31,27 @@ fn main() -> ExitCode {
         }
     };
     if let Some(cli::Command::ClashSet(set)) = args.command {
-        return clash_set(set);
+        return run_clash_set(set);
     }
     if let Some(cli::Command::SelfCheck(s)) = args.command {
         return self_check(s);
     }
-    if let Some(cmd) = &args.command {
+    if let Some(cmd) = args.command.as_ref().filter(|c| !matches!(c, cli::Command::Scene(_))) {
         // `schema`, `completions <shell>`, `man`: generated text on stdout; `bench`: forwarded.
         let text = match cmd {
-            cli::Command::Output(c) => c.render(),
-            cli::Command::ClashSet(_) | cli::Command::SelfCheck(_) => unreachable!("handled above"),
+            cli::Command::Output(c) => app::man::render(c),
+            cli::Command::ClashSet(_) | cli::Command::SelfCheck(_) | cli::Command::Scene(_) => {
+                unreachable!("handled above")
+            }
             cli::Command::Bench(b) => return bench_forward(&b.args),
         };
         return print_stdout(&text);
     }
-    let quiet = args.quiet;
-    let format = args.outputs.format;
+    let flags = match &args.command {
+        Some(cli::Command::Scene(s)) => &s.check,
+        _ => &args.check,
+    };
+    let (quiet, format) = (flags.quiet, flags.outputs.format);
     let (stdout_tty, stderr_tty) = (std::io::stdout().is_terminal(), std::io::stderr().is_terminal());
     let color = std::env::var_os("NO_COLOR").is_none_or(|v| v.is_empty());
     // Progress and the human summary only for a person at a terminal, never in pipes or CI logs.
@@ -51,7 +62,7 @@ fn main() -> ExitCode {
             s.phase(p);
         }
     };
-    let outcome = args.into_config().and_then(|cfg| cli::run_with_progress(&cfg, &on_phase));
+    let outcome = args.into_config().and_then(|cfg| run::run_with_progress(&cfg, &on_phase));
     if let Some(s) = spinner {
         s.finish();
     }
@@ -62,7 +73,7 @@ fn main() -> ExitCode {
                     eprintln!("meshclash: warning: {w}");
                 }
             }
-            let text_on_tty = format == Some(Format::Text) && stdout_tty;
+            let text_on_tty = format == Some(cli::FormatArg::Text) && stdout_tty;
             if stderr_tty && !quiet && !text_on_tty {
                 eprint!("{}", text::render(&out.report, color));
             }
@@ -88,8 +99,7 @@ fn main() -> ExitCode {
 }
 
 /// `meshclash clash-set FILE`: like the main job, with one document for all checks.
-fn clash_set(set: meshclash::clash_set::ClashSetArgs) -> ExitCode {
-    use meshclash::clash_set;
+fn run_clash_set(set: clash_set::ClashSetArgs) -> ExitCode {
     if let Some(kind) = set.schema {
         return print_stdout(&clash_set::schema_json(kind));
     }
@@ -144,15 +154,15 @@ fn print_stdout(text: &str) -> ExitCode {
 }
 
 /// `meshclash self FILE`: the report on stdout (or -o), the summary on stderr at a terminal.
-fn self_check(args: meshclash::self_cmd::SelfArgs) -> ExitCode {
+fn self_check(args: self_cmd::SelfArgs) -> ExitCode {
     let quiet = args.quiet;
-    match meshclash::self_cmd::run(&args) {
+    match self_cmd::run(&args) {
         Ok(out) => {
             if !quiet {
                 for w in &out.warnings {
                     eprintln!("meshclash: warning: {w}");
                 }
-                let text_on_stdout = args.format == Some(meshclash::self_cmd::SelfFormat::Text);
+                let text_on_stdout = args.format == Some(self_cmd::SelfFormat::Text);
                 if std::io::stderr().is_terminal() && !text_on_stdout {
                     eprint!("{}", out.summary);
                 }

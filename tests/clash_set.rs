@@ -1,7 +1,7 @@
 //! `meshclash clash-set FILE`: several named checks in one run, through the real binary.
 
 use assert_cmd::Command;
-use meshclash::clash_set::ClashSetReport;
+use meshclash::report::clash_set::ClashSetReport;
 use meshclash::report::{self, Report};
 use std::path::{Path, PathBuf};
 

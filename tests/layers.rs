@@ -4,6 +4,11 @@
 //! when a new one appears, or when one is gone and still listed). Run with
 //! `cargo test --test suite layers -- --nocapture` to print the graph and its cycles.
 //!
+//! Two crates share `src/`: the library (`src/lib.rs` and every top-level module but `app`)
+//! and the binary (`src/main.rs` and `src/app/`, the app layer: clap, the spinner). The binary
+//! may use the library (`meshclash::`), never the reverse; inside `src/app/`, the submodules
+//! name each other through `super::`, and their graph has no cycle either.
+//!
 //! Unit-test code (`#[cfg(test)]` blocks and `tests.rs` files) is not counted; the test support
 //! of `src/testing/` is (it is a module like the others).
 
@@ -65,7 +70,7 @@ fn graph() -> BTreeMap<String, BTreeSet<String>> {
     let mut g: BTreeMap<String, BTreeSet<String>> = BTreeMap::new();
     for f in files {
         let m = top_module(&src, &f);
-        if m == "lib" || m == "main" {
+        if m == "lib" || m == "main" || m == APP {
             continue;
         }
         let is_test =
@@ -73,6 +78,28 @@ fn graph() -> BTreeMap<String, BTreeSet<String>> {
         let refs = crate_refs(&std::fs::read_to_string(&f).unwrap(), is_test);
         let deps = g.entry(m.clone()).or_default();
         deps.extend(refs.into_iter().filter(|r| *r != m));
+    }
+    g
+}
+
+/// The binary's own module tree under `src/` (with `src/main.rs`).
+const APP: &str = "app";
+
+/// The graph of the binary's app layer: `src/app/x.rs` -> the sibling modules it names through
+/// `super::`.
+fn app_graph() -> BTreeMap<String, BTreeSet<String>> {
+    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("src").join(APP);
+    let mut files = Vec::new();
+    rust_files(&dir, &mut files);
+    let mut g: BTreeMap<String, BTreeSet<String>> = BTreeMap::new();
+    for f in files {
+        let m = top_module(&dir, &f);
+        if m == "mod" {
+            continue;
+        }
+        let text = std::fs::read_to_string(&f).unwrap();
+        let refs = crate_refs(&text.replace("super::", "crate::"), false);
+        g.entry(m.clone()).or_default().extend(refs.into_iter().filter(|r| *r != m && *r != "super"));
     }
     g
 }
@@ -112,8 +139,7 @@ fn lower_layers_import_nothing_above_them() {
 /// Import cycles between top-level modules that exist today, each as its sorted member list
 /// (a strongly connected component of the graph). Issue 13 removes them; remove an entry here
 /// when its cycle is gone (the test says so).
-const KNOWN_CYCLES: &[&[&str]] = &[KNOWN_CYCLE_0];
-const KNOWN_CYCLE_0: &[&str] = &["check", "clash_set", "cli", "output", "report", "self_cmd"];
+const KNOWN_CYCLES: &[&[&str]] = &[];
 
 /// Strongly connected components that contain a cycle (the import cycles), each sorted, in
 /// sorted order.
@@ -167,6 +193,44 @@ fn no_new_import_cycle_between_top_level_modules() {
             k.join(", ")
         );
     }
+}
+
+#[test]
+fn the_library_never_uses_the_binary() {
+    // The app layer is the binary's: the library does not declare it, and no library file
+    // names it (it could not compile if one did, but a `pub mod app` in lib.rs would).
+    let src = Path::new(env!("CARGO_MANIFEST_DIR")).join("src");
+    let lib = std::fs::read_to_string(src.join("lib.rs")).unwrap();
+    assert!(!lib
+        .lines()
+        .any(|l| l.trim_start().starts_with("pub mod app") || l.trim_start().starts_with("mod app")));
+    let main = std::fs::read_to_string(src.join("main.rs")).unwrap();
+    assert!(main.lines().any(|l| l.trim() == "mod app;"), "src/main.rs declares the app layer");
+    let g = graph();
+    assert!(!g.contains_key(APP));
+    for (m, deps) in &g {
+        assert!(!deps.contains(APP), "src/{m} names crate::{APP}, the binary's module tree");
+    }
+    // And the library keeps clap and indicatif out of its code (so out of its public API).
+    let mut files = Vec::new();
+    rust_files(&src, &mut files);
+    for f in files.iter().filter(|f| top_module(&src, f) != APP && top_module(&src, f) != "main") {
+        let text = std::fs::read_to_string(f).unwrap();
+        for dep in ["clap::", "clap_complete", "clap_mangen", "indicatif"] {
+            assert!(!text.contains(dep), "{} uses {dep}: the app layer belongs in src/app/", f.display());
+        }
+    }
+}
+
+#[test]
+fn the_app_layer_has_no_import_cycle() {
+    let g = app_graph();
+    for (m, d) in &g {
+        println!("app::{m} -> {}", d.iter().cloned().collect::<Vec<_>>().join(" "));
+    }
+    assert!(g.contains_key("args") && g.contains_key("run"), "src/app/ is gone: update this test");
+    let found = cycles(&g);
+    assert!(found.is_empty(), "import cycles inside src/app/: {found:?}");
 }
 
 #[test]

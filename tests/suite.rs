@@ -16,6 +16,10 @@ mod brute_force;
 mod clash_set;
 #[path = "cli.rs"]
 mod cli;
+#[path = "cli_messages.rs"]
+mod cli_messages;
+#[path = "cli_subcommands.rs"]
+mod cli_subcommands;
 #[path = "extremes.rs"]
 mod extremes;
 #[path = "fcl_reference.rs"]

@@ -111,7 +111,7 @@ pub fn run_command(args: &BenchArgs) -> Result<String> {
     };
     let rep = run(&opts)?;
     if let Some(path) = &args.plot {
-        meshclash::report::write_atomic(path, svg::plot_svg(&rep).as_bytes())?;
+        meshclash::output::write::write_file(path, svg::plot_svg(&rep).as_bytes())?;
     }
     let bad: Vec<String> = rep
         .trade

@@ -7,7 +7,9 @@
 pub mod assembly;
 pub mod containment;
 pub mod cross_check;
+pub mod finding_id;
 pub mod health;
 pub mod query;
 pub mod regions;
 pub mod self_clash;
+pub mod self_parts;

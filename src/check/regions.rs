@@ -5,7 +5,7 @@
 //! (exactly coincident positions) or their B triangles do — which also joins pairs that share a
 //! triangle. Each region gets a centre, a box and an extent from the pairs' shared segments (or,
 //! for coplanar contacts, the triangles' boxes), and a stable id: the smallest finding id
-//! ([`crate::report::baseline::finding_id`], derived from geometry and part names) among its
+//! ([`crate::check::finding_id`], derived from geometry and part names) among its
 //! pairs, so ids do not depend on thread timing or file order.
 
 use crate::bvh::{self, BuildOptions, Bvh};
@@ -100,7 +100,7 @@ pub fn regions(pairs: &[PairFinding], a: &Mesh, b: &Mesh) -> Vec<Region> {
                 bounds = bounds.grow(lo).grow(hi);
                 sum += lo * 0.5 + hi * 0.5;
                 crossing += (p.kind == PairKind::Crossing) as usize;
-                let fid = crate::report::baseline::finding_id(a, p.a, b, p.b);
+                let fid = crate::check::finding_id::finding_id(a, p.a, b, p.b);
                 if id.as_ref().is_none_or(|m| fid < *m) {
                     id = Some(fid);
                 }

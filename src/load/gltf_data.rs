@@ -165,6 +165,21 @@ pub(crate) fn parse_document(path: &Path, json: &[u8]) -> Result<Document> {
             }
         }
     }
+    // The spec requires min/max on POSITION accessors, and gltf-json refuses a file without
+    // them; the loader never reads them (it reads and checks every position itself), so a
+    // missing pair is filled with a placeholder: a file whose POSITION holds ±inf is then
+    // refused for the non-finite coordinate (naming mesh and position), not for the bounds.
+    for mesh in &root.meshes {
+        for prim in &mesh.primitives {
+            if let Some(a) = prim.attributes.get(&positions) {
+                let acc = &mut root.accessors[a.value()];
+                if acc.min.is_none() || acc.max.is_none() {
+                    acc.min = Some(serde_json::json!([0.0, 0.0, 0.0]));
+                    acc.max = Some(serde_json::json!([0.0, 0.0, 0.0]));
+                }
+            }
+        }
+    }
     Document::from_json(root).map_err(|e| {
         let msg = match &e {
             ::gltf::Error::Validation(list) => {

@@ -1003,3 +1003,27 @@ fn node_transforms_are_read_as_f64_not_f32() {
     ));
     assert_eq!(l.mesh.positions[0], DVec3::new(t, t, 0.0));
 }
+
+#[test]
+fn infinite_position_without_bounds_is_refused_for_the_coordinate() {
+    // Issue 10 item 6: POSITION holds +inf and its accessor has no min/max (which the spec
+    // requires): the error names the non-finite position, not the missing bounds.
+    let mut bin = f32s(&[0.0, 0.0, 0.0, f32::INFINITY, 0.0, 0.0, 0.0, 1.0, 0.0]);
+    for i in [0u16, 1, 2, 0] {
+        bin.extend_from_slice(&i.to_le_bytes());
+    }
+    let views = TRI_VIEWS.replace(r#","min":[0,0,0],"max":[1,1,0]"#, "");
+    assert!(!views.contains("\"min\""));
+    let json = format!(
+        r#"{{"asset":{{"version":"2.0"}},"buffers":[{{"byteLength":44}}],{views},"nodes":[{{"mesh":0}}]}}"#
+    );
+    let e = load_bytes(Path::new("t.glb"), &glb(json.as_bytes(), Some(&bin)), Format::Glb)
+        .unwrap_err()
+        .to_string();
+    assert!(e.starts_with("t.glb: "), "{e}");
+    assert_eq!(e, "t.glb: position 1 of mesh 0 primitive 0 has a non-finite coordinate (inf)");
+    assert!(!e.contains("min"), "{e}");
+    // The same file with finite values and no bounds loads (the bounds are never read).
+    let ok = load_bytes(Path::new("t.glb"), &glb(json.as_bytes(), Some(&tri_bin())), Format::Glb).unwrap();
+    assert_eq!(ok.mesh.positions.len(), 3);
+}

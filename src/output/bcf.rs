@@ -40,7 +40,7 @@ pub const COLOR_A: &str = "FFFF800D";
 pub const COLOR_B: &str = "FF1F78CC";
 
 /// `--bcf-topics`: what one topic is.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, clap::ValueEnum)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
 pub enum Topics {
     /// One topic per clash region (a part pair with several separate interferences gets one
     /// topic per interference).

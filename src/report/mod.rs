@@ -54,14 +54,13 @@
 //! index into `inputs.*.objects`.
 
 pub mod baseline;
+pub mod clash_set;
 pub mod self_report;
 
 use crate::check::query::{ClashResult, Input, PairFinding, TreeStats, Verdict};
-use crate::error::Result;
 use crate::geom::{Aabb, DVec3};
 use glam::DMat4;
 use serde::{Deserialize, Serialize};
-use std::path::Path;
 
 /// The schema identifier written in every report.
 pub const SCHEMA: &str = "meshclash.report/2";
@@ -966,9 +965,4 @@ pub fn to_json(report: &Report) -> String {
     let mut s = serde_json::to_string_pretty(report).expect("report serialises");
     s.push('\n');
     s
-}
-
-/// Write `bytes` to `path` completely or not at all; see [`crate::output::write::write_file`].
-pub fn write_atomic(path: &Path, bytes: &[u8]) -> Result<()> {
-    crate::output::write::write_file(path, bytes)
 }

@@ -43,8 +43,8 @@
 
 use crate::check::health::{Finding, Health};
 use crate::check::query::Input;
+use crate::check::self_parts::{PartResult, SelfFailOn};
 use crate::report::{ObjectReport, PairReport, ReportContact, ReportPairKind, ReportVerdict, Tool};
-use crate::self_cmd::{PartResult, SelfFailOn};
 use serde::{Deserialize, Serialize};
 
 /// The schema identifier of a self report.

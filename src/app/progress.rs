@@ -1,4 +1,4 @@
-//! Progress: the phases [`crate::cli::run_with_progress`] reports through its callback, and a
+//! Progress: the phases [`super::run::run_with_progress`] reports through its callback, and a
 //! [`Spinner`] the binary draws on stderr when a phase runs for longer than a delay.
 //!
 //! The library draws nothing by itself: the spinner draws only on the target its caller hands it

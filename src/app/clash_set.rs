@@ -23,79 +23,32 @@
 //! `-q`) belong to the `clash-set` command line, not to the file; `export_glb` is not available.
 //!
 //! Each check is turned into the argument list of the equivalent `meshclash` command line and
-//! parsed by the same [`crate::cli::Args`], validated by the same [`crate::cli::Args::into_config`]
-//! and run by the same [`crate::cli::check_in_pool`]: its report is byte for byte the report that
+//! parsed by the same [`super::args::Args`], validated by the same [`super::args::Args::into_config`]
+//! and run by the same [`super::run::check_in_pool`]: its report is byte for byte the report that
 //! command prints. Every check is validated before any runs, and nothing is written unless every
 //! check ran.
 
-use crate::cli::{self, Args, Unit};
-use crate::error::{Error, Result};
-use crate::output::{junit, progress::Phase};
-use crate::report::{self, Report};
+use super::args::Args;
+use super::args::Unit;
+pub use super::args::{ClashSetArgs, SchemaKind, SetFormat};
+use super::config;
+use super::progress::Phase;
+use super::run;
 use clap::Parser as _;
+use meshclash::error::{Error, Result};
+use meshclash::output::junit;
+use meshclash::report;
 use serde::de::Error as _;
-use serde::{Deserialize, Deserializer, Serialize};
+use serde::{Deserialize, Deserializer};
 use serde_json::value::RawValue;
 use std::ffi::OsString;
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 
-/// The schema identifier of the clash-set output document.
-pub const SCHEMA: &str = "meshclash.clash-set/1";
+pub use meshclash::report::clash_set::{CheckReport, ClashSetReport, SCHEMA};
 
 /// The clash-set file version this build reads.
 pub const VERSION: u32 = 1;
-
-/// `meshclash clash-set FILE`: the file and the per-run flags (same meaning as on the main
-/// command).
-#[derive(Debug, Clone, Default, clap::Args)]
-pub struct ClashSetArgs {
-    /// The clash-set file (JSON; see the README or `--schema file`).
-    #[arg(value_name = "FILE", required_unless_present = "schema")]
-    pub file: Option<PathBuf>,
-    /// Write the clash-set report to FILE (atomically) instead of stdout.
-    #[arg(short, long, value_name = "FILE")]
-    pub output: Option<PathBuf>,
-    /// What to print on stdout: the JSON document, one summary line per check, or JUnit XML
-    /// [default: json, or nothing when -o is given].
-    #[arg(long, value_enum, value_name = "FORMAT")]
-    pub format: Option<SetFormat>,
-    /// Also write JUnit XML to FILE (atomically): one test suite per check.
-    #[arg(long, value_name = "FILE")]
-    pub junit: Option<PathBuf>,
-    /// Worker threads (0 = one per core).
-    #[arg(long, value_name = "N", default_value_t = 0)]
-    pub threads: usize,
-    /// Deterministic reports: no timings, no thread count.
-    #[arg(long)]
-    pub no_timings: bool,
-    /// Nothing on stderr but errors.
-    #[arg(short, long)]
-    pub quiet: bool,
-    /// Print the JSON Schema of the clash-set `file` or of its `output` document, and exit.
-    #[arg(long, value_enum, value_name = "WHICH", exclusive = true)]
-    pub schema: Option<SchemaKind>,
-}
-
-/// `--format` values of `clash-set`.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
-pub enum SetFormat {
-    /// The JSON document (`meshclash.clash-set/1`): every check's report.
-    Json,
-    /// One summary line per check, then the total.
-    Text,
-    /// JUnit XML, one test suite per check.
-    Junit,
-}
-
-/// `--schema` values.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
-pub enum SchemaKind {
-    /// The clash-set file format.
-    File,
-    /// The output document (`meshclash.clash-set/1`).
-    Output,
-}
 
 /// A number as its JSON text (or the content of a JSON string): handed unchanged to the flag's
 /// parser, so no precision is lost between the file and the check.
@@ -265,32 +218,6 @@ struct NameOnly {
     name: Option<serde_json::Value>,
 }
 
-/// The output document.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, schemars::JsonSchema)]
-#[serde(deny_unknown_fields)]
-pub struct ClashSetReport {
-    /// Always [`SCHEMA`].
-    pub schema: String,
-    /// Who wrote it.
-    pub tool: report::Tool,
-    /// The clash-set file as given.
-    pub file: String,
-    /// True if any check failed its `fail_on` (the process exits 1).
-    pub failed: bool,
-    /// One entry per check, in file order.
-    pub checks: Vec<CheckReport>,
-}
-
-/// One check's result.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, schemars::JsonSchema)]
-#[serde(deny_unknown_fields)]
-pub struct CheckReport {
-    /// The check's name.
-    pub name: String,
-    /// Its report, exactly as the equivalent `meshclash` command line writes it.
-    pub report: Report,
-}
-
 /// A validated check: its name, the argument list it stands for, and its configuration.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Check {
@@ -298,8 +225,8 @@ pub struct Check {
     pub name: String,
     /// The equivalent command line (argv\[0\] is `meshclash`).
     pub argv: Vec<OsString>,
-    /// What [`crate::cli::Args::into_config`] made of it.
-    pub config: cli::Config,
+    /// What [`super::args::Args::into_config`] made of it.
+    pub config: config::Config,
 }
 
 fn err(file: &Path, msg: impl Into<String>) -> Error {
@@ -434,7 +361,7 @@ pub fn argv(c: &CheckSpec, dir: &Path, run: &ClashSetArgs) -> std::result::Resul
 }
 
 /// Read and validate the clash-set file `file`: every check parsed, merged with the defaults,
-/// turned into its command line and validated into a [`cli::Config`]. Any problem is an
+/// turned into its command line and validated into a [`config::Config`]. Any problem is an
 /// [`Error::Input`] naming the file and the check.
 pub fn load(file: &Path, run: &ClashSetArgs) -> Result<Vec<Check>> {
     let bytes = std::fs::read(file).map_err(|e| err(file, format!("cannot read: {e}")))?;
@@ -531,18 +458,18 @@ pub fn schema_json(kind: SchemaKind) -> String {
 pub fn run_with_progress(args: &ClashSetArgs, progress: &(dyn Fn(Phase) + Sync)) -> Result<SetOutcome> {
     let file = args.file.as_deref().ok_or_else(|| Error::Usage("missing clash-set FILE".into()))?;
     let checks = load(file, args)?;
-    let outputs: Vec<crate::output::write::Named> = [("-o", &args.output), ("--junit", &args.junit)]
+    let outputs: Vec<meshclash::output::write::Named> = [("-o", &args.output), ("--junit", &args.junit)]
         .into_iter()
         .filter_map(|(f, p)| Some((f, p.as_deref()?)))
         .collect();
     let mut inputs = vec![file];
-    inputs.extend(checks.iter().flat_map(|c| crate::output::input_paths(&c.config)));
-    crate::output::write::check_outputs(&outputs, &inputs)?;
-    let entries = cli::in_pool(args.threads, |threads| {
+    inputs.extend(checks.iter().flat_map(|c| super::run::input_paths(&c.config)));
+    meshclash::output::write::check_outputs(&outputs, &inputs)?;
+    let entries = run::in_pool(args.threads, |threads| {
         checks
             .iter()
             .map(|c| {
-                let rep = cli::check_in_pool(&c.config, threads, progress)
+                let rep = run::check_in_pool(&c.config, threads, progress)
                     .map_err(|e| err(file, format!("check '{}': {}", c.name, inner(e))))?;
                 Ok(CheckReport { name: c.name.clone(), report: rep })
             })
@@ -555,7 +482,7 @@ pub fn run_with_progress(args: &ClashSetArgs, progress: &(dyn Fn(Phase) + Sync))
         failed: entries.iter().any(|c| c.report.failed),
         checks: entries,
     };
-    let mut staged = crate::output::write::Staged::new();
+    let mut staged = meshclash::output::write::Staged::new();
     if let Some(path) = &args.junit {
         staged.stage(path, junit_xml(&doc).as_bytes())?;
     }
@@ -609,10 +536,10 @@ pub fn summary(doc: &ClashSetReport) -> String {
         }
         match m.min_distance {
             Some(d) if r.settings.units == "model" => {
-                let _ = write!(s, ", min distance {}", crate::output::text::num(d));
+                let _ = write!(s, ", min distance {}", meshclash::output::text::num(d));
             }
             Some(d) => {
-                let _ = write!(s, ", min distance {} {}", crate::output::text::num(d), r.settings.units);
+                let _ = write!(s, ", min distance {} {}", meshclash::output::text::num(d), r.settings.units);
             }
             None => {}
         }
@@ -730,8 +657,8 @@ mod tests {
             ]
         );
         let c = &cs[0].config;
-        assert_eq!(c.clearance, cli::Tol::Abs(2.0));
-        assert_eq!(c.touch, cli::Tol::Rel(1e-6));
+        assert_eq!(c.clearance, config::Tol::Abs(2.0));
+        assert_eq!(c.touch, config::Tol::Rel(1e-6));
         assert_eq!(c.units.report, Some(Unit::Mm));
         assert_eq!(c.units.inputs, [Some(Unit::In), None]);
         assert_eq!(c.units.scale, [None, Some(0.5)]);
@@ -747,7 +674,7 @@ mod tests {
             r#"{"version": 1, "checks": [{"name": "n", "a": "a.obj", "b": "b.obj", "clearance": 0.10000000000000002}]}"#,
         )
         .unwrap();
-        assert_eq!(cs[0].config.clearance, cli::Tol::Abs(f64::from_bits(0.1f64.to_bits() + 1)));
+        assert_eq!(cs[0].config.clearance, config::Tol::Abs(f64::from_bits(0.1f64.to_bits() + 1)));
     }
 
     #[test]

@@ -1,0 +1,618 @@
+//! Command-line definition (clap): the flags of the main check, the subcommands, and the value
+//! enums. Validation into a [`super::config::Config`] is in [`super::config`].
+
+use clap::{Parser, ValueEnum};
+use meshclash::check::self_parts::SelfFailOn;
+use meshclash::error::{Error, Result};
+use meshclash::output::bcf::Topics;
+use meshclash::output::{Format, OutputOptions};
+use std::path::PathBuf;
+
+/// Do two meshes clash, where, and how close do they come? Reads OBJ, STL (ASCII or binary) and
+/// glTF (.gltf/.glb); writes a JSON report. Exit code: 0 nothing at or above --fail-on,
+/// 1 findings at or above it, 2 bad input, I/O or usage error.
+#[derive(Debug, Parser)]
+#[command(
+    name = "meshclash",
+    version,
+    about,
+    long_about = None,
+    args_conflicts_with_subcommands = true,
+    subcommand_negates_reqs = true
+)]
+pub struct Args {
+    /// First mesh (A).
+    #[arg(required = true)]
+    pub a: Option<PathBuf>,
+    /// Second mesh (B).
+    #[arg(required = true)]
+    pub b: Option<PathBuf>,
+    /// `scene`, `clash-set`, `self`, `schema`, `completions <shell>`, `man` or `bench` instead of
+    /// a two-file check.
+    #[command(subcommand)]
+    pub command: Option<Command>,
+    /// The check's flags (shared with `scene`).
+    #[command(flatten)]
+    pub check: CheckArgs,
+}
+
+/// The flags of a check (two files, or `scene FILE`).
+#[derive(Debug, Clone, clap::Args)]
+pub struct CheckArgs {
+    /// Write the report to FILE (atomically) instead of stdout.
+    #[arg(short, long, value_name = "FILE")]
+    pub output: Option<PathBuf>,
+    /// Move A by x,y,z (after --transform-a).
+    #[arg(long, value_name = "X,Y,Z", allow_hyphen_values = true)]
+    pub translate_a: Option<String>,
+    /// Move B by x,y,z (after --transform-b).
+    #[arg(long, value_name = "X,Y,Z", allow_hyphen_values = true)]
+    pub translate_b: Option<String>,
+    /// Affine transform of A: 12 (3×4) or 16 (4×4, last row 0,0,0,1) comma-separated numbers, row-major.
+    #[arg(long, value_name = "M", allow_hyphen_values = true)]
+    pub transform_a: Option<String>,
+    /// Affine transform of B, as --transform-a.
+    #[arg(long, value_name = "M", allow_hyphen_values = true)]
+    pub transform_b: Option<String>,
+    /// Pairs that do not touch but are within this distance count as touching: in the report
+    /// units (--units, else the files' own), or relative to the model size with a `rel` suffix (`1e-6rel` = 1e-6 × the diagonal of the
+    /// box around both inputs).
+    #[arg(long, value_name = "E", default_value = "0", allow_hyphen_values = true)]
+    pub touch_tolerance: String,
+    /// Also report every pair closer than D that does not touch (report units, or `rel` suffix).
+    #[arg(long, value_name = "D", default_value = "0", allow_hyphen_values = true)]
+    pub clearance: String,
+    /// Exit 1 when the verdict is at or above this.
+    #[arg(long, value_enum, default_value_t = FailOnArg::Clash)]
+    pub fail_on: FailOnArg,
+    /// BVH split strategy.
+    #[arg(long, value_enum, default_value_t = BvhArg::Sah)]
+    pub bvh: BvhArg,
+    /// Largest BVH leaf, in triangles (1..=64).
+    #[arg(long, value_name = "N", default_value_t = 4)]
+    pub leaf_size: u32,
+    /// Worker threads (0 = one per core).
+    #[arg(long, value_name = "N", default_value_t = 0)]
+    pub threads: usize,
+    /// List at most N pairs (the summary counts stay complete).
+    #[arg(long, value_name = "N", default_value_t = 1000)]
+    pub max_pairs: usize,
+    /// Also run parry3d-f64 on the same input and add a `cross_check` block listing every
+    /// disagreement (slow on large overlapping meshes: parry's distance is not a dual walk).
+    #[arg(long, value_enum, value_name = "TOOL")]
+    pub cross_check: Option<CrossCheckArg>,
+    /// Pair classification: `exact` predicates, or `fast` plain f64 determinants (gives up
+    /// exactness on nearly touching or coplanar pairs; `meshclash bench --trade` measures it).
+    #[arg(long, value_enum, default_value_t = ModeArg::Exact)]
+    pub mode: ModeArg,
+    /// Stop at the first crossing pair: a quick pass/fail gate. Counts become lower bounds,
+    /// no distance or containment is computed, and which pair is listed depends on timing.
+    #[arg(long)]
+    pub first_hit: bool,
+    /// Split every part into its connected bodies (triangles joined through edges used by
+    /// exactly two triangles), named `part/body1`, `part/body2`, …: e.g. two cubes in one STL
+    /// solid that touch along an edge become two parts.
+    #[arg(long)]
+    pub split_bodies: bool,
+    /// Estimate each clash region's penetration depth: the deepest vertex of one part inside
+    /// the other closed part, measured to its surface (a lower bound; costs a tree per part
+    /// with a region and point queries, at most about 2048 per region and side).
+    #[arg(long)]
+    pub penetration: bool,
+    /// Allowed relative error of the minimum distance (reported d <= (1+R)·true + A).
+    #[arg(long, value_name = "R", default_value_t = 0.0)]
+    pub distance_rel_err: f64,
+    /// Allowed absolute error of the minimum distance (report units).
+    #[arg(long, value_name = "A", default_value_t = 0.0)]
+    pub distance_abs_err: f64,
+    /// Check only parts of A whose name matches GLOB (`*`, `?`; repeatable). Part names are
+    /// glTF node paths (`Engine/Piston_2`), OBJ `o`/`g` names, STL solid names.
+    #[arg(long, value_name = "GLOB")]
+    pub select_a: Vec<String>,
+    /// Check only parts of B matching GLOB (in scene mode: the second set; without it, the
+    /// selected parts are checked all-vs-all).
+    #[arg(long, value_name = "GLOB")]
+    pub select_b: Vec<String>,
+    /// Leave out parts matching GLOB, on both sides (repeatable).
+    #[arg(long, value_name = "GLOB")]
+    pub exclude: Vec<String>,
+    /// Deterministic report: no timings, no thread count (byte-identical across runs).
+    #[arg(long)]
+    pub no_timings: bool,
+    /// Units of the report: every input is converted into U (multiplied in f64 after loading,
+    /// before --transform/--translate, which are therefore in U), and all coordinates,
+    /// distances and tolerances are in U. Inputs of unknown units (OBJ, STL, without
+    /// --units-a/-b) are taken to be in U, with a warning. Verdicts are exact for the converted
+    /// coordinates (a factor that is not a power of two rounds each coordinate once). Default:
+    /// --units-a, else --units-b, else none: no conversion, lengths in the files' own units.
+    #[arg(long, value_enum, value_name = "U")]
+    pub units: Option<Unit>,
+    /// Units of A's coordinates [default: m for glTF/GLB (the glTF specification), unknown for
+    /// OBJ/STL]. In scene mode, the units of the file.
+    #[arg(long, value_enum, value_name = "U")]
+    pub units_a: Option<Unit>,
+    /// Units of B's coordinates, as --units-a.
+    #[arg(long, value_enum, value_name = "U")]
+    pub units_b: Option<Unit>,
+    /// Multiply A's coordinates by F (finite, > 0) with the unit conversion, before
+    /// --transform-a/--translate-a: the coordinates are multiplied once by the f64 product of
+    /// the conversion factor and F. In scene mode, applies to the file.
+    #[arg(long, value_name = "F", allow_hyphen_values = true)]
+    pub scale_a: Option<f64>,
+    /// Multiply B's coordinates by F, as --scale-a.
+    #[arg(long, value_name = "F", allow_hyphen_values = true)]
+    pub scale_b: Option<f64>,
+    /// Output flags: --format, --junit, --baseline, --export-glb.
+    #[command(flatten)]
+    pub outputs: OutputArgs,
+    /// Nothing on stderr but errors: no warnings, no summary, no progress.
+    #[arg(short, long)]
+    pub quiet: bool,
+}
+
+/// `meshclash scene FILE`: one file's parts against each other.
+#[derive(Debug, Clone, clap::Args)]
+pub struct SceneArgs {
+    /// The file whose parts are checked (glTF nodes, OBJ objects or groups, STL solids).
+    #[arg(value_name = "FILE")]
+    pub file: PathBuf,
+    /// The check's flags (as for two files; `-a` flags name the file).
+    #[command(flatten)]
+    pub check: CheckArgs,
+}
+
+/// Subcommands instead of a check: the generated-text ones of [`TextCommand`], and
+/// `bench`.
+#[derive(Debug, clap::Subcommand)]
+pub enum Command {
+    /// Check the parts of one file against each other (all against all, or --select-a
+    /// against --select-b); the check's flags apply (`./scene` names a file called scene).
+    Scene(Box<SceneArgs>),
+    /// `schema`, `completions <shell>`, `man`.
+    #[command(flatten)]
+    Output(TextCommand),
+    /// Moved to the `meshclash-bench` binary (workspace member `bench/`): runs it with these
+    /// arguments when it sits next to `meshclash`, else says how to run it.
+    #[command(disable_help_flag = true)]
+    Bench(BenchForward),
+    /// Run the named checks of a clash-set file (JSON) in one go: one JSON document with every
+    /// check's report, exit 1 if any check fails its --fail-on, 2 on bad input in any check.
+    ClashSet(ClashSetArgs),
+    /// Check one mesh against itself: self-clashing triangle pairs and mesh health per part.
+    #[command(name = "self")]
+    SelfCheck(SelfArgs),
+}
+
+/// `meshclash bench ARGS..`: forwarded to `meshclash-bench`.
+#[derive(Debug, Clone, clap::Args)]
+pub struct BenchForward {
+    /// Arguments for `meshclash-bench` (see `cargo run --release -p meshclash-bench -- --help`).
+    #[arg(trailing_var_arg = true, allow_hyphen_values = true, num_args = 0..)]
+    pub args: Vec<std::ffi::OsString>,
+}
+
+/// `--fail-on` values.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
+pub enum FailOnArg {
+    /// Crossing pairs fail.
+    Clash,
+    /// Touching or crossing pairs fail.
+    Touching,
+    /// Anything within the clearance fails.
+    Clearance,
+    /// Never fail on findings.
+    Never,
+    /// With --baseline: fail only on crossing pairs that were not crossing in the baseline, or
+    /// on containment the baseline did not report.
+    New,
+}
+
+/// `--cross-check` values.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
+pub enum CrossCheckArg {
+    /// parry3d-f64 0.31 (GJK triangle tests, f64).
+    Parry,
+}
+
+/// `--mode` values.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
+pub enum ModeArg {
+    /// Exact predicates (default).
+    Exact,
+    /// Plain f64 determinants, no exact fallback.
+    Fast,
+}
+
+/// `--bvh` values.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
+pub enum BvhArg {
+    /// Binned surface-area heuristic.
+    Sah,
+    /// Spatial median of the centroid bounds.
+    Median,
+    /// Equal counts (object median).
+    Equal,
+}
+
+/// The output flags, flattened into [`Args`].
+#[derive(Debug, Clone, Default, clap::Args)]
+pub struct OutputArgs {
+    /// What to print on stdout: the JSON report, a human summary or JUnit XML [default: json,
+    /// or nothing when -o is given].
+    #[arg(long, value_enum, value_name = "FORMAT")]
+    pub format: Option<FormatArg>,
+    /// Also write JUnit XML to FILE (atomically): one test case per checked pair of inputs,
+    /// failed when the run fails.
+    #[arg(long, value_name = "FILE")]
+    pub junit: Option<PathBuf>,
+    /// Compare with an earlier report: every finding gets a status (new or persistent) and the
+    /// report a `baseline` block with the resolved ones. Findings are matched by stable ids.
+    #[arg(long, value_name = "REPORT")]
+    pub baseline: Option<PathBuf>,
+    /// Write a self-contained GLB scene to FILE: both inputs, the listed pairs highlighted by
+    /// kind, and markers at the closest points and the crossings.
+    #[arg(long, value_name = "FILE")]
+    pub export_glb: Option<PathBuf>,
+    /// Write a self-contained HTML report to FILE: the summary, a sortable list of clashes and
+    /// a WebGL viewer of the parts involved (no network needed to open it).
+    #[arg(long, value_name = "FILE")]
+    pub html: Option<PathBuf>,
+    /// Write the clashes as BCF 2.1 topics to FILE (.bcfzip), for BIM tools: one topic per
+    /// clash region or part pair (--bcf-topics), with a camera, the parts and the witness line.
+    #[arg(long, value_name = "FILE")]
+    pub bcf: Option<PathBuf>,
+    /// What one BCF topic is.
+    #[arg(long, value_enum, value_name = "WHAT", default_value = "regions")]
+    pub bcf_topics: TopicsArg,
+}
+
+impl OutputArgs {
+    /// Validate. `fail_on_new` is whether `--fail-on new` was given: it needs `--baseline`.
+    pub fn into_options(self, fail_on_new: bool) -> Result<OutputOptions> {
+        if fail_on_new && self.baseline.is_none() {
+            return Err(Error::Usage("--fail-on new needs --baseline REPORT".into()));
+        }
+        Ok(OutputOptions {
+            format: self.format.map(Into::into),
+            junit: self.junit,
+            baseline: self.baseline,
+            export_glb: self.export_glb,
+            html: self.html,
+            bcf: self.bcf.map(|p| (p, self.bcf_topics.into())),
+            fail_on_new,
+        })
+    }
+}
+
+/// `--format`: what goes to stdout (the library's [`Format`]).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
+pub enum FormatArg {
+    /// The JSON report (`meshclash.report/2`).
+    Json,
+    /// The human summary (the one shown on stderr on a terminal).
+    Text,
+    /// JUnit XML, one test case per checked pair of inputs.
+    Junit,
+}
+
+impl From<FormatArg> for Format {
+    fn from(f: FormatArg) -> Self {
+        match f {
+            FormatArg::Json => Format::Json,
+            FormatArg::Text => Format::Text,
+            FormatArg::Junit => Format::Junit,
+        }
+    }
+}
+
+/// `--bcf-topics`: what one topic is (the library's [`Topics`]).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, ValueEnum)]
+pub enum TopicsArg {
+    /// One topic per clash region (a part pair with several separate interferences gets one
+    /// topic per interference).
+    #[default]
+    Regions,
+    /// One topic per clashing part pair.
+    PartPairs,
+}
+
+impl From<TopicsArg> for Topics {
+    fn from(t: TopicsArg) -> Self {
+        match t {
+            TopicsArg::Regions => Topics::Regions,
+            TopicsArg::PartPairs => Topics::PartPairs,
+        }
+    }
+}
+
+/// A unit of length (`--units`, `--units-a`, `--units-b`).
+#[derive(
+    Debug, Clone, Copy, PartialEq, Eq, ValueEnum, serde::Serialize, serde::Deserialize, schemars::JsonSchema,
+)]
+pub enum Unit {
+    /// Micrometre.
+    #[value(name = "um")]
+    #[serde(rename = "um")]
+    Um,
+    /// Millimetre.
+    #[value(name = "mm")]
+    #[serde(rename = "mm")]
+    Mm,
+    /// Centimetre.
+    #[value(name = "cm")]
+    #[serde(rename = "cm")]
+    Cm,
+    /// Metre (glTF's unit by specification).
+    #[value(name = "m")]
+    #[serde(rename = "m")]
+    M,
+    /// Inch (25.4 mm exactly).
+    #[value(name = "in")]
+    #[serde(rename = "in")]
+    In,
+    /// Foot (12 in).
+    #[value(name = "ft")]
+    #[serde(rename = "ft")]
+    Ft,
+    /// Yard (3 ft).
+    #[value(name = "yd")]
+    #[serde(rename = "yd")]
+    Yd,
+}
+
+impl Unit {
+    /// Its name on the command line and in the report.
+    pub fn name(self) -> &'static str {
+        match self {
+            Unit::Um => "um",
+            Unit::Mm => "mm",
+            Unit::Cm => "cm",
+            Unit::M => "m",
+            Unit::In => "in",
+            Unit::Ft => "ft",
+            Unit::Yd => "yd",
+        }
+    }
+
+    /// Its length in micrometres: an exact integer for every unit (the inch is 25.4 mm by
+    /// definition).
+    pub fn micrometres(self) -> u32 {
+        match self {
+            Unit::Um => 1,
+            Unit::Mm => 1_000,
+            Unit::Cm => 10_000,
+            Unit::M => 1_000_000,
+            Unit::In => 25_400,
+            Unit::Ft => 304_800,
+            Unit::Yd => 914_400,
+        }
+    }
+
+    /// The factor that converts coordinates in `self` to `to`: the exact ratio of two integers,
+    /// rounded once to f64 (one IEEE division of exactly representable operands).
+    pub fn factor_to(self, to: Unit) -> f64 {
+        f64::from(self.micrometres()) / f64::from(to.micrometres())
+    }
+}
+
+/// The subcommands beside the main `meshclash A B` job. Each prints to stdout.
+#[derive(Debug, Clone, PartialEq, Eq, clap::Subcommand)]
+pub enum TextCommand {
+    /// Print the JSON Schema (draft 2020-12) of the report.
+    Schema,
+    /// Print a shell completion script.
+    Completions {
+        /// The shell.
+        #[arg(value_enum)]
+        shell: clap_complete::Shell,
+    },
+    /// Print the man page (roff).
+    Man,
+}
+
+/// `meshclash clash-set FILE`: the file and the per-run flags (same meaning as on the main
+/// command).
+#[derive(Debug, Clone, Default, clap::Args)]
+pub struct ClashSetArgs {
+    /// The clash-set file (JSON; see the README or `--schema file`).
+    #[arg(value_name = "FILE", required_unless_present = "schema")]
+    pub file: Option<PathBuf>,
+    /// Write the clash-set report to FILE (atomically) instead of stdout.
+    #[arg(short, long, value_name = "FILE")]
+    pub output: Option<PathBuf>,
+    /// What to print on stdout: the JSON document, one summary line per check, or JUnit XML
+    /// [default: json, or nothing when -o is given].
+    #[arg(long, value_enum, value_name = "FORMAT")]
+    pub format: Option<SetFormat>,
+    /// Also write JUnit XML to FILE (atomically): one test suite per check.
+    #[arg(long, value_name = "FILE")]
+    pub junit: Option<PathBuf>,
+    /// Worker threads (0 = one per core).
+    #[arg(long, value_name = "N", default_value_t = 0)]
+    pub threads: usize,
+    /// Deterministic reports: no timings, no thread count.
+    #[arg(long)]
+    pub no_timings: bool,
+    /// Nothing on stderr but errors.
+    #[arg(short, long)]
+    pub quiet: bool,
+    /// Print the JSON Schema of the clash-set `file` or of its `output` document, and exit.
+    #[arg(long, value_enum, value_name = "WHICH", exclusive = true)]
+    pub schema: Option<SchemaKind>,
+}
+
+/// `--format` values of `clash-set`.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
+pub enum SetFormat {
+    /// The JSON document (`meshclash.clash-set/1`): every check's report.
+    Json,
+    /// One summary line per check, then the total.
+    Text,
+    /// JUnit XML, one test suite per check.
+    Junit,
+}
+
+/// `--schema` values.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
+pub enum SchemaKind {
+    /// The clash-set file format.
+    File,
+    /// The output document (`meshclash.clash-set/1`).
+    Output,
+}
+
+/// Check one mesh against itself: every pair of triangles of one part that meets anywhere the
+/// connectivity does not say it meets (after merging exactly coincident vertices), and each
+/// part's health (closed, duplicate faces, zero-area triangles, non-manifold edges and
+/// vertices, boundary edges, inconsistent winding, signed volume).
+#[derive(Debug, Clone, clap::Args)]
+pub struct SelfArgs {
+    /// The mesh (OBJ, STL, glTF/GLB).
+    pub file: PathBuf,
+    /// Check only parts whose name matches GLOB (`*`, `?`; repeatable).
+    #[arg(long, value_name = "GLOB")]
+    pub select: Vec<String>,
+    /// Leave out parts matching GLOB (repeatable).
+    #[arg(long, value_name = "GLOB")]
+    pub exclude: Vec<String>,
+    /// Split every part into its connected bodies first (as for a check).
+    #[arg(long)]
+    pub split_bodies: bool,
+    /// Check the whole file as one part (objects ignored): connectivity and health across
+    /// objects, e.g. two solids glued face to face.
+    #[arg(long, conflicts_with_all = ["select", "exclude", "split_bodies"])]
+    pub whole_file: bool,
+    /// Exit 1 when any of these is found (comma-separated): `self-clash` (alias `clash`:
+    /// crossing pairs), `touching` (any self-clash pair), `open`, `non-manifold` (edges or
+    /// vertices), `duplicates`, `degenerate` (zero-area triangles), `winding`, `never`.
+    #[arg(long, value_enum, value_delimiter = ',', value_name = "WHAT", default_value = "self-clash")]
+    pub fail_on: Vec<SelfFailOnArg>,
+    /// Write the report to FILE (atomically) instead of stdout.
+    #[arg(short, long, value_name = "FILE")]
+    pub output: Option<PathBuf>,
+    /// Also write JUnit XML to FILE (atomically): one test case per checked part, failed when
+    /// the part has something in --fail-on.
+    #[arg(long, value_name = "FILE")]
+    pub junit: Option<PathBuf>,
+    /// What to print on stdout [default: json, or nothing when -o is given].
+    #[arg(long, value_enum, value_name = "FORMAT")]
+    pub format: Option<SelfFormat>,
+    /// List at most N pairs (the counts stay complete).
+    #[arg(long, value_name = "N", default_value_t = 1000)]
+    pub max_pairs: usize,
+    /// List at most N triangle ids per health finding.
+    #[arg(long, value_name = "N", default_value_t = 10)]
+    pub first_n: usize,
+    /// BVH split strategy (the answer is the same with each; only the time differs).
+    #[arg(long, value_enum, default_value_t = super::args::BvhArg::Sah)]
+    pub bvh: super::args::BvhArg,
+    /// Largest BVH leaf, in triangles (1..=64).
+    #[arg(long, value_name = "N", default_value_t = 4)]
+    pub leaf_size: u32,
+    /// Worker threads (0 = one per core).
+    #[arg(long, value_name = "N", default_value_t = 0)]
+    pub threads: usize,
+    /// Deterministic report: no timings, no thread count (byte-identical across runs).
+    #[arg(long)]
+    pub no_timings: bool,
+    /// Nothing on stderr but errors.
+    #[arg(short, long)]
+    pub quiet: bool,
+}
+
+/// `--fail-on` values of `self` (the library's [`SelfFailOn`]).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord, clap::ValueEnum)]
+pub enum SelfFailOnArg {
+    /// Crossing self-clash pairs (the default).
+    #[value(name = "self-clash", alias = "clash")]
+    SelfClash,
+    /// Any self-clash pair, crossing or touching.
+    Touching,
+    /// A part that is not closed.
+    Open,
+    /// Non-manifold edges or vertices.
+    NonManifold,
+    /// Duplicate faces.
+    Duplicates,
+    /// Zero-area triangles.
+    Degenerate,
+    /// Edges used twice in the same direction.
+    Winding,
+    /// Never fail on findings.
+    Never,
+}
+
+impl From<SelfFailOnArg> for SelfFailOn {
+    fn from(a: SelfFailOnArg) -> Self {
+        match a {
+            SelfFailOnArg::SelfClash => SelfFailOn::SelfClash,
+            SelfFailOnArg::Touching => SelfFailOn::Touching,
+            SelfFailOnArg::Open => SelfFailOn::Open,
+            SelfFailOnArg::NonManifold => SelfFailOn::NonManifold,
+            SelfFailOnArg::Duplicates => SelfFailOn::Duplicates,
+            SelfFailOnArg::Degenerate => SelfFailOn::Degenerate,
+            SelfFailOnArg::Winding => SelfFailOn::Winding,
+            SelfFailOnArg::Never => SelfFailOn::Never,
+        }
+    }
+}
+
+/// `--format` values of `self`.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
+pub enum SelfFormat {
+    /// The JSON report (`meshclash.self/1`).
+    Json,
+    /// A summary for a person.
+    Text,
+}
+
+/// Parse the process's arguments: [`hoist_subcommand`] first, then clap, with help wrapped to
+/// `width` columns (None: the terminal's width).
+pub fn parse(width: Option<usize>) -> std::result::Result<Args, clap::Error> {
+    use clap::{CommandFactory, FromArgMatches};
+    let argv = hoist_subcommand(std::env::args_os().collect());
+    let mut cmd = Args::command();
+    if let Some(w) = width {
+        cmd = cmd.term_width(w);
+    }
+    let mut matches = cmd.try_get_matches_from_mut(argv)?;
+    Args::from_arg_matches_mut(&mut matches).map_err(|e| e.format(&mut cmd))
+}
+
+/// `meshclash --threads 1 clash-set x.json` means `meshclash clash-set --threads 1 x.json`:
+/// when the first positional argument is a subcommand's name and flags of the main command come
+/// before it, the name moves to the front (the subcommand then parses those flags as its own, or
+/// says which one it does not take). Flag values are skipped using the clap definition, so a
+/// file called `self` given to `-o` stays a value.
+pub fn hoist_subcommand(mut argv: Vec<std::ffi::OsString>) -> Vec<std::ffi::OsString> {
+    use clap::CommandFactory;
+    let cmd = Args::command();
+    let takes_value = |a: &clap::Arg| a.get_action().takes_values();
+    let mut i = 1;
+    while i < argv.len() {
+        let Some(t) = argv[i].to_str() else { break };
+        if t == "--" {
+            break;
+        }
+        if let Some(long) = t.strip_prefix("--") {
+            if !long.contains('=')
+                && cmd.get_arguments().any(|a| a.get_long() == Some(long) && takes_value(a))
+            {
+                i += 1;
+            }
+        } else if t.len() > 1 && t.starts_with('-') {
+            let c = t[1..].chars().next();
+            if t.chars().count() == 2 && cmd.get_arguments().any(|a| a.get_short() == c && takes_value(a)) {
+                i += 1;
+            }
+        } else {
+            if i > 1 && cmd.get_subcommands().any(|s| s.get_name() == t) {
+                let name = argv.remove(i);
+                argv.insert(1, name);
+            }
+            break;
+        }
+        i += 1;
+    }
+    argv
+}
