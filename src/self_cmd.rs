@@ -51,6 +51,17 @@ pub struct SelfArgs {
     /// What to print on stdout [default: json, or nothing when -o is given].
     #[arg(long, value_enum, value_name = "FORMAT")]
     pub format: Option<SelfFormat>,
+    /// Write a self-contained HTML report to FILE: the summary, a list of the self-clashes
+    /// and health problems, and a WebGL viewer highlighting their triangles.
+    #[arg(long, value_name = "FILE")]
+    pub html: Option<PathBuf>,
+    /// Write a GLB scene to FILE: the parts, and a node per self-clash and health problem
+    /// with its triangles highlighted, a marker and a camera.
+    #[arg(long, value_name = "FILE")]
+    pub export_glb: Option<PathBuf>,
+    /// Which axis points up, for --html and --export-glb [default: z for STL, else y].
+    #[arg(long, value_enum, value_name = "AXIS", default_value = "auto", hide_default_value = true)]
+    pub up: crate::output::glb::Up,
     /// List at most N pairs (the counts stay complete).
     #[arg(long, value_name = "N", default_value_t = 1000)]
     pub max_pairs: usize,
@@ -228,10 +239,15 @@ pub fn run(args: &SelfArgs) -> Result<SelfOutcome> {
     if !(1..=64).contains(&args.leaf_size) {
         return Err(Error::Usage(format!("--leaf-size must be 1..=64, got {}", args.leaf_size)));
     }
-    let outputs: Vec<crate::output::write::Named> = [("-o", &args.output), ("--junit", &args.junit)]
-        .into_iter()
-        .filter_map(|(f, p)| Some((f, p.as_deref()?)))
-        .collect();
+    let outputs: Vec<crate::output::write::Named> = [
+        ("-o", &args.output),
+        ("--junit", &args.junit),
+        ("--html", &args.html),
+        ("--export-glb", &args.export_glb),
+    ]
+    .into_iter()
+    .filter_map(|(f, p)| Some((f, p.as_deref()?)))
+    .collect();
     crate::output::write::check_outputs(&outputs, &[&args.file])?;
     crate::cli::in_pool(args.threads, |threads| run_in_pool(args, threads))
 }
@@ -299,6 +315,13 @@ fn run_in_pool(args: &SelfArgs, threads: usize) -> Result<SelfOutcome> {
     let mut staged = crate::output::write::Staged::new();
     if let Some(path) = &args.junit {
         staged.stage(path, junit(&parts, &fail_on).as_bytes())?;
+    }
+    let z_up = args.up.z_up(&report.input.format);
+    if let Some(path) = &args.html {
+        staged.stage(path, crate::output::html::export_self(&report, &input.mesh, z_up).as_bytes())?;
+    }
+    if let Some(path) = &args.export_glb {
+        staged.stage(path, &crate::output::glb::export_self(&report, &input.mesh, z_up))?;
     }
     if let Some(path) = &args.output {
         staged.stage_with(path, |w| {

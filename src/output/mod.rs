@@ -63,6 +63,15 @@ pub struct OutputArgs {
     /// What one BCF topic is.
     #[arg(long, value_enum, value_name = "WHAT", default_value = "regions")]
     pub bcf_topics: bcf::Topics,
+    /// BCF version of --bcf: 2.1 (read by every BIM tool) or 3.0.
+    #[arg(long, value_enum, value_name = "V", default_value = "2.1")]
+    pub bcf_version: bcf::Version,
+    /// Which axis points up in the inputs, for --export-glb and --html: `z` turns the GLB's
+    /// root node -90° about X (CAD data shows upright in glTF viewers) and orbits the HTML
+    /// viewer around Z; coordinates in the files stay those of the report [default: z for
+    /// STL, else y].
+    #[arg(long, value_enum, value_name = "AXIS", default_value = "auto", hide_default_value = true)]
+    pub up: glb::Up,
 }
 
 /// The validated output options (part of [`crate::cli::Config`]).
@@ -80,6 +89,10 @@ pub struct OutputOptions {
     pub html: Option<PathBuf>,
     /// `--bcf FILE` and `--bcf-topics`.
     pub bcf: Option<(PathBuf, bcf::Topics)>,
+    /// `--bcf-version`.
+    pub bcf_version: bcf::Version,
+    /// `--up`.
+    pub up: glb::Up,
     /// `--fail-on new`: fail only on new crossings and new containment (needs a baseline).
     pub fail_on_new: bool,
 }
@@ -97,6 +110,8 @@ impl OutputArgs {
             export_glb: self.export_glb,
             html: self.html,
             bcf: self.bcf.map(|p| (p, self.bcf_topics)),
+            bcf_version: self.bcf_version,
+            up: self.up,
             fail_on_new,
         })
     }
@@ -176,13 +191,15 @@ pub fn finish(
         staged.stage(path, junit::from_report(rep).as_bytes())?;
     }
     if let Some(path) = &opts.export_glb {
-        staged.stage(path, &glb::export(rep, meshes[0], meshes[1]))?;
+        let z_up = opts.up.z_up(&rep.inputs.a.format);
+        staged.stage(path, &glb::export(rep, result, meshes[0], meshes[1], z_up))?;
     }
     if let Some(path) = &opts.html {
-        staged.stage(path, html::export(rep, result, meshes[0], meshes[1]).as_bytes())?;
+        let z_up = opts.up.z_up(&rep.inputs.a.format);
+        staged.stage(path, html::export(rep, result, meshes[0], meshes[1], z_up).as_bytes())?;
     }
     if let Some((path, topics)) = &opts.bcf {
-        staged.stage(path, &bcf::export(rep, result, meshes[0], meshes[1], *topics))?;
+        staged.stage(path, &bcf::export(rep, result, meshes[0], meshes[1], *topics, opts.bcf_version))?;
     }
     Ok(())
 }
