@@ -43,6 +43,9 @@ pub const MAX_SEGMENTS: usize = 4_000;
 /// the same mesh, slot 0.
 type PartKey = (usize, u32);
 
+/// A row's two parts and its member pairs (carried through the sort).
+type RowExtra = ((PartKey, PartKey), Vec<usize>);
+
 /// One row of the clash list.
 #[derive(Debug, Clone, Serialize)]
 pub struct Row {
@@ -313,8 +316,7 @@ pub fn clashes(rep: &Report, result: &ClashResult, a: &Mesh, b: &Mesh) -> Clashe
         "clearance" => 2,
         _ => 3,
     };
-    let mut both: Vec<(Row, ((PartKey, PartKey), Vec<usize>))> =
-        rows.into_iter().zip(keys.into_iter().zip(members_of)).collect();
+    let mut both: Vec<(Row, RowExtra)> = rows.into_iter().zip(keys.into_iter().zip(members_of)).collect();
     both.sort_by(|(x, _), (y, _)| {
         rank(&x.kind)
             .cmp(&rank(&y.kind))
@@ -323,7 +325,7 @@ pub fn clashes(rep: &Report, result: &ClashResult, a: &Mesh, b: &Mesh) -> Clashe
             .then(x.distance.unwrap_or(f64::INFINITY).total_cmp(&y.distance.unwrap_or(f64::INFINITY)))
             .then(x.id.cmp(&y.id))
     });
-    let (rows, rest): (Vec<Row>, Vec<((PartKey, PartKey), Vec<usize>)>) = both.into_iter().unzip();
+    let (rows, rest): (Vec<Row>, Vec<RowExtra>) = both.into_iter().unzip();
     let (keys, members) = rest.into_iter().unzip();
     Clashes { rows, keys, centre, members }
 }
@@ -442,8 +444,9 @@ pub fn export_self(rep: &SelfReport, mesh: &Mesh, z_up: bool) -> String {
     let findings = self_findings(rep);
     let centre = centre_of(&[mesh]);
     let rel = |p: DVec3| -> [f32; 3] { (p - centre).as_vec3().to_array() };
-    // A page mesh where each finding's triangles are copies in objects of their own (the
-    // originals leave their part, so nothing is drawn twice in one place).
+    // A page mesh where each finding's triangles are copies in objects of their own. A
+    // self-clash's triangles leave their part (its two sides are the row's A and B); a health
+    // finding's stay in the part, which is its row's A (the viewer draws the smaller B over it).
     let mut m = mesh.clone();
     if rep.settings.whole_file {
         m.tri_object = vec![0; m.triangles.len()];
@@ -457,12 +460,13 @@ pub fn export_self(rep: &SelfReport, mesh: &Mesh, z_up: bool) -> String {
     let mut rows = Vec::new();
     let mut keys = Vec::new();
     for f in &findings {
+        let is_clash = f.kind == "crossing" || f.kind == "touching";
         let mut new_object = |m: &mut Mesh, name: String, tris: &[u32]| -> u32 {
             let o = m.objects.len() as u32;
             m.objects.push(crate::scene::mesh::Object { name, ..Default::default() });
             for &t in tris {
                 if let Some(slot) = moved.get_mut(t as usize) {
-                    *slot = true;
+                    *slot |= is_clash;
                     copies.push(mesh.triangles[t as usize]);
                     copy_object.push(o);
                 }
@@ -470,7 +474,6 @@ pub fn export_self(rep: &SelfReport, mesh: &Mesh, z_up: bool) -> String {
             o
         };
         let part_object = f.object.unwrap_or(0);
-        let is_clash = f.kind == "crossing" || f.kind == "touching";
         let (ka, kb, a_name, b_name) = if is_clash {
             let (na, nb) =
                 (format!("{} (lower triangles)", f.part), format!("{} (higher triangles)", f.part));
