@@ -364,6 +364,8 @@ pub struct SelfFinding {
 pub fn self_findings(rep: &SelfReport) -> Vec<SelfFinding> {
     let (mut clash, mut health) = (Vec::new(), Vec::new());
     for p in &rep.parts {
+        // `--whole-file` names the part by the path as given: show the file name only.
+        let part = if p.object.is_none() { crate::output::glb::file_name(&p.name) } else { p.name.clone() };
         let pairs = p.crossing_pairs + p.touching_pairs;
         if pairs > 0 {
             let listed: Vec<&crate::report::PairReport> =
@@ -385,7 +387,7 @@ pub fn self_findings(rep: &SelfReport) -> Vec<SelfFinding> {
             };
             clash.push(SelfFinding {
                 object: p.object,
-                part: p.name.clone(),
+                part: part.clone(),
                 kind: kind.into(),
                 title: format!(
                     "self-clash {kind} {}, {pairs} pair{}{note}",
@@ -415,9 +417,9 @@ pub fn self_findings(rep: &SelfReport) -> Vec<SelfFinding> {
             }
             health.push(SelfFinding {
                 object: p.object,
-                part: p.name.clone(),
+                part: part.clone(),
                 kind: kind.into(),
-                title: format!("{kind} {}: {} {what}", p.name, f.count),
+                title: format!("{kind} {part}: {} {what}", f.count),
                 count: f.count,
                 crossing: 0,
                 a_tris: f.triangles.clone(),
