@@ -141,7 +141,10 @@ fn two_files_one_node_per_input_and_each_clash_with_marker_lines_triangles_and_c
     assert!(g.names().iter().all(|n| !n.contains(&dir)), "{:?}", g.names());
     let (a, b) = (g.node("A: fcl_env.obj"), g.node("B: fcl_rob.obj"));
     assert_eq!(g.tris(&a, "part A"), r.inputs.a.triangles);
-    assert_eq!(g.tris(&b, "part B"), r.inputs.b.triangles);
+    // The robot is small next to the environment: nearly opaque, so it keeps its own tint.
+    assert_eq!(g.tris(&b, "small part B"), r.inputs.b.triangles);
+    let alpha = |m: &str| g.material(m).pbr_metallic_roughness().base_color_factor()[3];
+    assert!(alpha("small part B") > alpha("part A"));
 
     // One clash node per region, named and counted like the region.
     let clashes = g.clashes();
@@ -196,7 +199,6 @@ fn two_files_one_node_per_input_and_each_clash_with_marker_lines_triangles_and_c
 
     // Parts see-through, highlighted triangles fainter still, lines and markers opaque; the
     // closest-point markers larger than a clash marker.
-    let alpha = |m: &str| g.material(m).pbr_metallic_roughness().base_color_factor()[3];
     assert_eq!(g.material("part A").alpha_mode(), gltf::material::AlphaMode::Blend);
     assert!(alpha("part A") < 1.0 && alpha("crossing triangles") < alpha("part A"));
     assert_ne!(
@@ -252,11 +254,11 @@ fn scene_is_written_once_with_every_region_however_few_pairs_are_listed() {
     assert_eq!(rx["truncated"], true);
     let group = g.doc.nodes().find(|n| n.name() == Some("clashes (6)")).unwrap();
     assert_eq!(g.extras(&group), rx);
-    // The plate is the A side of the worst clash, the dowels B.
+    // The plate is the A side of the worst clash, the (small) dowels B.
     let tint = |n: &gltf::Node| g.prims(n)[0].1.clone();
     let sides = parts.iter().find(|n| n.name().unwrap().contains("sides")).unwrap();
     assert_eq!(tint(sides), "part A");
-    assert!(parts.iter().filter(|n| n.name().unwrap().contains("dowel")).all(|n| tint(n) == "part B"));
+    assert!(parts.iter().filter(|n| n.name().unwrap().contains("dowel")).all(|n| tint(n) == "small part B"));
 
     // Byte-identical whatever the thread count.
     let one = d.path().join("one.glb");

@@ -19,8 +19,9 @@
 //!   region, or part pair without one, worst first, with their complete pair counts, so every
 //!   clash shows however many pairs the report lists (`--max-pairs`); the root's extras say
 //!   how many pairs the report lists of how many (`truncated`).
-//! * Parts are semi-transparent (alpha [`PART_ALPHA`]) in tints that read on white and dark
-//!   backgrounds; a clash's triangles are drawn fainter still (alpha [`HIGHLIGHT_ALPHA`]) in the
+//! * Parts are semi-transparent (alpha [`PART_ALPHA`]; a small part, a bolt in a plate,
+//!   [`SMALL_PART_ALPHA`] so it keeps its own tint) in tints that read on white and dark
+//!   backgrounds (the browser test checks both); a clash's triangles are drawn fainter still (alpha [`HIGHLIGHT_ALPHA`]) in the
 //!   kind's colour, so a floor slab crossed by three legs does not fill the frame; the contact
 //!   segments (the intersection curve) and markers are opaque. The closest-point markers are
 //!   [`CLOSEST_SCALE`] times the clash markers, and come later in the file, so they show above
@@ -47,9 +48,14 @@ use serde_json::{json, Value};
 use std::collections::{BTreeMap, BTreeSet};
 
 /// Alpha of the parts.
-pub const PART_ALPHA: f32 = 0.4;
+pub const PART_ALPHA: f32 = 0.5;
+/// Alpha of a small part (box diagonal under [`SMALL_PART`] of the model's): a bolt inside a
+/// plate stays its own colour instead of mixing with the plate's.
+pub const SMALL_PART_ALPHA: f32 = 0.85;
+/// What "small" means for [`SMALL_PART_ALPHA`], relative to the model's box diagonal.
+pub const SMALL_PART: f64 = 0.25;
 /// Alpha of a clash's highlighted triangles.
-pub const HIGHLIGHT_ALPHA: f32 = 0.3;
+pub const HIGHLIGHT_ALPHA: f32 = 0.12;
 /// Alpha of the parts that are in no clash.
 pub const CONTEXT_ALPHA: f32 = 0.12;
 /// Distinct triangles highlighted per clash at most (an even stride of them beyond).
@@ -88,6 +94,8 @@ impl Up {
 enum Mat {
     PartA,
     PartB,
+    SmallA,
+    SmallB,
     Context,
     Crossing,
     Touching,
@@ -98,9 +106,11 @@ enum Mat {
     Closest,
 }
 
-const MATERIALS: [(Mat, &str, [f32; 4], bool); 10] = [
+const MATERIALS: [(Mat, &str, [f32; 4], bool); 12] = [
     (Mat::PartA, "part A", [1.0, 0.5, 0.05, PART_ALPHA], true),
     (Mat::PartB, "part B", [0.12, 0.47, 0.8, PART_ALPHA], true),
+    (Mat::SmallA, "small part A", [1.0, 0.5, 0.05, SMALL_PART_ALPHA], true),
+    (Mat::SmallB, "small part B", [0.12, 0.47, 0.8, SMALL_PART_ALPHA], true),
     (Mat::Context, "other parts", [0.55, 0.57, 0.6, CONTEXT_ALPHA], true),
     (Mat::Crossing, "crossing triangles", [0.9, 0.05, 0.05, HIGHLIGHT_ALPHA], true),
     (Mat::Touching, "touching triangles", [1.0, 0.6, 0.0, HIGHLIGHT_ALPHA], true),
@@ -311,10 +321,16 @@ pub fn write(s: &Scene) -> Vec<u8> {
         let (tri_idx, vmap) = mesh.reindex(&p.tris);
         let pos: Vec<[f32; 3]> = vmap.iter().map(|&v| rel(mesh.positions[v as usize])).collect();
         let idx: Vec<u32> = tri_idx.iter().flatten().copied().collect();
-        let mat = match p.tint {
-            Tint::A => Mat::PartA,
-            Tint::B => Mat::PartB,
-            Tint::Context => Mat::Context,
+        let small = {
+            let b = Aabb::of_points(vmap.iter().map(|&v| &mesh.positions[v as usize]));
+            b.extent().length() < SMALL_PART * model
+        };
+        let mat = match (p.tint, small) {
+            (Tint::A, false) => Mat::PartA,
+            (Tint::B, false) => Mat::PartB,
+            (Tint::A, true) => Mat::SmallA,
+            (Tint::B, true) => Mat::SmallB,
+            (Tint::Context, _) => Mat::Context,
         };
         let prim = g.primitive(&pos, &idx, mat, TRIANGLES);
         let extras = json!({"triangles": p.tris.len()});
@@ -374,8 +390,8 @@ pub fn write(s: &Scene) -> Vec<u8> {
         extras["highlighted_triangles"] = json!(shown);
         extras["segments_drawn"] = json!(c.segments.len());
         let node = g.node(&c.name, prims, Some(extras));
-        // A camera at a distance that fits the clash (at least a little of its surroundings).
-        let r = ((bounds.max - bounds.min).length() * 0.5).max(model * 0.01);
+        // A camera at a distance that fits the clash and some of its surroundings.
+        let r = ((bounds.max - bounds.min).length() * 0.8).max(model * 0.02);
         let dist = r / (FOV * 0.5).sin() * 1.2;
         let cam = g.camera(
             &format!("camera #{}", n + 1),

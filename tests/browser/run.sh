@@ -56,10 +56,30 @@ printf 'o strip\nv 0 0 0\nv 0 1 0\nv 2 0 0\nv 2 1 0\nv 1 0 1\nv 1 1 1\nv 1 0 -1\
 check self-strip 3 -- self "$out/strip.obj"
 check self-rob 3 -- self meshes/fcl_rob.obj --fail-on never
 
+# --export-glb: each GLB drawn through its own cameras by a viewer of our own
+# (tests/browser/glb_viewer.html): both tints on white and on dark, the first clash in view.
+glb() {
+  name=$1; shift 2
+  pages=$((pages + 1))
+  set +e
+  "$MESHCLASH" "$@" -q --no-timings --export-glb "$out/$name.glb" -o "$out/$name-glb.json"
+  code=$?
+  set -e
+  [ "$code" -le 1 ] || { echo "meshclash failed on $name (exit $code)" >&2; exit 1; }
+  node tests/browser/driver.mjs --glb "$out/$name.glb" "$shots/$name-glb-overview.png" "$shots/$name-glb-clash.png"
+}
+glb fcl -- meshes/fcl_env.obj meshes/fcl_rob.obj
+glb pins -- scene meshes/pins.glb
+glb self-strip -- self "$out/strip.obj"
+if [ -f ../shared/meshes/2CylinderEngine.glb ]; then
+  glb engine -- scene ../shared/meshes/2CylinderEngine.glb
+fi
+
 if [ "$update_docs" = 1 ]; then
   mkdir -p docs/img
-  for f in fcl-clash pins-clash engine-clash self-strip-clash self-rob-clash; do
-    [ -f "$shots/$f.png" ] && cp "$shots/$f.png" "docs/img/html-$f.png"
+  for f in fcl-clash pins-clash engine-clash self-strip-clash self-rob-clash engine-glb-overview-dark engine-glb-clash; do
+    case $f in *-glb-*) dest=docs/img/$f.png ;; *) dest=docs/img/html-$f.png ;; esac
+    [ -f "$shots/$f.png" ] && cp "$shots/$f.png" "$dest"
   done
   echo "screenshots copied to docs/img/"
 fi
