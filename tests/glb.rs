@@ -397,8 +397,10 @@ fn self_glb_has_a_node_per_self_clash_and_health_problem() {
         ]
     );
     assert_eq!(h.boundary_loops, 1);
-    // The self-clash: triangles 0, 1, 4, 5 highlighted, one line per listed pair with a segment.
-    assert_eq!(g.tris(&clashes[0], "crossing triangles"), 4);
+    // The self-clash: lower triangles 0, 1 in the A tint, higher 4, 5 in the B tint, one line
+    // per listed pair with a segment.
+    assert_eq!(g.tris(&clashes[0], "small part A"), 2);
+    assert_eq!(g.tris(&clashes[0], "small part B"), 2);
     let with_segment = r.pairs.iter().filter(|p| p.segment.is_some()).count();
     assert_eq!(g.lines(&clashes[0], "contact segments"), with_segment);
     assert_eq!(g.tris(&clashes[2], "crossing triangles"), h.boundary_edges.triangles.len());

@@ -171,6 +171,10 @@ pub struct ClashNode {
     pub extras: Value,
     /// Highlighted triangles: (mesh slot, triangle).
     pub tris: Vec<(usize, u32)>,
+    /// When not empty, the clash has two sides drawn in the A and B tints (nearly opaque):
+    /// `tris` as A, these as B (a self-clash's lower and higher triangles); else `tris` are
+    /// drawn faint in the kind's colour.
+    pub b_tris: Vec<(usize, u32)>,
     /// Contact segments (world coordinates).
     pub segments: Vec<[DVec3; 2]>,
     /// Witness segment (world).
@@ -340,28 +344,36 @@ pub fn write(s: &Scene) -> Vec<u8> {
     let mut clash_nodes = Vec::new();
     for (n, c) in s.clashes.iter().enumerate() {
         let mut prims = Vec::new();
-        // The clash's triangles, each once, at an even stride beyond MAX_HIGHLIGHT.
-        let distinct: BTreeSet<(usize, u32)> = c.tris.iter().copied().collect();
-        let stride = distinct.len().div_ceil(MAX_HIGHLIGHT).max(1);
-        let (mut pos, mut idx) = (Vec::new(), Vec::new());
+        let faint = match c.kind.as_str() {
+            "touching" => Mat::Touching,
+            "clearance" | "closest" => Mat::Clearance,
+            _ => Mat::Crossing,
+        };
+        let sides = if c.b_tris.is_empty() {
+            vec![(&c.tris, faint)]
+        } else {
+            vec![(&c.tris, Mat::SmallA), (&c.b_tris, Mat::SmallB)]
+        };
         let mut tri_box = Aabb::EMPTY;
-        for &(slot, t) in distinct.iter().step_by(stride) {
-            let mesh = s.meshes[slot];
-            for &v in &mesh.triangles[t as usize] {
-                let p = mesh.positions[v as usize];
-                tri_box = tri_box.grow(p);
-                idx.push(pos.len() as u32);
-                pos.push(rel(p));
+        let mut shown = 0;
+        for (tris, mat) in sides {
+            // The clash's triangles, each once, at an even stride beyond MAX_HIGHLIGHT.
+            let distinct: BTreeSet<(usize, u32)> = tris.iter().copied().collect();
+            let stride = distinct.len().div_ceil(MAX_HIGHLIGHT).max(1);
+            let (mut pos, mut idx) = (Vec::new(), Vec::new());
+            for &(slot, t) in distinct.iter().step_by(stride) {
+                let mesh = s.meshes[slot];
+                for &v in &mesh.triangles[t as usize] {
+                    let p = mesh.positions[v as usize];
+                    tri_box = tri_box.grow(p);
+                    idx.push(pos.len() as u32);
+                    pos.push(rel(p));
+                }
             }
-        }
-        let shown = idx.len() / 3;
-        if !idx.is_empty() {
-            let mat = match c.kind.as_str() {
-                "touching" => Mat::Touching,
-                "clearance" | "closest" => Mat::Clearance,
-                _ => Mat::Crossing,
-            };
-            prims.push(g.primitive(&pos, &idx, mat, TRIANGLES));
+            shown += idx.len() / 3;
+            if !idx.is_empty() {
+                prims.push(g.primitive(&pos, &idx, mat, TRIANGLES));
+            }
         }
         let mut bounds = if c.bounds.is_empty() { tri_box } else { c.bounds };
         for [p, q] in &c.segments {
@@ -562,6 +574,7 @@ pub fn scene<'a>(rep: &Report, result: &ClashResult, a: &'a Mesh, b: &'a Mesh, z
                     "segments_left_off": row.segments_left_off,
                 }),
                 tris,
+                b_tris: Vec::new(),
                 segments,
                 witness,
                 bounds: Aabb { min: world(&row.bounds[0]), max: world(&row.bounds[1]) },
@@ -604,7 +617,9 @@ pub fn export(rep: &Report, result: &ClashResult, a: &Mesh, b: &Mesh, z_up: bool
 
 /// The scene of a `meshclash self` report: one node per part (the parts with a finding
 /// orange, the others faint), one node per self-clash and health finding
-/// ([`html::self_findings`]) with its listed triangles highlighted.
+/// ([`html::self_findings`]) with its listed triangles highlighted: a self-clash's lower
+/// triangles in the A tint and higher ones in the B tint (as the HTML page draws them), a health
+/// finding's faint red.
 pub fn self_scene<'a>(rep: &SelfReport, mesh: &'a Mesh, z_up: bool) -> Scene<'a> {
     let findings = html::self_findings(rep);
     let with: BTreeSet<Option<u32>> = findings.iter().map(|f| f.object).collect();
@@ -634,7 +649,9 @@ pub fn self_scene<'a>(rep: &SelfReport, mesh: &'a Mesh, z_up: bool) -> Scene<'a>
             kind: f.kind.clone(),
             extras: json!({"rank": i + 1, "kind": f.kind, "part": f.part, "count": f.count,
                            "listed_triangles": f.a_tris.len() + f.b_tris.len()}),
-            tris: f.a_tris.iter().chain(&f.b_tris).map(|&t| (0, t)).collect(),
+            // A self-clash's two sides in the two tints; a health finding's triangles faint.
+            tris: f.a_tris.iter().map(|&t| (0, t)).collect(),
+            b_tris: f.b_tris.iter().map(|&t| (0, t)).collect(),
             segments: f.segments.clone(),
             witness: None,
             bounds: Aabb::EMPTY,
