@@ -105,7 +105,7 @@ struct Page {
     verdict: String,
     failed: bool,
     units: String,
-    /// `z` when the first input is STL (CAD, Z up), else `y` (glTF's convention).
+    /// `z` or `y` (`--up`; `z` by default for STL inputs, CAD being Z up).
     up: String,
     centre: [f64; 3],
     parts: Vec<PartView>,
