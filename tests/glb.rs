@@ -411,3 +411,18 @@ fn self_glb_has_a_node_per_self_clash_and_health_problem() {
     let rx = g.extras(&g.root());
     assert_eq!((rx["pairs"].as_str(), rx["truncated"].as_bool()), (Some("4 of 4"), Some(false)));
 }
+
+#[test]
+fn self_outputs_never_overwrite_the_input() {
+    let d = tempfile::tempdir().unwrap();
+    let strip = folded_strip(d.path());
+    let before = std::fs::read(&strip).unwrap();
+    for flag in ["--html", "--export-glb"] {
+        let out = bin().arg("self").arg(&strip).arg(flag).arg(&strip).output().unwrap();
+        assert_eq!(out.status.code(), Some(2), "{flag}");
+        let err = String::from_utf8_lossy(&out.stderr).into_owned();
+        assert_eq!(err.lines().count(), 1, "{err}");
+        assert!(err.contains(flag) && err.contains("strip.obj"), "{err}");
+        assert_eq!(std::fs::read(&strip).unwrap(), before);
+    }
+}

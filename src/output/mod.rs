@@ -48,8 +48,9 @@ pub struct OutputArgs {
     /// report a `baseline` block with the resolved ones. Findings are matched by stable ids.
     #[arg(long, value_name = "REPORT")]
     pub baseline: Option<PathBuf>,
-    /// Write a self-contained GLB scene to FILE: both inputs, the listed pairs highlighted by
-    /// kind, and markers at the closest points and the crossings.
+    /// Write a self-contained GLB scene to FILE for any glTF viewer: a node per part (A orange,
+    /// B blue), a node per clash worst first (marker, contact lines, its triangles, a camera,
+    /// counts in extras) and the closest points.
     #[arg(long, value_name = "FILE")]
     pub export_glb: Option<PathBuf>,
     /// Write a self-contained HTML report to FILE: the summary, a sortable list of clashes and
