@@ -156,3 +156,72 @@ fn two_files_in_model_units_and_witness_line() {
         }
     }
 }
+
+#[test]
+fn bcf_3_0_layout_same_topics_and_viewpoints() {
+    let d = tempfile::tempdir().unwrap();
+    let (v21, _, _) = run(d.path(), &["scene", &shipped("pins.glb")]);
+    let (files, rep, _) = run(d.path(), &["scene", &shipped("pins.glb"), "--bcf-version", "3.0"]);
+    // bcf.version: VersionId 3.0, no DetailedVersion (3.0 dropped it).
+    let version = roxmltree::Document::parse(&files["bcf.version"]).unwrap();
+    assert_eq!(version.root_element().tag_name().name(), "Version");
+    assert_eq!(version.root_element().attribute("VersionId"), Some("3.0"));
+    assert!(text(&version, "DetailedVersion").is_empty());
+    // extensions.xml lists the values the topics use; every list of the schema is there.
+    let ext = roxmltree::Document::parse(&files["extensions.xml"]).unwrap();
+    let lists: Vec<&str> =
+        ext.root_element().children().filter(|n| n.is_element()).map(|n| n.tag_name().name()).collect();
+    assert_eq!(
+        lists,
+        ["TopicTypes", "TopicStatuses", "Priorities", "TopicLabels", "Users", "SnippetTypes", "Stages"]
+    );
+    assert_eq!(text(&ext, "TopicType"), ["Clash"]);
+    assert_eq!(text(&ext, "TopicStatus"), ["Open"]);
+    assert_eq!(text(&ext, "TopicLabel"), ["meshclash"]);
+    // The same topics (GUIDs) as 2.1, one per region.
+    let guids = topics(&files);
+    assert_eq!(guids, topics(&v21));
+    assert_eq!(guids.len(), rep.regions.len());
+    assert_eq!(files.len(), 2 + 2 * guids.len());
+    for g in &guids {
+        let markup = roxmltree::Document::parse(&files[&format!("{g}/markup.bcf")]).unwrap();
+        let top: Vec<&str> = markup
+            .root_element()
+            .children()
+            .filter(|n| n.is_element())
+            .map(|n| n.tag_name().name())
+            .collect();
+        assert_eq!(top, ["Topic"], "3.0: the viewpoints are inside the topic");
+        let topic = markup.root_element().first_element_child().unwrap();
+        assert_eq!(topic.attribute("Guid"), Some(g.as_str()));
+        assert_eq!(topic.attribute("TopicType"), Some("Clash"));
+        let order: Vec<&str> =
+            topic.children().filter(|n| n.is_element()).map(|n| n.tag_name().name()).collect();
+        assert_eq!(order, ["Title", "Labels", "CreationDate", "CreationAuthor", "Description", "Viewpoints"]);
+        assert_eq!(text(&markup, "Label"), ["meshclash"]);
+        let vp_ref = markup.descendants().find(|n| n.has_tag_name("ViewPoint")).unwrap();
+        assert_eq!(text(&markup, "Viewpoint"), ["viewpoint.bcfv"]);
+        let vp = roxmltree::Document::parse(&files[&format!("{g}/viewpoint.bcfv")]).unwrap();
+        assert_eq!(vp.root_element().attribute("Guid"), vp_ref.attribute("Guid"));
+        let cam = vp.descendants().find(|n| n.has_tag_name("PerspectiveCamera")).unwrap();
+        let fields: Vec<&str> =
+            cam.children().filter(|n| n.is_element()).map(|n| n.tag_name().name()).collect();
+        assert_eq!(
+            fields,
+            ["CameraViewPoint", "CameraDirection", "CameraUpVector", "FieldOfView", "AspectRatio"]
+        );
+        // The viewpoint content is the 2.1 one plus the aspect ratio.
+        let old = roxmltree::Document::parse(&v21[&format!("{g}/viewpoint.bcfv")]).unwrap();
+        assert_eq!(xyz(&vp, "CameraViewPoint"), xyz(&old, "CameraViewPoint"));
+        assert_eq!(text(&vp, "AuthoringToolId"), text(&old, "AuthoringToolId"));
+    }
+    // A bad version is a usage error.
+    let out = Command::cargo_bin("meshclash")
+        .unwrap()
+        .args(["scene", &shipped("pins.glb"), "--bcf-version", "2.0", "--bcf", "x.bcfzip"])
+        .current_dir(d.path())
+        .output()
+        .unwrap();
+    assert_eq!(out.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&out.stderr).contains("2.1"));
+}

@@ -200,3 +200,43 @@ fn html_to_an_unwritable_place_is_exit_2_naming_it() {
     assert!(err.contains("/nonexistent-dir/r.html"), "{err}");
     assert_eq!(err.lines().count(), 1, "{err}");
 }
+
+#[test]
+fn self_page_lists_self_clashes_and_health_problems_with_their_triangles() {
+    let d = tempfile::tempdir().unwrap();
+    let strip = crate::glb::folded_strip(d.path());
+    let html = d.path().join("s.html");
+    let out = bin().arg("self").arg(&strip).args(["--no-timings", "--html"]).arg(&html).output().unwrap();
+    assert_eq!(out.status.code(), Some(1));
+    let r: meshclash::report::self_report::SelfReport = serde_json::from_slice(&out.stdout).unwrap();
+    let page = std::fs::read_to_string(&html).unwrap();
+    assert!(!page.contains("http://") && !page.contains("https://"));
+    assert!(page.contains("self-clash"), "the summary is the self summary");
+    let v = data(&page);
+    let rows = v["rows"].as_array().unwrap();
+    let kinds: Vec<&str> = rows.iter().map(|r| r["kind"].as_str().unwrap()).collect();
+    assert_eq!(kinds, ["crossing", "winding", "open"]);
+    let parts = v["parts"].as_array().unwrap();
+    let part = |r: &Value, k: &str| &parts[r[k].as_u64().unwrap() as usize];
+    // The self-clash: lower triangles (0, 1) as A, higher ones (4, 5) as B, the rest of the
+    // strip faded; the contact segments of the listed pairs.
+    let c = &rows[0];
+    assert_eq!((c["pairs"].as_u64(), c["crossing"].as_u64()), (Some(4), Some(2)));
+    assert_eq!((part(c, "a")["shown"].as_u64(), part(c, "b")["shown"].as_u64()), (Some(2), Some(2)));
+    assert_eq!(part(c, "a")["name"], "strip (lower triangles)");
+    let with_segment = r.pairs.iter().filter(|p| p.segment.is_some()).count();
+    assert_eq!(c["segments"].as_array().unwrap().len(), 6 * with_segment);
+    // The health problem: its listed triangles as B against the rest of the part.
+    let o = &rows[2];
+    let h = &r.parts[0].health;
+    assert_eq!(o["pairs"].as_u64(), Some(h.boundary_edges.count));
+    assert_eq!(part(o, "b")["shown"].as_u64(), Some(h.boundary_edges.triangles.len() as u64));
+    assert_eq!(part(o, "b")["name"], "strip (open)");
+    // A self-clash's triangles leave the strip (drawn once, in its two sides); a health
+    // finding's are copies over the strip, which stays whole otherwise.
+    let shown: u64 = parts.iter().map(|p| p["shown"].as_u64().unwrap()).sum();
+    assert_eq!(part(o, "a")["name"], "strip");
+    assert_eq!(part(o, "a")["shown"].as_u64(), Some(2));
+    let copies = h.boundary_edges.triangles.len() + h.inconsistent_winding_edges.triangles.len();
+    assert_eq!(shown as usize, 6 + copies);
+}

@@ -24,6 +24,8 @@ mod cli_subcommands;
 mod extremes;
 #[path = "fcl_reference.rs"]
 mod fcl_reference;
+#[path = "glb.rs"]
+mod glb;
 #[path = "gltf_ext.rs"]
 mod gltf_ext;
 #[path = "hostile.rs"]

@@ -249,8 +249,9 @@ pub struct OutputArgs {
     /// report a `baseline` block with the resolved ones. Findings are matched by stable ids.
     #[arg(long, value_name = "REPORT")]
     pub baseline: Option<PathBuf>,
-    /// Write a self-contained GLB scene to FILE: both inputs, the listed pairs highlighted by
-    /// kind, and markers at the closest points and the crossings.
+    /// Write a self-contained GLB scene to FILE for any glTF viewer: a node per part (A orange,
+    /// B blue), a node per clash worst first (marker, contact lines, its triangles, a camera,
+    /// counts in extras) and the closest points.
     #[arg(long, value_name = "FILE")]
     pub export_glb: Option<PathBuf>,
     /// Write a self-contained HTML report to FILE: the summary, a sortable list of clashes and
@@ -264,6 +265,15 @@ pub struct OutputArgs {
     /// What one BCF topic is.
     #[arg(long, value_enum, value_name = "WHAT", default_value = "regions")]
     pub bcf_topics: TopicsArg,
+    /// BCF version of --bcf: 2.1 (read by every BIM tool) or 3.0.
+    #[arg(long, value_enum, value_name = "V", default_value = "2.1")]
+    pub bcf_version: BcfVersionArg,
+    /// Which axis points up in the inputs, for --export-glb and --html: `z` turns the GLB's
+    /// root node -90° about X (CAD data shows upright in glTF viewers) and orbits the HTML
+    /// viewer around Z; coordinates in the files stay those of the report [default: z for
+    /// STL, else y].
+    #[arg(long, value_enum, value_name = "AXIS", default_value = "auto", hide_default_value = true)]
+    pub up: UpArg,
 }
 
 impl OutputArgs {
@@ -279,6 +289,8 @@ impl OutputArgs {
             export_glb: self.export_glb,
             html: self.html,
             bcf: self.bcf.map(|p| (p, self.bcf_topics.into())),
+            bcf_version: self.bcf_version.into(),
+            up: self.up.into(),
             fail_on_new,
         })
     }
@@ -321,6 +333,49 @@ impl From<TopicsArg> for Topics {
         match t {
             TopicsArg::Regions => Topics::Regions,
             TopicsArg::PartPairs => Topics::PartPairs,
+        }
+    }
+}
+
+/// `--bcf-version` (the library's [`meshclash::output::bcf::Version`]).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, ValueEnum)]
+pub enum BcfVersionArg {
+    /// BCF 2.1 (every BIM tool reads it).
+    #[default]
+    #[value(name = "2.1")]
+    V21,
+    /// BCF 3.0.
+    #[value(name = "3.0")]
+    V30,
+}
+
+impl From<BcfVersionArg> for meshclash::output::bcf::Version {
+    fn from(v: BcfVersionArg) -> Self {
+        match v {
+            BcfVersionArg::V21 => Self::V21,
+            BcfVersionArg::V30 => Self::V30,
+        }
+    }
+}
+
+/// `--up` (the library's [`meshclash::output::glb::Up`]).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, ValueEnum)]
+pub enum UpArg {
+    /// Z when the (first) input is STL, as CAD exports are; else Y (glTF's convention).
+    #[default]
+    Auto,
+    /// Y up (glTF, most OBJ).
+    Y,
+    /// Z up (CAD: STL, STEP-derived OBJ, IFC converted without a Y-up turn).
+    Z,
+}
+
+impl From<UpArg> for meshclash::output::glb::Up {
+    fn from(u: UpArg) -> Self {
+        match u {
+            UpArg::Auto => Self::Auto,
+            UpArg::Y => Self::Y,
+            UpArg::Z => Self::Z,
         }
     }
 }
@@ -497,6 +552,17 @@ pub struct SelfArgs {
     /// What to print on stdout [default: json, or nothing when -o is given].
     #[arg(long, value_enum, value_name = "FORMAT")]
     pub format: Option<SelfFormat>,
+    /// Write a self-contained HTML report to FILE: the summary, a list of the self-clashes
+    /// and health problems, and a WebGL viewer highlighting their triangles.
+    #[arg(long, value_name = "FILE")]
+    pub html: Option<PathBuf>,
+    /// Write a GLB scene to FILE: the parts, and a node per self-clash and health problem
+    /// with its triangles highlighted, a marker and a camera.
+    #[arg(long, value_name = "FILE")]
+    pub export_glb: Option<PathBuf>,
+    /// Which axis points up, for --html and --export-glb [default: z for STL, else y].
+    #[arg(long, value_enum, value_name = "AXIS", default_value = "auto", hide_default_value = true)]
+    pub up: UpArg,
     /// List at most N pairs (the counts stay complete).
     #[arg(long, value_name = "N", default_value_t = 1000)]
     pub max_pairs: usize,

@@ -35,10 +35,15 @@ pub fn run(args: &SelfArgs) -> Result<SelfOutcome> {
     if !(1..=64).contains(&args.leaf_size) {
         return Err(Error::Usage(format!("--leaf-size must be 1..=64, got {}", args.leaf_size)));
     }
-    let outputs: Vec<meshclash::output::write::Named> = [("-o", &args.output), ("--junit", &args.junit)]
-        .into_iter()
-        .filter_map(|(f, p)| Some((f, p.as_deref()?)))
-        .collect();
+    let outputs: Vec<meshclash::output::write::Named> = [
+        ("-o", &args.output),
+        ("--junit", &args.junit),
+        ("--html", &args.html),
+        ("--export-glb", &args.export_glb),
+    ]
+    .into_iter()
+    .filter_map(|(f, p)| Some((f, p.as_deref()?)))
+    .collect();
     meshclash::output::write::check_outputs(&outputs, &[&args.file])?;
     super::run::in_pool(args.threads, |threads| run_in_pool(args, threads))
 }
@@ -107,6 +112,13 @@ fn run_in_pool(args: &SelfArgs, threads: usize) -> Result<SelfOutcome> {
     let mut staged = meshclash::output::write::Staged::new();
     if let Some(path) = &args.junit {
         staged.stage(path, junit(&parts, &fail_on).as_bytes())?;
+    }
+    let z_up = meshclash::output::glb::Up::from(args.up).z_up(&report.input.format);
+    if let Some(path) = &args.html {
+        staged.stage(path, meshclash::output::html::export_self(&report, &input.mesh, z_up).as_bytes())?;
+    }
+    if let Some(path) = &args.export_glb {
+        staged.stage(path, &meshclash::output::glb::export_self(&report, &input.mesh, z_up))?;
     }
     if let Some(path) = &args.output {
         staged.stage_with(path, |w| {

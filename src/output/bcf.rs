@@ -1,5 +1,11 @@
-//! `--bcf FILE.bcfzip`: the clashes as BCF 2.1 topics, for BIM tools (Navisworks, Solibri,
-//! BIMcollab, Revit, IfcOpenShell's BCF, ...).
+//! `--bcf FILE.bcfzip`: the clashes as BCF 2.1 topics (or 3.0 with `--bcf-version 3.0`), for
+//! BIM tools (Navisworks, Solibri, BIMcollab, Revit, IfcOpenShell's BCF, ...).
+//!
+//! BCF 3.0 differs in layout only: `bcf.version` is `<Version VersionId="3.0"/>`, an
+//! `extensions.xml` at the root lists the values used (topic type `Clash`, status `Open`, label
+//! and user `meshclash`), the topic holds its `<Labels><Label>` and `<Viewpoints><ViewPoint>`,
+//! and the camera has an `AspectRatio`. No `documents.xml` (no documents) and no
+//! `snapshot.png` in either version (rendering one needs a rasteriser meshclash does not have).
 //!
 //! The archive holds `bcf.version` and one folder per topic named by its GUID, with
 //! `markup.bcf` (the topic: `TopicType="Clash"`, title, description) and `viewpoint.bcfv` (a
@@ -50,6 +56,27 @@ pub enum Topics {
     PartPairs,
 }
 
+/// `--bcf-version`: the BCF schema version written.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum Version {
+    /// BCF 2.1 (every BIM tool reads it).
+    #[default]
+    V21,
+    /// BCF 3.0: `extensions.xml` at the root, viewpoints and labels inside the topic, cameras
+    /// with an aspect ratio.
+    V30,
+}
+
+impl Version {
+    /// `2.1` or `3.0`.
+    pub fn name(self) -> &'static str {
+        match self {
+            Version::V21 => "2.1",
+            Version::V30 => "3.0",
+        }
+    }
+}
+
 /// One topic before writing.
 struct Topic {
     guid: String,
@@ -63,7 +90,14 @@ struct Topic {
 }
 
 /// The archive as bytes. `result` and the meshes are those the report was built from.
-pub fn export(rep: &Report, result: &ClashResult, a: &Mesh, b: &Mesh, topics: Topics) -> Vec<u8> {
+pub fn export(
+    rep: &Report,
+    result: &ClashResult,
+    a: &Mesh,
+    b: &Mesh,
+    topics: Topics,
+    version: Version,
+) -> Vec<u8> {
     let cl = html::clashes(rep, result, a, b);
     let to_m = metres(rep);
     let gltf = |f: &str| f == "gltf" || f == "glb";
@@ -153,7 +187,7 @@ pub fn export(rep: &Report, result: &ClashResult, a: &Mesh, b: &Mesh, topics: To
         out.push(Topic { guid: guid(key), title, description, components, centre, radius, lines });
     }
     let date = if rep.timings_ms.is_some() { now_iso() } else { "1970-01-01T00:00:00Z".to_string() };
-    archive(&out, &date)
+    archive(&out, &date, version)
 }
 
 /// Factor from the report units to metres (model units: taken as metres).
@@ -259,24 +293,54 @@ fn num(x: f64) -> String {
     format!("{x}")
 }
 
-fn version() -> Vec<u8> {
+fn version_file(v: Version) -> Vec<u8> {
     let mut x = Xml::new();
-    x.open("Version", &[("VersionId", "2.1")]).leaf("DetailedVersion", "2.1").close("Version");
+    match v {
+        Version::V21 => {
+            x.open("Version", &[("VersionId", "2.1")]).leaf("DetailedVersion", "2.1").close("Version");
+        }
+        Version::V30 => {
+            x.empty("Version", &[("VersionId", "3.0")]);
+        }
+    }
     x.bytes()
 }
 
-fn markup(t: &Topic, date: &str) -> Vec<u8> {
+/// BCF 3.0 `extensions.xml`: the values the topics use (every list is required, some empty).
+fn extensions() -> Vec<u8> {
+    let mut x = Xml::new();
+    x.open("Extensions", &[]);
+    x.open("TopicTypes", &[]).leaf("TopicType", "Clash").close("TopicTypes");
+    x.open("TopicStatuses", &[]).leaf("TopicStatus", "Open").close("TopicStatuses");
+    x.empty("Priorities", &[]);
+    x.open("TopicLabels", &[]).leaf("TopicLabel", "meshclash").close("TopicLabels");
+    x.open("Users", &[]).leaf("User", "meshclash").close("Users");
+    x.empty("SnippetTypes", &[]).empty("Stages", &[]);
+    x.close("Extensions");
+    x.bytes()
+}
+
+fn markup(t: &Topic, date: &str, v: Version) -> Vec<u8> {
     let vp = guid(&format!("{} viewpoint", t.guid));
     let mut x = Xml::new();
     x.open("Markup", &[]);
     x.open("Topic", &[("Guid", &t.guid), ("TopicType", "Clash"), ("TopicStatus", "Open")]);
-    x.leaf("Title", &t.title)
-        .leaf("Labels", "meshclash")
-        .leaf("CreationDate", date)
-        .leaf("CreationAuthor", "meshclash")
-        .leaf("Description", &t.description);
+    x.leaf("Title", &t.title);
+    match v {
+        Version::V21 => x.leaf("Labels", "meshclash"),
+        Version::V30 => x.open("Labels", &[]).leaf("Label", "meshclash").close("Labels"),
+    };
+    x.leaf("CreationDate", date).leaf("CreationAuthor", "meshclash").leaf("Description", &t.description);
+    if v == Version::V30 {
+        // 3.0: the viewpoints are part of the topic.
+        x.open("Viewpoints", &[]);
+        x.open("ViewPoint", &[("Guid", &vp)]).leaf("Viewpoint", "viewpoint.bcfv").close("ViewPoint");
+        x.close("Viewpoints");
+    }
     x.close("Topic");
-    x.open("Viewpoints", &[("Guid", &vp)]).leaf("Viewpoint", "viewpoint.bcfv").close("Viewpoints");
+    if v == Version::V21 {
+        x.open("Viewpoints", &[("Guid", &vp)]).leaf("Viewpoint", "viewpoint.bcfv").close("Viewpoints");
+    }
     x.close("Markup");
     x.bytes()
 }
@@ -295,7 +359,7 @@ fn component(x: &mut Xml, name: &str, file: &str) {
     }
 }
 
-fn viewpoint(t: &Topic) -> Vec<u8> {
+fn viewpoint(t: &Topic, v: Version) -> Vec<u8> {
     let vp = guid(&format!("{} viewpoint", t.guid));
     // From front-left above (Z up), at a distance that fits a sphere of `radius` in 60°.
     let dir = DVec3::new(0.55, 0.65, -0.52).normalize();
@@ -322,6 +386,9 @@ fn viewpoint(t: &Topic) -> Vec<u8> {
     x.open("PerspectiveCamera", &[]);
     x.point("CameraViewPoint", eye).point("CameraDirection", dir).point("CameraUpVector", up);
     x.leaf("FieldOfView", "60");
+    if v == Version::V30 {
+        x.leaf("AspectRatio", "1.5");
+    }
     x.close("PerspectiveCamera");
     if !t.lines.is_empty() {
         x.open("Lines", &[]);
@@ -334,7 +401,7 @@ fn viewpoint(t: &Topic) -> Vec<u8> {
     x.bytes()
 }
 
-fn archive(topics: &[Topic], date: &str) -> Vec<u8> {
+fn archive(topics: &[Topic], date: &str, v: Version) -> Vec<u8> {
     let mut z = zip::ZipWriter::new(std::io::Cursor::new(Vec::new()));
     let opts = zip::write::SimpleFileOptions::default()
         .compression_method(zip::CompressionMethod::Deflated)
@@ -343,10 +410,13 @@ fn archive(topics: &[Topic], date: &str) -> Vec<u8> {
         z.start_file(name, opts).expect("in memory");
         z.write_all(bytes).expect("in memory");
     };
-    put("bcf.version", &version());
+    put("bcf.version", &version_file(v));
+    if v == Version::V30 {
+        put("extensions.xml", &extensions());
+    }
     for t in topics {
-        put(&format!("{}/markup.bcf", t.guid), &markup(t, date));
-        put(&format!("{}/viewpoint.bcfv", t.guid), &viewpoint(t));
+        put(&format!("{}/markup.bcf", t.guid), &markup(t, date, v));
+        put(&format!("{}/viewpoint.bcfv", t.guid), &viewpoint(t, v));
     }
     z.finish().expect("in memory").into_inner()
 }

@@ -17,6 +17,7 @@
 
 use crate::check::query::{ClashResult, PairKind};
 use crate::geom::Aabb;
+use crate::report::self_report::SelfReport;
 use crate::report::Report;
 use crate::report::{ReportContainment, ReportVerdict};
 use crate::scene::mesh::Mesh;
@@ -41,6 +42,9 @@ pub const MAX_SEGMENTS: usize = 4_000;
 /// A part of one input: (mesh slot, object index). In scene and self checks both sides are
 /// the same mesh, slot 0.
 type PartKey = (usize, u32);
+
+/// A row's two parts and its member pairs (carried through the sort).
+type RowExtra = ((PartKey, PartKey), Vec<usize>);
 
 /// One row of the clash list.
 #[derive(Debug, Clone, Serialize)]
@@ -101,7 +105,7 @@ struct Page {
     verdict: String,
     failed: bool,
     units: String,
-    /// `z` when the first input is STL (CAD, Z up), else `y` (glTF's convention).
+    /// `z` or `y` (`--up`; `z` by default for STL inputs, CAD being Z up).
     up: String,
     centre: [f64; 3],
     parts: Vec<PartView>,
@@ -112,10 +116,11 @@ struct Page {
 
 /// The HTML page for a two-file or scene report. `result` and the meshes are those the report
 /// was built from (scene mode: `a` and `b` are the same mesh).
-pub fn export(rep: &Report, result: &ClashResult, a: &Mesh, b: &Mesh) -> String {
+/// `z_up`: the viewer orbits around Z (`--up`).
+pub fn export(rep: &Report, result: &ClashResult, a: &Mesh, b: &Mesh, z_up: bool) -> String {
     let same = std::ptr::eq(a, b);
     let meshes: Vec<&Mesh> = if same { vec![a] } else { vec![a, b] };
-    let Clashes { rows, keys, centre } = clashes(rep, result, a, b);
+    let Clashes { rows, keys, centre, .. } = clashes(rep, result, a, b);
     let title = if same {
         format!("meshclash scene {}", rep.inputs.a.path)
     } else {
@@ -128,7 +133,7 @@ pub fn export(rep: &Report, result: &ClashResult, a: &Mesh, b: &Mesh) -> String 
             verdict: rep.verdict.name().to_string(),
             failed: rep.failed,
             units: rep.settings.units.clone(),
-            up: if rep.inputs.a.format == "stl" { "z" } else { "y" }.into(),
+            up: if z_up { "z" } else { "y" }.into(),
             summary,
             meshes: &meshes,
             centre,
@@ -146,6 +151,9 @@ pub struct Clashes {
     pub keys: Vec<((usize, u32), (usize, u32))>,
     /// The world point the rows' coordinates are relative to.
     pub centre: DVec3,
+    /// For each row, its pairs (indices into the result's pairs; empty for a part pair without
+    /// a region).
+    pub members: Vec<Vec<usize>>,
 }
 
 /// The rows of [`Clashes`] for a report (see [`export`] for the arguments).
@@ -157,6 +165,7 @@ pub fn clashes(rep: &Report, result: &ClashResult, a: &Mesh, b: &Mesh) -> Clashe
     let rel = |p: DVec3| -> [f32; 3] { (p - centre).as_vec3().to_array() };
     let mut rows = Vec::new();
     let mut keys: Vec<(PartKey, PartKey)> = Vec::new();
+    let mut members_of: Vec<Vec<usize>> = Vec::new();
 
     // Rows from regions (their member pairs give segments and baseline status).
     let regions = crate::check::regions::regions(&result.pairs, a, b);
@@ -211,6 +220,7 @@ pub fn clashes(rep: &Report, result: &ClashResult, a: &Mesh, b: &Mesh) -> Clashe
             witness,
         });
         keys.push((ka, kb));
+        members_of.push(members);
     }
 
     // Part pairs without a region: containment, or findings not grouped.
@@ -261,6 +271,7 @@ pub fn clashes(rep: &Report, result: &ClashResult, a: &Mesh, b: &Mesh) -> Clashe
             witness,
         });
         keys.push((ka, kb));
+        members_of.push(Vec::new());
     }
 
     // Nothing listed: one row for the closest points (or the containment of one input in the
@@ -293,6 +304,7 @@ pub fn clashes(rep: &Report, result: &ClashResult, a: &Mesh, b: &Mesh) -> Clashe
                 witness: flat(&[rel(p), rel(q)]),
             });
             keys.push((ka, kb));
+            members_of.push(Vec::new());
         }
     }
 
@@ -304,7 +316,7 @@ pub fn clashes(rep: &Report, result: &ClashResult, a: &Mesh, b: &Mesh) -> Clashe
         "clearance" => 2,
         _ => 3,
     };
-    let mut both: Vec<(Row, (PartKey, PartKey))> = rows.into_iter().zip(keys).collect();
+    let mut both: Vec<(Row, RowExtra)> = rows.into_iter().zip(keys.into_iter().zip(members_of)).collect();
     both.sort_by(|(x, _), (y, _)| {
         rank(&x.kind)
             .cmp(&rank(&y.kind))
@@ -313,8 +325,209 @@ pub fn clashes(rep: &Report, result: &ClashResult, a: &Mesh, b: &Mesh) -> Clashe
             .then(x.distance.unwrap_or(f64::INFINITY).total_cmp(&y.distance.unwrap_or(f64::INFINITY)))
             .then(x.id.cmp(&y.id))
     });
-    let (rows, keys): (Vec<Row>, Vec<(PartKey, PartKey)>) = both.into_iter().unzip();
-    Clashes { rows, keys, centre }
+    let (rows, rest): (Vec<Row>, Vec<RowExtra>) = both.into_iter().unzip();
+    let (keys, members) = rest.into_iter().unzip();
+    Clashes { rows, keys, centre, members }
+}
+
+/// One finding of a `meshclash self` report, as the HTML list and the GLB show it: a part's
+/// self-clashing pairs, or one kind of health problem of a part.
+#[derive(Debug, Clone)]
+pub struct SelfFinding {
+    /// The part's object (None with `--whole-file`).
+    pub object: Option<u32>,
+    /// The part's name.
+    pub part: String,
+    /// `crossing` or `touching` (self-clash); `non-manifold`, `duplicate faces`, `zero-area`,
+    /// `winding` or `open` (health).
+    pub kind: String,
+    /// `self-clash crossing bracket, 12 pairs`, `open bracket: 40 boundary edges, 2 loops`.
+    pub title: String,
+    /// Pairs, edges, faces or vertices (complete).
+    pub count: u64,
+    /// Of the pairs, crossing.
+    pub crossing: u64,
+    /// Listed triangles: of a self-clash, the lower triangle of each listed pair; of a health
+    /// finding, its first triangles (`--first-n`).
+    pub a_tris: Vec<u32>,
+    /// Of a self-clash, the higher triangle of each listed pair when it is not also a lower one.
+    pub b_tris: Vec<u32>,
+    /// Contact segments of the listed pairs (world), at most [`MAX_SEGMENTS`].
+    pub segments: Vec<[DVec3; 2]>,
+    /// Segments left off.
+    pub segments_left_off: usize,
+}
+
+/// The findings of a self report, worst first: self-clashes (crossing, then touching; more
+/// pairs first), then health problems part by part (non-manifold, duplicate faces, zero-area
+/// triangles, winding, open). Only the report's listed pairs are drawn; counts are complete.
+pub fn self_findings(rep: &SelfReport) -> Vec<SelfFinding> {
+    let (mut clash, mut health) = (Vec::new(), Vec::new());
+    for p in &rep.parts {
+        // `--whole-file` names the part by the path as given: show the file name only.
+        let part = if p.object.is_none() { crate::output::glb::file_name(&p.name) } else { p.name.clone() };
+        let pairs = p.crossing_pairs + p.touching_pairs;
+        if pairs > 0 {
+            let listed: Vec<&crate::report::PairReport> =
+                rep.pairs.iter().filter(|q| p.object.is_none_or(|o| q.a_object == o)).collect();
+            let a: BTreeSet<u32> = listed.iter().map(|q| q.a).collect();
+            let b: BTreeSet<u32> = listed.iter().map(|q| q.b).filter(|t| !a.contains(t)).collect();
+            let segs: Vec<[DVec3; 2]> = listed
+                .iter()
+                .filter_map(|q| q.segment)
+                .map(|[s, t]| [DVec3::from_array(s), DVec3::from_array(t)])
+                .collect();
+            let stride = segs.len().div_ceil(MAX_SEGMENTS).max(1);
+            let segments: Vec<[DVec3; 2]> = segs.iter().step_by(stride).copied().collect();
+            let kind = if p.crossing_pairs > 0 { "crossing" } else { "touching" };
+            let note = if (listed.len() as u64) < pairs {
+                format!(" ({} listed)", listed.len())
+            } else {
+                String::new()
+            };
+            clash.push(SelfFinding {
+                object: p.object,
+                part: part.clone(),
+                kind: kind.into(),
+                title: format!(
+                    "self-clash {kind} {}, {pairs} pair{}{note}",
+                    p.name,
+                    if pairs == 1 { "" } else { "s" }
+                ),
+                count: pairs,
+                crossing: p.crossing_pairs,
+                a_tris: a.into_iter().collect(),
+                b_tris: b.into_iter().collect(),
+                segments_left_off: segs.len() - segments.len(),
+                segments,
+            });
+        }
+        let h = &p.health;
+        let loops = format!(", {} loop{}", h.boundary_loops, if h.boundary_loops == 1 { "" } else { "s" });
+        for (kind, f, what) in [
+            ("non-manifold", &h.non_manifold_edges, "non-manifold edges".to_string()),
+            ("non-manifold", &h.non_manifold_vertices, "non-manifold vertices".to_string()),
+            ("duplicate faces", &h.duplicate_faces, "duplicate faces".to_string()),
+            ("zero-area", &h.zero_area_triangles, "zero-area triangles".to_string()),
+            ("winding", &h.inconsistent_winding_edges, "edges with inconsistent winding".to_string()),
+            ("open", &h.boundary_edges, format!("boundary edges{loops}")),
+        ] {
+            if f.count == 0 {
+                continue;
+            }
+            health.push(SelfFinding {
+                object: p.object,
+                part: part.clone(),
+                kind: kind.into(),
+                title: format!("{kind} {part}: {} {what}", f.count),
+                count: f.count,
+                crossing: 0,
+                a_tris: f.triangles.clone(),
+                b_tris: Vec::new(),
+                segments: Vec::new(),
+                segments_left_off: 0,
+            });
+        }
+    }
+    clash.sort_by(|x, y| {
+        (x.kind != "crossing")
+            .cmp(&(y.kind != "crossing"))
+            .then(y.count.cmp(&x.count))
+            .then(x.object.cmp(&y.object))
+    });
+    clash.extend(health);
+    clash
+}
+
+/// The HTML page of a `meshclash self` report: one row per finding ([`self_findings`]). The
+/// viewer draws a self-clash's lower triangles as A (orange) and higher ones as B (blue), and a
+/// health finding's triangles as B against the rest of its part as A; other parts faded.
+pub fn export_self(rep: &SelfReport, mesh: &Mesh, z_up: bool) -> String {
+    let findings = self_findings(rep);
+    let centre = centre_of(&[mesh]);
+    let rel = |p: DVec3| -> [f32; 3] { (p - centre).as_vec3().to_array() };
+    // A page mesh where each finding's triangles are copies in objects of their own. A
+    // self-clash's triangles leave their part (its two sides are the row's A and B); a health
+    // finding's stay in the part, which is its row's A (the viewer draws the smaller B over it).
+    let mut m = mesh.clone();
+    if rep.settings.whole_file {
+        m.tri_object = vec![0; m.triangles.len()];
+        m.objects = vec![crate::scene::mesh::Object {
+            name: crate::output::glb::file_name(&rep.input.path),
+            ..Default::default()
+        }];
+    }
+    let mut moved = vec![false; mesh.triangles.len()];
+    let (mut copies, mut copy_object) = (Vec::new(), Vec::new());
+    let mut rows = Vec::new();
+    let mut keys = Vec::new();
+    for f in &findings {
+        let is_clash = f.kind == "crossing" || f.kind == "touching";
+        let mut new_object = |m: &mut Mesh, name: String, tris: &[u32]| -> u32 {
+            let o = m.objects.len() as u32;
+            m.objects.push(crate::scene::mesh::Object { name, ..Default::default() });
+            for &t in tris {
+                if let Some(slot) = moved.get_mut(t as usize) {
+                    *slot |= is_clash;
+                    copies.push(mesh.triangles[t as usize]);
+                    copy_object.push(o);
+                }
+            }
+            o
+        };
+        let part_object = f.object.unwrap_or(0);
+        let (ka, kb, a_name, b_name) = if is_clash {
+            let (na, nb) =
+                (format!("{} (lower triangles)", f.part), format!("{} (higher triangles)", f.part));
+            (new_object(&mut m, na.clone(), &f.a_tris), new_object(&mut m, nb.clone(), &f.b_tris), na, nb)
+        } else {
+            let nb = format!("{} ({})", f.part, f.kind);
+            (part_object, new_object(&mut m, nb.clone(), &f.a_tris), f.part.clone(), nb)
+        };
+        let tri_box = f.a_tris.iter().chain(&f.b_tris).fold(Aabb::EMPTY, |b, &t| {
+            mesh.triangles[t as usize].iter().fold(b, |b, &v| b.grow(mesh.positions[v as usize]))
+        });
+        let bx = f.segments.iter().fold(tri_box, |b, [p, q]| b.grow(*p).grow(*q));
+        let bounds = if bx.is_empty() { [[0.0; 3]; 2] } else { [rel(bx.min), rel(bx.max)] };
+        let segments: Vec<[f32; 3]> = f.segments.iter().flat_map(|[p, q]| [rel(*p), rel(*q)]).collect();
+        rows.push(Row {
+            id: format!("self:{}:{}", f.object.map_or_else(|| "file".to_string(), |o| o.to_string()), f.kind),
+            a: 0,
+            b: 0,
+            a_name,
+            b_name,
+            kind: f.kind.clone(),
+            pairs: f.count,
+            crossing: f.crossing,
+            distance: is_clash.then_some(0.0),
+            penetration: None,
+            status: None,
+            bounds,
+            segments: flat(&segments),
+            segments_left_off: f.segments_left_off,
+            witness: Vec::new(),
+        });
+        keys.push(((0, ka), (0, kb)));
+    }
+    let keep: Vec<usize> = (0..mesh.triangles.len()).filter(|&t| !moved[t]).collect();
+    m.triangles = keep.iter().map(|&t| mesh.triangles[t]).chain(copies).collect();
+    let mut objs: Vec<u32> = keep.iter().map(|&t| m.tri_object[t]).collect();
+    objs.extend(copy_object);
+    m.tri_object = objs;
+    page(
+        PageInput {
+            title: format!("meshclash self {}", rep.input.path),
+            verdict: rep.verdict.name().to_string(),
+            failed: rep.failed,
+            units: "model".into(),
+            up: if z_up { "z" } else { "y" }.into(),
+            summary: crate::report::self_report::text(rep),
+            meshes: &[&m],
+            centre,
+        },
+        rows,
+        &keys,
+    )
 }
 
 /// Everything [`page`] needs besides the rows.

@@ -46,6 +46,10 @@ pub struct OutputOptions {
     pub html: Option<PathBuf>,
     /// `--bcf FILE` and `--bcf-topics`.
     pub bcf: Option<(PathBuf, bcf::Topics)>,
+    /// `--bcf-version`.
+    pub bcf_version: bcf::Version,
+    /// `--up`.
+    pub up: glb::Up,
     /// `--fail-on new`: fail only on new crossings and new containment (needs a baseline).
     pub fail_on_new: bool,
 }
@@ -83,13 +87,15 @@ pub fn finish(
         staged.stage(path, junit::from_report(rep).as_bytes())?;
     }
     if let Some(path) = &opts.export_glb {
-        staged.stage(path, &glb::export(rep, meshes[0], meshes[1]))?;
+        let z_up = opts.up.z_up(&rep.inputs.a.format);
+        staged.stage(path, &glb::export(rep, result, meshes[0], meshes[1], z_up))?;
     }
     if let Some(path) = &opts.html {
-        staged.stage(path, html::export(rep, result, meshes[0], meshes[1]).as_bytes())?;
+        let z_up = opts.up.z_up(&rep.inputs.a.format);
+        staged.stage(path, html::export(rep, result, meshes[0], meshes[1], z_up).as_bytes())?;
     }
     if let Some((path, topics)) = &opts.bcf {
-        staged.stage(path, &bcf::export(rep, result, meshes[0], meshes[1], *topics))?;
+        staged.stage(path, &bcf::export(rep, result, meshes[0], meshes[1], *topics, opts.bcf_version))?;
     }
     Ok(())
 }

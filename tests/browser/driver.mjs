@@ -3,20 +3,27 @@
 // small PNG decoder on Node's zlib.
 //
 //   node tests/browser/driver.mjs REPORT.html OVERVIEW.png CLASH.png [--rows N]
+//   node tests/browser/driver.mjs --glb SCENE.glb OVERVIEW.png CLASH.png
 //
 // Fails (exit 1, a line on stderr) unless: the page reaches WebGL ready; the overview frame and
 // the frame after clicking the first clash row both contain the A colour (orange) and the B
 // colour (blue) in the canvas, and the selected frame the contact colour (magenta) when that row
 // has contact segments; the page made no request other than the report file itself; the console
 // and the log have no error and no exception was thrown. `--rows N` also asserts the table rows.
+//
+// With --glb: the GLB is embedded in tests/browser/glb_viewer.html (a minimal viewer written for
+// this test) and drawn through the file's own cameras: `camera overview` on white and on a dark
+// background must show part A (orange) and part B (blue); `camera #1` must show the first clash's
+// contact lines and marker (magenta) and both parts.
 import { spawn } from 'node:child_process';
-import { mkdtempSync, rmSync, writeFileSync } from 'node:fs';
+import { mkdtempSync, readFileSync, rmSync, writeFileSync } from 'node:fs';
 import { tmpdir } from 'node:os';
-import { join, resolve } from 'node:path';
-import { pathToFileURL } from 'node:url';
+import { dirname, join, resolve } from 'node:path';
+import { fileURLToPath, pathToFileURL } from 'node:url';
 import { inflateSync } from 'node:zlib';
 
-const args = process.argv.slice(2);
+const glbMode = process.argv[2] === '--glb';
+const args = process.argv.slice(glbMode ? 3 : 2);
 const [htmlPath, overviewPng, clashPng] = args;
 const rowsIdx = args.indexOf('--rows');
 const wantRows = rowsIdx >= 0 ? Number(args[rowsIdx + 1]) : null;
@@ -107,7 +114,10 @@ function decodePng(bytes) {
   return { w, h, bpp, px: out };
 }
 // Pixels of the A (orange), B (blue) and contact (magenta) hues inside rect.
-function colourCounts(img, rect) {
+// `hues`: the A, B and contact windows (degrees); the GLB check blends several translucent
+// layers, which pulls a tint's hue a little towards its neighbours', so it passes wider ones.
+const HUES = { a: [15, 45], b: [195, 225], seg: [300, 340] };
+function colourCounts(img, rect, hues = HUES) {
   const n = { a: 0, b: 0, seg: 0 };
   for (let y = Math.max(0, rect.y | 0); y < Math.min(img.h, (rect.y + rect.height) | 0); y++) {
     for (let x = Math.max(0, rect.x | 0); x < Math.min(img.w, (rect.x + rect.width) | 0); x++) {
@@ -118,9 +128,10 @@ function colourCounts(img, rect) {
       if (max === r) hue = (60 * (g - b) / (max - min) + 360) % 360;
       else if (max === g) hue = 60 * (b - r) / (max - min) + 120;
       else hue = 60 * (r - g) / (max - min) + 240;
-      if (hue >= 15 && hue <= 45) n.a++;
-      else if (hue >= 195 && hue <= 225) n.b++;
-      else if (hue >= 300 && hue <= 340) n.seg++;
+      const inside = (w) => hue >= w[0] && hue <= w[1];
+      if (inside(hues.a)) n.a++;
+      else if (inside(hues.b)) n.b++;
+      else if (inside(hues.seg)) n.seg++;
     }
   }
   return n;
@@ -128,7 +139,13 @@ function colourCounts(img, rect) {
 
 // ---------- the test ----------
 async function main() {
-  const url = pathToFileURL(resolve(htmlPath)).href;
+  let page = resolve(htmlPath);
+  if (glbMode) {
+    const viewer = readFileSync(join(dirname(fileURLToPath(import.meta.url)), 'glb_viewer.html'), 'utf8');
+    page = resolve(overviewPng.replace(/\.png$/, '') + '.view.html');
+    writeFileSync(page, viewer.replace('%GLB%', readFileSync(htmlPath).toString('base64')));
+  }
+  const url = pathToFileURL(page).href;
   const requests = [], errors = [];
   const { targetId } = await send('Target.createTarget', { url: 'about:blank' });
   const { sessionId } = await send('Target.attachToTarget', { targetId, flatten: true });
@@ -151,6 +168,7 @@ async function main() {
   for (let i = 0; !loaded; i++) { if (i > 600) fail('no load event'); await sleep(50); }
   let ready;
   for (let i = 0; !(ready = await evaluate('document.body.dataset.ready')); i++) { if (i > 600) fail('page never ready'); await sleep(50); }
+  if (glbMode) return glbChecks(s, evaluate, requests, errors, url);
   if (ready !== 'webgl') fail(`page ready without WebGL (${ready})`);
   const rows = await evaluate('document.querySelectorAll("#clashes tbody tr").length');
   if (wantRows !== null && rows !== wantRows) fail(`${rows} table rows, expected ${wantRows}`);
@@ -182,4 +200,34 @@ async function main() {
   clearTimeout(guard);
   cleanup();
 }
+// The --glb checks, once the viewer page is ready.
+async function glbChecks(s, evaluate, requests, errors, url) {
+  const rect = { x: 0, y: 0, width: 1000, height: 700 };
+  const view = async (camera, bg, file) => {
+    await evaluate(`window.glbView(${JSON.stringify(camera)}, ${JSON.stringify(bg)})`);
+    await evaluate('new Promise((r) => requestAnimationFrame(() => requestAnimationFrame(r)))');
+    const { data } = await s('Page.captureScreenshot', { format: 'png' });
+    const png = Buffer.from(data, 'base64');
+    if (file) writeFileSync(file, png);
+    return colourCounts(decodePng(png), rect, { a: [10, 50], b: [190, 250], seg: [295, 345] });
+  };
+  if (errors.length) fail(`console errors:\n  ${errors.join('\n  ')}`);
+  // All three views first (the screenshots are there to look at when a check fails).
+  const white = await view('camera overview', [1, 1, 1], overviewPng);
+  const dark = await view('camera overview', [0.08, 0.08, 0.1], overviewPng.replace(/\.png$/, '-dark.png'));
+  const clash = await view('camera #1', [1, 1, 1], clashPng);
+  if (white.a < 200 || white.b < 200) fail(`overview on white: A/B tints missing (orange ${white.a}, blue ${white.b} px)`);
+  if (dark.a < 200 || dark.b < 200) fail(`overview on dark: A/B tints missing (orange ${dark.a}, blue ${dark.b} px)`);
+  if (clash.seg < 5) fail(`camera #1: the clash's lines and marker are not in view (${clash.seg} magenta px)`);
+  if (clash.a < 200 || clash.b < 200) fail(`camera #1: A/B tints missing (orange ${clash.a}, blue ${clash.b} px)`);
+  const foreign = requests.filter((u) => u !== url);
+  if (foreign.length) fail(`network requests: ${foreign.join(', ')}`);
+  if (errors.length) fail(`console errors:\n  ${errors.join('\n  ')}`);
+  console.log(`ok ${htmlPath}: overview white orange ${white.a} blue ${white.b} px, dark orange ${dark.a} blue ${dark.b} px; ` +
+    `camera #1 orange ${clash.a} blue ${clash.b} magenta ${clash.seg} px; no requests, no console errors`);
+  await send('Browser.close').catch(() => {});
+  clearTimeout(guard);
+  cleanup();
+}
+
 main().catch((e) => fail(e.stack || String(e)));

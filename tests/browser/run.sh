@@ -50,11 +50,36 @@ check pins-apart 1 -- meshes/pins.glb meshes/pins.glb --translate-b 300,0,0
 if [ -f ../shared/meshes/2CylinderEngine.glb ]; then
   check engine - -- scene ../shared/meshes/2CylinderEngine.glb --penetration
 fi
+# `meshclash self` pages: a strip folded back through itself (tests/glb.rs: 2 crossing and 2
+# touching pairs, inconsistent winding, open), and the robot (self-touching, non-manifold, open).
+printf 'o strip\nv 0 0 0\nv 0 1 0\nv 2 0 0\nv 2 1 0\nv 1 0 1\nv 1 1 1\nv 1 0 -1\nv 1 1 -1\nf 1 3 4\nf 1 4 2\nf 3 5 6\nf 3 6 4\nf 5 6 8\nf 5 8 7\n' >"$out/strip.obj"
+check self-strip 3 -- self "$out/strip.obj"
+check self-rob 3 -- self meshes/fcl_rob.obj --fail-on never
+
+# --export-glb: each GLB drawn through its own cameras by a viewer of our own
+# (tests/browser/glb_viewer.html): both tints on white and on dark, the first clash in view.
+glb() {
+  name=$1; shift 2
+  pages=$((pages + 1))
+  set +e
+  "$MESHCLASH" "$@" -q --no-timings --export-glb "$out/$name.glb" -o "$out/$name-glb.json"
+  code=$?
+  set -e
+  [ "$code" -le 1 ] || { echo "meshclash failed on $name (exit $code)" >&2; exit 1; }
+  node tests/browser/driver.mjs --glb "$out/$name.glb" "$shots/$name-glb-overview.png" "$shots/$name-glb-clash.png"
+}
+glb fcl -- meshes/fcl_env.obj meshes/fcl_rob.obj
+glb pins -- scene meshes/pins.glb
+glb self-strip -- self "$out/strip.obj"
+if [ -f ../shared/meshes/2CylinderEngine.glb ]; then
+  glb engine -- scene ../shared/meshes/2CylinderEngine.glb
+fi
 
 if [ "$update_docs" = 1 ]; then
   mkdir -p docs/img
-  for f in fcl-clash pins-clash engine-clash; do
-    [ -f "$shots/$f.png" ] && cp "$shots/$f.png" "docs/img/html-$f.png"
+  for f in fcl-clash pins-clash engine-clash self-strip-clash self-rob-clash engine-glb-overview-dark engine-glb-clash; do
+    case $f in *-glb-*) dest=docs/img/$f.png ;; *) dest=docs/img/html-$f.png ;; esac
+    [ -f "$shots/$f.png" ] && cp "$shots/$f.png" "$dest"
   done
   echo "screenshots copied to docs/img/"
 fi
