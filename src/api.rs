@@ -325,7 +325,8 @@ fn finish_report(
         assembly: assembly_view,
     };
     let mut rep = report::build(&ctx, &result);
-    let findings = report::baseline::findings(&result.pairs, &a.input.mesh, &b.input.mesh);
+    let listed = &result.pairs[..rep.pairs.len()];
+    let findings = report::baseline::findings(listed, &a.input.mesh, &b.input.mesh);
     report::baseline::assign_ids(&mut rep, &findings);
     if a.array {
         rep.inputs.a.format = ARRAY_FORMAT.into();

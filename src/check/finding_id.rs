@@ -43,6 +43,12 @@ impl Fnv {
 
 /// The stable id of the pair (triangle `ta` of `a`, triangle `tb` of `b`), see the module docs.
 pub fn finding_id(a: &Mesh, ta: u32, b: &Mesh, tb: u32) -> String {
+    format_id(finding_hash(a, ta, b, tb))
+}
+
+/// The 64-bit hash behind [`finding_id`] (the id is its 16 hex digits, so ids order as their
+/// hashes do).
+pub fn finding_hash(a: &Mesh, ta: u32, b: &Mesh, tb: u32) -> u64 {
     fn name(m: &Mesh, t: u32) -> &str {
         m.objects.get(m.tri_object[t as usize] as usize).map_or("", |o| &o.name)
     }
@@ -51,5 +57,10 @@ pub fn finding_id(a: &Mesh, ta: u32, b: &Mesh, tb: u32) -> String {
     h.name(name(a, ta));
     h.triangle(b, tb);
     h.name(name(b, tb));
-    format!("{:016x}", h.finish())
+    h.finish()
+}
+
+/// A finding id as written: 16 lowercase hex digits.
+pub fn format_id(hash: u64) -> String {
+    format!("{hash:016x}")
 }

@@ -76,6 +76,8 @@ pub fn regions(pairs: &[PairFinding], a: &Mesh, b: &Mesh) -> Vec<Region> {
             }
         }
     }
+    let hashes: Vec<u64> =
+        pairs.par_iter().map(|p| crate::check::finding_id::finding_hash(a, p.a, b, p.b)).collect();
     let mut groups: HashMap<u32, Vec<usize>> = HashMap::new();
     for i in 0..n {
         let r = find(&mut parent, i as u32);
@@ -86,7 +88,7 @@ pub fn regions(pairs: &[PairFinding], a: &Mesh, b: &Mesh) -> Vec<Region> {
         .map(|members| {
             let mut bounds = Aabb::EMPTY;
             let mut sum = DVec3::ZERO;
-            let mut id: Option<String> = None;
+            let mut id = u64::MAX;
             let mut crossing = 0;
             for &i in &members {
                 let p = &pairs[i];
@@ -100,14 +102,11 @@ pub fn regions(pairs: &[PairFinding], a: &Mesh, b: &Mesh) -> Vec<Region> {
                 bounds = bounds.grow(lo).grow(hi);
                 sum += lo * 0.5 + hi * 0.5;
                 crossing += (p.kind == PairKind::Crossing) as usize;
-                let fid = crate::check::finding_id::finding_id(a, p.a, b, p.b);
-                if id.as_ref().is_none_or(|m| fid < *m) {
-                    id = Some(fid);
-                }
+                id = id.min(hashes[i]);
             }
             let p0 = &pairs[members[0]];
             Region {
-                id: id.unwrap_or_default(),
+                id: crate::check::finding_id::format_id(id),
                 objects: (a.tri_object[p0.a as usize], b.tri_object[p0.b as usize]),
                 pairs: members.len(),
                 crossing,

@@ -73,7 +73,9 @@ pub fn finish(
     meshes: [&Mesh; 2],
     staged: &mut write::Staged,
 ) -> Result<()> {
-    let findings = baseline::findings(&result.pairs, meshes[0], meshes[1]);
+    // Every pair's id for a baseline comparison; without one, only the listed pairs show theirs.
+    let listed = if opts.baseline.is_some() { result.pairs.len() } else { rep.pairs.len() };
+    let findings = baseline::findings(&result.pairs[..listed], meshes[0], meshes[1]);
     baseline::assign_ids(rep, &findings);
     if let Some(path) = &opts.baseline {
         let base = baseline::read(path)?;

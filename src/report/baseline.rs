@@ -76,7 +76,8 @@ pub use crate::check::finding_id::finding_id;
 
 /// Ids and kinds of every pair found (in the order of `pairs`).
 pub fn findings(pairs: &[PairFinding], a: &Mesh, b: &Mesh) -> Vec<Finding> {
-    pairs.iter().map(|p| Finding { id: finding_id(a, p.a, b, p.b), kind: p.kind }).collect()
+    use rayon::prelude::*;
+    pairs.par_iter().map(|p| Finding { id: finding_id(a, p.a, b, p.b), kind: p.kind }).collect()
 }
 
 /// Set `id` on the listed pairs: `rep.pairs` are the first of the pairs `findings` was made from.
