@@ -29,6 +29,8 @@ pub mod output;
 pub mod report;
 pub mod scene;
 pub mod self_cmd;
+pub mod shard;
+pub mod shard_cli;
 #[cfg(any(test, feature = "testing"))]
 pub mod testing;
 

@@ -10,6 +10,9 @@ use std::io::IsTerminal;
 use std::process::ExitCode;
 
 fn main() -> ExitCode {
+    if let Some(code) = meshclash::shard_cli::dispatch() {
+        return ExitCode::from(code); // `plan`, `run`, `merge` (issue 14)
+    }
     let args = match Args::try_parse() {
         Ok(a) => a,
         Err(e) if e.use_stderr() => {
