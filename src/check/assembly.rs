@@ -290,10 +290,21 @@ pub enum Pairing {
     AllVsAll,
 }
 
-/// Check parts `sel_a` against `sel_b` (indices into `parts`) of `meshes[input]`; of the
-/// candidate part pairs, only those `keep` accepts (all but a shard's are dropped before any
-/// tree is built: [`PartsHook`]).
+/// Check parts `sel_a` against `sel_b` (indices into `parts`) of `meshes[input]`.
 pub fn check_parts(
+    meshes: [&Mesh; 2],
+    parts: Vec<Part>,
+    sel_a: &[usize],
+    sel_b: &[usize],
+    pairing: Pairing,
+    settings: &Settings,
+) -> AssemblyResult {
+    check_parts_kept(meshes, parts, sel_a, sel_b, pairing, settings, &|_, _| true)
+}
+
+/// [`check_parts`], of the candidate part pairs only those `keep` accepts: the others are
+/// dropped before any tree is built (a shard's pairs: [`PartsHook`]).
+pub fn check_parts_kept(
     meshes: [&Mesh; 2],
     parts: Vec<Part>,
     sel_a: &[usize],
@@ -784,7 +795,7 @@ fn run_checked(a: &Mesh, b: &Mesh, sel: &Selection, settings: &Settings) -> Resu
     }
     let pairing = if sel.scene && sel.select_b.is_empty() { Pairing::AllVsAll } else { Pairing::Cross };
     let keep = |x, y| sel.hook.as_ref().is_none_or(|h| h.0.keep(x, y));
-    let ar = check_parts([a, if sel.scene { a } else { b }], parts, &sa, &sb, pairing, settings, &keep);
+    let ar = check_parts_kept([a, if sel.scene { a } else { b }], parts, &sa, &sb, pairing, settings, &keep);
     let mut pairs_seen = std::collections::HashSet::new();
     let mut merged: Vec<PairFinding> = Vec::new();
     let mut part_pairs = Vec::new();
