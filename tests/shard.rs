@@ -458,3 +458,32 @@ fn plan_lists_stable_ids_costs_and_refuses_what_cannot_be_sharded() {
     refused(p, &["plan", "scene", "missing.glb", "-o", "x.json"], &["missing.glb"]);
     refused(p, &["run", "--plan", "fcl_env.obj", "--shard", "1/1", "-o", "x.json"], &["fcl_env.obj"]);
 }
+
+#[test]
+fn deploy_local_sh_runs_plan_shards_and_merge() {
+    let d = workdir(&["shared.STL"]);
+    let p = d.path();
+    let script = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("deploy/local.sh");
+    let o = Command::new("bash")
+        .arg(&script)
+        .args([
+            "3",
+            "out",
+            "--",
+            "scene",
+            "shared.STL",
+            "--split-bodies",
+            "--no-timings",
+            "--junit",
+            "out/r.xml",
+        ])
+        .env("MESHCLASH", env!("CARGO_BIN_EXE_meshclash"))
+        .current_dir(p)
+        .output()
+        .unwrap();
+    let (report, junit, code) = single(p, &["scene", "shared.STL", "--split-bodies"]);
+    assert_eq!(o.status.code(), Some(code), "{}", stderr(&o));
+    assert!(std::fs::read(p.join("out/report.json")).unwrap() == report);
+    assert!(std::fs::read(p.join("out/r.xml")).unwrap() == junit);
+    assert!((1..=3).all(|i| p.join(format!("out/shard-{i}.json")).is_file()));
+}
