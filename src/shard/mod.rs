@@ -213,6 +213,9 @@ pub fn needed_parts(
     s.into_iter().collect()
 }
 
+/// What a shard's check leaves: its outcome and the sizes of the trees it owns (part, bytes).
+pub type Captured = (WireOutcome, Vec<(usize, u64)>);
+
 /// A shard: checks its pairs only, captures the outcome and measures the trees it owns.
 #[derive(Debug)]
 pub struct ShardHook {
@@ -229,7 +232,7 @@ pub struct ShardHook {
     /// Tree options of the check.
     pub bvh: crate::bvh::BuildOptions,
     /// The outcome and the tree sizes, once seen.
-    pub captured: Mutex<Option<(WireOutcome, Vec<(usize, u64)>)>>,
+    pub captured: Mutex<Option<Captured>>,
 }
 
 impl PartsHook for ShardHook {
@@ -357,3 +360,6 @@ impl MergeHook {
         Ok(out)
     }
 }
+
+#[cfg(test)]
+mod tests;
