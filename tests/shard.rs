@@ -247,7 +247,7 @@ fn federation(dir: &Path, k: usize) {
         serde_json::json!([{ "nodes": (0..k as u64).map(|c| k as u64 * n + c).collect::<Vec<_>>() }]);
     j["scene"] = 0.into();
     let mut js = serde_json::to_vec(&j).unwrap();
-    while js.len() % 4 != 0 {
+    while !js.len().is_multiple_of(4) {
         js.push(b' ');
     }
     let mut out = Vec::new();
