@@ -441,8 +441,17 @@ pub fn validate(
     reports: Vec<ShardReport>,
     allow_partial: bool,
 ) -> Result<(Vec<ShardReport>, bool)> {
-    let first = &reports[0];
-    let (hash, n) = (first.plan_hash.clone(), first.shards);
+    // The plan most reports belong to (the first one's on a tie) decides which are foreign.
+    let mut votes: BTreeMap<&str, (usize, usize)> = BTreeMap::new();
+    for (k, r) in reports.iter().enumerate() {
+        votes.entry(r.plan_hash.as_str()).or_insert((0, k)).0 += 1;
+    }
+    let (_, &(_, k0)) = votes
+        .iter()
+        .max_by_key(|(_, &(count, first))| (count, std::cmp::Reverse(first)))
+        .expect("one report at least");
+    let reference = &files[k0];
+    let (hash, n) = (reports[k0].plan_hash.clone(), reports[k0].shards);
     let mut by_index: BTreeMap<usize, (usize, ShardReport)> = BTreeMap::new();
     for (k, r) in reports.into_iter().enumerate() {
         let f = &files[k];
@@ -452,7 +461,7 @@ pub fn validate(
                 format!(
                     "foreign shard: it belongs to another plan (plan sha256 {}…, {} has {}…)",
                     &r.plan_hash[..12.min(r.plan_hash.len())],
-                    files[0].display(),
+                    reference.display(),
                     &hash[..12.min(hash.len())]
                 ),
             ));
@@ -461,10 +470,10 @@ pub fn validate(
             return Err(Error::input(
                 f,
                 format!(
-                    "shard {}/{} of a {n}-shard run ({} is 1 of {n})",
+                    "shard {}/{} of a {n}-shard run ({} is one of {n})",
                     r.shard,
                     r.shards,
-                    files[0].display()
+                    reference.display()
                 ),
             ));
         }

@@ -94,22 +94,13 @@ pub fn empty_outcome(parts: &[Part], selected: [usize; 2], mode: &'static str) -
     }
 }
 
-/// A part's facts the plan needs.
-#[derive(Debug, Clone)]
-pub struct PlanPart {
-    /// `a:`/`b:` and the path.
-    pub name: String,
-    /// The part itself without its triangle list (only the count is kept).
-    pub part: Part,
-}
-
 /// Planning: records the parts and every candidate pair, checks none (no tree is built). In
 /// files mode it stands in an empty outcome, so nothing is checked either.
 #[derive(Debug, Default)]
 pub struct PlanHook {
     /// Files mode (`--select`-less two-file check).
     pub files: bool,
-    /// The parts (triangle lists replaced by their length in `triangles.len()` terms: kept).
+    /// The parts, as the check made them.
     pub parts: Mutex<Vec<Part>>,
     /// Every candidate, sorted.
     pub candidates: Mutex<Vec<(usize, usize)>>,
