@@ -207,8 +207,11 @@ fn verify_inputs(plan: &Plan, cfg: &Config) -> Result<()> {
     Ok(())
 }
 
-fn write_json<T: serde::Serialize>(path: &Path, v: &T) -> Result<()> {
-    let mut text = serde_json::to_string_pretty(v).map_err(|e| usage(format!("cannot serialise: {e}")))?;
+/// Write `v` as JSON: indented for people (the plan), compact for machines (shard reports,
+/// which hold every triangle pair).
+fn write_json<T: serde::Serialize>(path: &Path, v: &T, pretty: bool) -> Result<()> {
+    let text = if pretty { serde_json::to_string_pretty(v) } else { serde_json::to_string(v) };
+    let mut text = text.map_err(|e| usage(format!("cannot serialise: {e}")))?;
     text.push('\n');
     let mut staged = Staged::new();
     staged.stage(path, text.as_bytes())?;
@@ -235,7 +238,7 @@ fn plan_cmd(a: PlanArgs) -> Result<u8> {
     warn(quiet, &rep.warnings);
     let margin = rep.settings.touch_tolerance + rep.settings.clearance;
     let plan = hook.plan(stored, inputs, margin);
-    write_json(&out, &plan)?;
+    write_json(&out, &plan, true)?;
     if !quiet {
         eprintln!(
             "meshclash: plan: {} work pairs of {} candidate part pairs, {} parts, cost {}",
@@ -354,7 +357,7 @@ fn run_cmd(a: RunArgs) -> Result<u8> {
                 outcome: None,
                 trees: Vec::new(),
             };
-            let _ = write_json(&a.output, &failed);
+            let _ = write_json(&a.output, &failed, true);
             Err(e)
         }
     }
@@ -413,7 +416,7 @@ fn run_shard(a: &RunArgs, plan: &Plan, plan_hash: &str, i: usize, n: usize) -> R
         outcome: Some(outcome),
         trees,
     };
-    write_json(&a.output, &report)?;
+    write_json(&a.output, &report, false)?;
     if !a.quiet {
         eprintln!("meshclash: shard {i}/{n}: {} of {} pairs", mine.len(), plan.work_pairs);
     }
