@@ -28,6 +28,7 @@ pub mod narrow;
 pub mod output;
 pub mod report;
 pub mod scene;
+pub mod shard;
 #[cfg(any(test, feature = "testing"))]
 pub mod testing;
 

@@ -14,6 +14,9 @@ use std::io::IsTerminal;
 use std::process::ExitCode;
 
 fn main() -> ExitCode {
+    if let Some(code) = app::shard::dispatch() {
+        return ExitCode::from(code); // `plan`, `run`, `merge` (issue 14)
+    }
     // Help wraps to the terminal's width, or to 100 columns when stdout is not a terminal.
     let width = (!std::io::stdout().is_terminal()).then_some(100);
     let args = match cli::parse(width) {

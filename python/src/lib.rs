@@ -190,7 +190,7 @@ fn options(
         distance_error: DistanceError { rel: distance_rel_err, abs: distance_abs_err },
         deterministic: !timings,
         penetration,
-        selection: Selection { scene: false, select_a, select_b, exclude },
+        selection: Selection { scene: false, select_a, select_b, exclude, hook: None },
         split_bodies,
         threads,
     };

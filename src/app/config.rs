@@ -311,6 +311,7 @@ impl CheckArgs {
                 select_a: self.select_a.clone(),
                 select_b: self.select_b.clone(),
                 exclude: self.exclude.clone(),
+                hook: None,
             },
             outputs: self.outputs.into_options(self.fail_on == FailOnArg::New)?,
             units,

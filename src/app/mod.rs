@@ -13,3 +13,4 @@ pub mod man;
 pub mod progress;
 pub mod run;
 pub mod self_cmd;
+pub mod shard;

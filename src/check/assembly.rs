@@ -305,6 +305,20 @@ pub fn check_parts(
     pairing: Pairing,
     settings: &Settings,
 ) -> AssemblyResult {
+    check_parts_kept(meshes, parts, sel_a, sel_b, pairing, settings, &|_, _| true)
+}
+
+/// [`check_parts`], of the candidate part pairs only those `keep` accepts: the others are
+/// dropped before any tree is built (a shard's pairs: [`PartsHook`]).
+pub fn check_parts_kept(
+    meshes: [&Mesh; 2],
+    parts: Vec<Part>,
+    sel_a: &[usize],
+    sel_b: &[usize],
+    pairing: Pairing,
+    settings: &Settings,
+    keep: &(dyn Fn(usize, usize) -> bool + Sync),
+) -> AssemblyResult {
     let t0 = Instant::now();
     let tol = settings.tolerances;
     // Broad phase: a tree over the selected parts' boxes on each side, walked together.
@@ -333,6 +347,7 @@ pub fn check_parts(
     );
     candidates.sort_unstable();
     candidates.dedup();
+    candidates.retain(|&(a, b)| keep(a, b));
     // Lazy trees: only parts in some candidate pair.
     let mut built = vec![false; parts.len()];
     for &(a, b) in &candidates {
@@ -672,7 +687,38 @@ pub struct Selection {
     pub select_b: Vec<String>,
     /// Globs removing parts from both sides.
     pub exclude: Vec<String>,
+    /// Sharding (issue 14, `crate::shard`): restrict or stand in for the part-pair check.
+    pub hook: Option<Hook>,
 }
+
+/// The sharding hook of [`run`] (issue 14): a shard checks only its candidate part pairs, and
+/// a merge stands in the shards' combined outcome for the check; everything around [`run`]
+/// (loading, report, regions, baseline, JUnit) stays the single-machine code path.
+pub trait PartsHook: Send + Sync + std::fmt::Debug {
+    /// Check candidate part pair (`a`, `b`) (indices into the parts)? Parts mode only.
+    fn keep(&self, a: usize, b: usize) -> bool;
+    /// An outcome to return instead of checking anything (called once the parts and the
+    /// selection sizes are known, in both modes).
+    fn stand_in(
+        &self,
+        meshes: [&Mesh; 2],
+        parts: &[Part],
+        selected: [usize; 2],
+    ) -> Option<Result<Outcome, String>>;
+    /// Sees the outcome [`run`] returns.
+    fn seen(&self, meshes: [&Mesh; 2], outcome: &Outcome);
+}
+
+/// A shared [`PartsHook`] (equal when it is the same hook).
+#[derive(Debug, Clone)]
+pub struct Hook(pub std::sync::Arc<dyn PartsHook>);
+
+impl PartialEq for Hook {
+    fn eq(&self, o: &Hook) -> bool {
+        std::sync::Arc::ptr_eq(&self.0, &o.0)
+    }
+}
+impl Eq for Hook {}
 
 impl Selection {
     /// True when parts must be checked pair by pair (scene mode or a selection).
@@ -746,6 +792,14 @@ fn select(parts: &[Part], input: u8, globs: &[String], exclude: &[String]) -> Ve
 /// Check `a` against `b` (in scene mode, `a` against itself) part by part or as whole files.
 /// Errors (a selection that matches nothing) are one line.
 pub fn run(a: &Mesh, b: &Mesh, sel: &Selection, settings: &Settings) -> Result<Outcome, String> {
+    let o = run_checked(a, b, sel, settings)?;
+    if let Some(h) = &sel.hook {
+        h.0.seen([a, if sel.scene { a } else { b }], &o);
+    }
+    Ok(o)
+}
+
+fn run_checked(a: &Mesh, b: &Mesh, sel: &Selection, settings: &Settings) -> Result<Outcome, String> {
     let mut parts = parts_of(a, 0);
     if !sel.scene {
         parts.extend(parts_of(b, 1));
@@ -762,6 +816,10 @@ pub fn run(a: &Mesh, b: &Mesh, sel: &Selection, settings: &Settings) -> Result<O
             });
         }
     }
+    let meshes = [a, if sel.scene { a } else { b }];
+    if let Some(o) = sel.hook.as_ref().and_then(|h| h.0.stand_in(meshes, &parts, [sa.len(), sb.len()])) {
+        return o;
+    }
     if !sel.by_parts() {
         let result = crate::check::query::check(a, b, settings);
         let part_pairs = group_by_part(&parts, a, b, &result);
@@ -776,7 +834,8 @@ pub fn run(a: &Mesh, b: &Mesh, sel: &Selection, settings: &Settings) -> Result<O
         return Ok(Outcome { result, parts, part_pairs, info });
     }
     let pairing = if sel.scene && sel.select_b.is_empty() { Pairing::AllVsAll } else { Pairing::Cross };
-    let ar = check_parts([a, if sel.scene { a } else { b }], parts, &sa, &sb, pairing, settings);
+    let keep = |x, y| sel.hook.as_ref().is_none_or(|h| h.0.keep(x, y));
+    let ar = check_parts_kept([a, if sel.scene { a } else { b }], parts, &sa, &sb, pairing, settings, &keep);
     let mut pairs_seen = std::collections::HashSet::new();
     let mut merged: Vec<PairFinding> = Vec::new();
     let mut part_pairs = Vec::new();

@@ -113,6 +113,10 @@ pub fn parse(path: &str, bytes: &[u8]) -> std::result::Result<Baseline, String> 
         Some(_) => return Err("baseline is not a meshclash report: its \"schema\" is not a string".into()),
         None => return Err("baseline is not a meshclash report: it has no \"schema\"".into()),
     }
+    if v.get("complete") == Some(&serde_json::Value::Bool(false)) {
+        // `meshclash merge --allow-partial` (issue 14): pairs not re-checked must not read as resolved.
+        return Err("baseline is a partial merge (\"complete\": false): merge every shard first".into());
+    }
     let pairs = v.get("pairs").and_then(|p| p.as_array()).ok_or("baseline has no pairs list")?;
     let mut ids = HashMap::new();
     for (i, p) in pairs.iter().enumerate() {

@@ -1,0 +1,192 @@
+//! The tree-sharing facts of an assembly report (`sah_builds`, `shared_trees`,
+//! `memory_saved_bytes`) for the whole plan, which no single shard sees: which needed part
+//! leads which glTF mesh, which instance maps its leader's tree and which refits a copy, and the
+//! memory a copy per part would have taken.
+//!
+//! **Mirrors the private accounting of [`crate::check::assembly::check_parts`]** (grouping by
+//! `(input, glTF mesh)` in part order, the shift test, the box map fit, the byte counts): the
+//! byte-identity tests of `tests/shard.rs` fail when the two drift apart. Only the size of each
+//! own tree needs the tree; a shard builds the trees of the own-tree parts it is the owner of
+//! (see [`owned_tree_bytes`]) and the merge adds them up.
+
+use crate::bvh::{BuildOptions, Bvh, Node};
+use crate::check::assembly::{Part, Sharing};
+use crate::geom::predicates::BoxMap;
+use crate::geom::{Aabb, DVec3};
+use crate::scene::mesh::{Mesh, Object};
+use std::collections::{BTreeMap, HashMap};
+
+/// How each needed part gets its tree: its own (`leader == part`) or its leader's.
+#[derive(Debug, Clone)]
+pub struct Grouping {
+    /// Own-tree parts, in the order the check builds them (a layout each).
+    pub own: Vec<usize>,
+    /// Per needed part: (index into `own`, vertex shift, leader part).
+    plan: BTreeMap<usize, (usize, i64, usize)>,
+}
+
+fn shift_of(mesh: &Mesh, leader: &Part, inst: &Part) -> Option<i64> {
+    if leader.triangles.len() != inst.triangles.len() || leader.triangles.is_empty() {
+        return None;
+    }
+    let first = |p: &Part| mesh.triangles[p.triangles[0] as usize][0] as i64;
+    let shift = first(inst) - first(leader);
+    let same = leader.triangles.iter().zip(&inst.triangles).all(|(&l, &i)| {
+        let (l, i) = (mesh.triangles[l as usize], mesh.triangles[i as usize]);
+        (0..3).all(|k| i[k] as i64 == l[k] as i64 + shift)
+    });
+    same.then_some(shift)
+}
+
+fn relative_rows(leader: &Object, inst: &Object) -> Option<[[f64; 4]; 3]> {
+    let (l, i) = (leader.world?, inst.world?);
+    let det = l.determinant();
+    if det == 0.0 || !det.is_finite() {
+        return None;
+    }
+    let r = i * l.inverse();
+    Some([0, 1, 2].map(|k| [r.x_axis[k], r.y_axis[k], r.z_axis[k], r.w_axis[k]]))
+}
+
+/// Group the `needed` parts (ascending) as the check does.
+pub fn group(meshes: [&Mesh; 2], parts: &[Part], needed: &[usize]) -> Grouping {
+    let mut leader_of_mesh: HashMap<(u8, u32), usize> = HashMap::new();
+    let mut own = Vec::new();
+    let mut plan: BTreeMap<usize, (usize, i64, usize)> = BTreeMap::new();
+    for &i in needed {
+        let mesh = meshes[parts[i].input as usize];
+        let shared = parts[i].gltf_mesh.and_then(|m| {
+            let l = *leader_of_mesh.entry((parts[i].input, m)).or_insert(i);
+            let shift = if l == i { None } else { shift_of(mesh, &parts[l], &parts[i]) }?;
+            let (layout, _, _) = *plan.get(&l)?;
+            Some((layout, shift, l))
+        });
+        let p = shared.unwrap_or_else(|| {
+            own.push(i);
+            (own.len() - 1, 0, i)
+        });
+        plan.insert(i, p);
+    }
+    Grouping { own, plan }
+}
+
+/// Bytes of a tree as the check counts them.
+pub fn tree_bytes(t: &Bvh) -> usize {
+    t.nodes.len() * std::mem::size_of::<Node>() + t.prims.len() * 4
+}
+
+/// The tree the check builds for own-tree part `part` (over its triangles' world boxes).
+pub fn build_tree(mesh: &Mesh, part: &Part, opts: BuildOptions) -> Bvh {
+    let boxes: Vec<Aabb> =
+        part.triangles.iter().map(|&t| Aabb::of_triangle(&crate::bvh::triangle(mesh, t))).collect();
+    Bvh::build_from_boxes(&boxes, opts)
+}
+
+/// Tree sizes of the own-tree parts in `owned` (built here, in parallel).
+pub fn owned_tree_bytes(
+    meshes: [&Mesh; 2],
+    parts: &[Part],
+    owned: &[usize],
+    opts: BuildOptions,
+) -> Vec<(usize, u64)> {
+    use rayon::prelude::*;
+    owned
+        .par_iter()
+        .map(|&i| (i, tree_bytes(&build_tree(meshes[parts[i].input as usize], &parts[i], opts)) as u64))
+        .collect()
+}
+
+/// The layout of one own-tree part: (part-local vertices, bytes kept, vertex map or a run start).
+struct Layout {
+    tris: usize,
+    vertices: usize,
+    bytes: usize,
+    vmap: Vec<u32>,
+    run: Option<u32>,
+}
+
+impl Layout {
+    fn of(mesh: &Mesh, part: &Part) -> Layout {
+        let (tris, vmap) = mesh.reindex(&part.triangles);
+        let run = vmap.first().copied().filter(|&s| vmap.iter().zip(s..).all(|(&v, w)| v == w));
+        let kept_map = if run.is_some() { 0 } else { vmap.len() };
+        Layout { tris: tris.len(), vertices: vmap.len(), bytes: tris.len() * 12 + kept_map * 4, vmap, run }
+    }
+
+    fn vertex(&self, world: &[DVec3], v: u32, shift: i64) -> DVec3 {
+        let at = match self.run {
+            Some(s) => s as i64 + v as i64,
+            None => self.vmap[v as usize] as i64,
+        };
+        world[(at + shift) as usize]
+    }
+}
+
+/// `sah_builds` and the [`Sharing`] of a check whose needed parts are `needed`, given the size
+/// of every own tree (`tree_bytes[part]`). `None` names a missing tree size.
+pub fn sharing(
+    meshes: [&Mesh; 2],
+    parts: &[Part],
+    needed: &[usize],
+    tree_bytes: &HashMap<usize, u64>,
+) -> Result<(usize, Sharing), usize> {
+    use rayon::prelude::*;
+    let g = group(meshes, parts, needed);
+    let mesh_of = |i: usize| meshes[parts[i].input as usize];
+    let tb = |layout: usize| tree_bytes.get(&g.own[layout]).map(|&b| b as usize).ok_or(g.own[layout]);
+    let layouts: Vec<Layout> = g.own.par_iter().map(|&i| Layout::of(mesh_of(i), &parts[i])).collect();
+    // Instances: a box map when one fits, else a refitted copy (same size as the leader's tree).
+    let instances: Vec<(usize, usize, i64, usize)> = g
+        .plan
+        .iter()
+        .filter(|(&i, &(_, _, l))| l != i)
+        .map(|(&i, &(layout, shift, l))| (i, layout, shift, l))
+        .collect();
+    let mapped: Vec<(usize, bool)> = instances
+        .par_iter()
+        .map(|&(i, layout, shift, l)| {
+            let objects = &mesh_of(i).objects;
+            let lay = &layouts[layout];
+            let world = &mesh_of(i).positions;
+            let rows = relative_rows(&objects[parts[l].object as usize], &objects[parts[i].object as usize]);
+            let fits = rows.is_some_and(|r| {
+                let pairs =
+                    (0..lay.vertices as u32).map(|v| (lay.vertex(world, v, 0), lay.vertex(world, v, shift)));
+                BoxMap::fit(r, &parts[l].bounds, pairs).is_some()
+            });
+            (layout, fits)
+        })
+        .collect();
+    let mut users = vec![0usize; g.own.len()];
+    let mut refit_bytes = 0usize;
+    let mut maps = 0usize;
+    for &(layout, fits) in &mapped {
+        if fits {
+            users[layout] += 1;
+            maps += 1;
+        } else {
+            refit_bytes += tb(layout)?;
+        }
+    }
+    let mut copied = 0usize;
+    for &(layout, _, _) in g.plan.values() {
+        let l = &layouts[layout];
+        copied += l.vertices * 24 + l.tris * 16 + tb(layout)?;
+    }
+    let mut own_bytes = 0usize;
+    for layout in 0..g.own.len() {
+        own_bytes += tb(layout)?;
+    }
+    let kept = layouts.iter().map(|l| l.bytes).sum::<usize>()
+        + own_bytes
+        + refit_bytes
+        + maps * std::mem::size_of::<BoxMap>();
+    Ok((
+        g.own.len(),
+        Sharing {
+            shared_trees: users.iter().filter(|&&u| u > 0).count(),
+            mapped_instances: users.iter().sum(),
+            memory_saved_bytes: copied.saturating_sub(kept),
+        },
+    ))
+}
