@@ -286,6 +286,26 @@ where
 /// `(a, b)`. `merged` gives each vertex of `mesh` its exact-position id
 /// ([`crate::scene::bodies::merge_vertices`]).
 pub fn self_pairs(mesh: &Mesh, merged: &[u32], tris: &[u32], opts: BuildOptions) -> Vec<SelfPair> {
+    self_pairs_timed(mesh, merged, tris, opts).0
+}
+
+/// Milliseconds spent by one [`self_pairs_timed`] call, by phase.
+#[derive(Debug, Clone, Copy, Default, PartialEq)]
+pub struct SelfTimes {
+    /// Triangle boxes and the tree.
+    pub tree_ms: f64,
+    /// The walk with every pair test, and the final sort.
+    pub walk_ms: f64,
+}
+
+/// [`self_pairs`], with the time of each phase.
+pub fn self_pairs_timed(
+    mesh: &Mesh,
+    merged: &[u32],
+    tris: &[u32],
+    opts: BuildOptions,
+) -> (Vec<SelfPair>, SelfTimes) {
+    let t0 = std::time::Instant::now();
     let boxes: Vec<Aabb> =
         tris.par_iter().map(|&t| Aabb::of_triangle(&crate::bvh::triangle(mesh, t))).collect();
     let tree = Bvh::build_from_boxes(&boxes, opts);
@@ -301,6 +321,8 @@ pub fn self_pairs(mesh: &Mesh, merged: &[u32], tris: &[u32], opts: BuildOptions)
             (Aabb::of_triangle(&crate::bvh::triangle(mesh, t)), v.map(|i| merged[i as usize]), t)
         })
         .collect();
+    let tree_ms = t0.elapsed().as_secs_f64() * 1e3;
+    let t1 = std::time::Instant::now();
     let test = |x: &(Aabb, [u32; 3], u32), y: &(Aabb, [u32; 3], u32), out: &mut Vec<SelfPair>| {
         if !x.0.overlaps(&y.0) {
             return;
@@ -331,7 +353,7 @@ pub fn self_pairs(mesh: &Mesh, merged: &[u32], tris: &[u32], opts: BuildOptions)
         },
     );
     pairs.par_sort_unstable_by_key(|p| (p.a, p.b));
-    pairs
+    (pairs, SelfTimes { tree_ms, walk_ms: t1.elapsed().as_secs_f64() * 1e3 })
 }
 
 /// The same answer as [`self_pairs`] by testing every pair (quadratic; for tests).
@@ -349,6 +371,78 @@ pub fn self_pairs_brute_force(mesh: &Mesh, merged: &[u32], tris: &[u32]) -> Vec<
         }
     }
     out
+}
+
+/// The result for one part.
+#[derive(Debug, Clone, PartialEq)]
+pub struct PartResult {
+    /// Object index in the (possibly split) mesh; None for `--whole-file`.
+    pub object: Option<u32>,
+    /// Its name.
+    pub name: String,
+    /// Its triangles (indices into the mesh).
+    pub triangles: usize,
+    /// Its self-clashing pairs, sorted by (a, b).
+    pub pairs: Vec<SelfPair>,
+    /// How many of them cross.
+    pub crossing: u64,
+    /// Its health.
+    pub health: crate::check::health::Health,
+}
+
+/// Which parts [`check_parts`] checks.
+pub enum PartChoice<'a> {
+    /// Every object (object order) whose name passes the filter.
+    Objects(&'a dyn Fn(&str) -> bool),
+    /// All triangles as one part with this name.
+    Whole(&'a str),
+}
+
+/// Self-clash and health of the chosen parts of `mesh`, with the milliseconds spent on health
+/// (with the vertex merge) and on the self-clash walks (the two run at the same time, so their
+/// times overlap).
+pub fn check_parts(
+    mesh: &crate::scene::mesh::Mesh,
+    choice: PartChoice,
+    opts: BuildOptions,
+    first_n: usize,
+) -> (Vec<PartResult>, f64, f64) {
+    let t = std::time::Instant::now();
+    let (merged, _) = crate::scene::bodies::merge_vertices(&mesh.positions);
+    let parts: Vec<(Option<u32>, String, Vec<u32>)> = match choice {
+        PartChoice::Objects(keep) => crate::check::assembly::parts_of(mesh, 0)
+            .into_iter()
+            .filter(|p| keep(&p.name))
+            .map(|p| (Some(p.object), p.name, p.triangles))
+            .collect(),
+        PartChoice::Whole(name) => vec![(None, name.to_string(), (0..mesh.triangles.len() as u32).collect())],
+    };
+    let merge_ms = t.elapsed().as_secs_f64() * 1e3;
+    // Health and the self-clash walks run side by side: parts of the health pass are
+    // sequential (union-find), and the walk fills the other cores meanwhile.
+    let ms = |t: std::time::Instant| t.elapsed().as_secs_f64() * 1e3;
+    let ((healths, health_ms), (found, query_ms)) = rayon::join(
+        || {
+            let t = std::time::Instant::now();
+            let h: Vec<crate::check::health::Health> =
+                parts.iter().map(|p| crate::check::health::health(mesh, &merged, &p.2, first_n)).collect();
+            (h, ms(t))
+        },
+        || {
+            let t = std::time::Instant::now();
+            let f: Vec<Vec<SelfPair>> = parts.iter().map(|p| self_pairs(mesh, &merged, &p.2, opts)).collect();
+            (f, ms(t))
+        },
+    );
+    let results = parts
+        .into_iter()
+        .zip(healths.into_iter().zip(found))
+        .map(|((object, name, tris), (health, pairs))| {
+            let crossing = pairs.iter().filter(|q| q.hit.crossing).count() as u64;
+            PartResult { object, name, triangles: tris.len(), pairs, crossing, health }
+        })
+        .collect();
+    (results, merge_ms + health_ms, query_ms)
 }
 
 #[cfg(test)]

@@ -43,9 +43,62 @@
 
 use crate::check::health::{Finding, Health};
 use crate::check::query::Input;
+use crate::check::self_clash::PartResult;
 use crate::report::{ObjectReport, PairReport, ReportContact, ReportPairKind, ReportVerdict, Tool};
-use crate::self_cmd::{PartResult, SelfFailOn};
 use serde::{Deserialize, Serialize};
+
+/// `--fail-on` values of `self`.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord, clap::ValueEnum)]
+pub enum SelfFailOn {
+    /// Crossing self-clash pairs (the default).
+    #[value(name = "self-clash", alias = "clash")]
+    SelfClash,
+    /// Any self-clash pair, crossing or touching.
+    Touching,
+    /// A part that is not closed.
+    Open,
+    /// Non-manifold edges or vertices.
+    NonManifold,
+    /// Duplicate faces.
+    Duplicates,
+    /// Zero-area triangles.
+    Degenerate,
+    /// Edges used twice in the same direction.
+    Winding,
+    /// Never fail on findings.
+    Never,
+}
+
+impl SelfFailOn {
+    /// Name on the command line and in the report.
+    pub fn name(self) -> &'static str {
+        match self {
+            SelfFailOn::SelfClash => "self-clash",
+            SelfFailOn::Touching => "touching",
+            SelfFailOn::Open => "open",
+            SelfFailOn::NonManifold => "non-manifold",
+            SelfFailOn::Duplicates => "duplicates",
+            SelfFailOn::Degenerate => "degenerate",
+            SelfFailOn::Winding => "winding",
+            SelfFailOn::Never => "never",
+        }
+    }
+
+    /// Does this part's result meet the condition?
+    pub fn hit(self, part: &PartResult) -> bool {
+        let h = &part.health;
+        match self {
+            SelfFailOn::SelfClash => part.crossing > 0,
+            SelfFailOn::Touching => !part.pairs.is_empty(),
+            SelfFailOn::Open => !h.closed,
+            SelfFailOn::NonManifold => h.non_manifold_edges.count + h.non_manifold_vertices.count > 0,
+            SelfFailOn::Duplicates => h.duplicate_faces.count > 0,
+            SelfFailOn::Degenerate => h.zero_area_triangles.count > 0,
+            SelfFailOn::Winding => h.inconsistent_winding_edges.count > 0,
+            SelfFailOn::Never => false,
+        }
+    }
+}
 
 /// The schema identifier of a self report.
 pub const SELF_SCHEMA: &str = "meshclash.self/1";
