@@ -74,6 +74,44 @@ pub struct Health {
     pub volume: Option<f64>,
 }
 
+/// An edge of a proper triangle: (key `lo << 32 | hi`, local triangle, edge number `c` (from
+/// corner `c` to corner `c + 1`), whether corner `c` is the low end); zero-area triangles leave
+/// sentinel entries with key `u64::MAX`.
+type Edge = (u64, u32, u8, bool);
+
+/// The edges without the sentinels, sorted. When the low ends are dense (at most 4 ids per
+/// edge, as in any part that is most of its mesh), a counting sort on the low end (one pass to
+/// count, one to scatter) and an insertion sort of each low end's few entries; otherwise a
+/// comparison sort. Both give the same total order.
+fn sort_edges(mut edges: Vec<Edge>) -> Vec<Edge> {
+    let real = edges.par_iter().filter(|e| e.0 != u64::MAX).count();
+    let lo = |e: &Edge| (e.0 >> 32) as usize;
+    let max_lo = edges.par_iter().filter(|e| e.0 != u64::MAX).map(lo).max().unwrap_or(0);
+    if real == 0 || max_lo / 4 > real {
+        edges.par_sort_unstable();
+        edges.truncate(real);
+        return edges;
+    }
+    let mut start = vec![0u32; max_lo + 2];
+    for e in edges.iter().filter(|e| e.0 != u64::MAX) {
+        start[lo(e) + 1] += 1;
+    }
+    for i in 1..start.len() {
+        start[i] += start[i - 1];
+    }
+    let mut next = start.clone();
+    let mut out: Vec<Edge> = vec![(u64::MAX, 0, 0, false); real];
+    for e in edges.into_iter().filter(|e| e.0 != u64::MAX) {
+        let at = &mut next[lo(&e)];
+        out[*at as usize] = e;
+        *at += 1;
+    }
+    drop((next, start));
+    // Each low end's run (a handful of entries) in full tuple order.
+    out.par_chunk_by_mut(|x, y| x.0 >> 32 == y.0 >> 32).for_each(|run| run.sort_unstable());
+    out
+}
+
 /// How many triangles go into one chunk of the volume sum (fixed, for determinism).
 const VOLUME_CHUNK: usize = 4096;
 
@@ -109,7 +147,6 @@ pub fn health(mesh: &Mesh, merged: &[u32], tris: &[u32], first_n: usize) -> Heal
     // c to corner c + 1), whether corner c is the low end), 16 bytes. Zero-area triangles get
     // sentinel keys (above every real key: lo < hi <= u32::MAX), cut off after the sort;
     // filling a preallocated array keeps the collection indexed and parallel.
-    type Edge = (u64, u32, u8, bool);
     let mut edges: Vec<Edge> = vec![(u64::MAX, 0, 0, false); 3 * tris.len()];
     edges.par_chunks_mut(3).enumerate().filter(|(k, _)| proper[*k]).for_each(|(k, out)| {
         let v = ids(k);
@@ -118,8 +155,7 @@ pub fn health(mesh: &Mesh, merged: &[u32], tris: &[u32], first_n: usize) -> Heal
             *e = ((a.min(b) as u64) << 32 | a.max(b) as u64, k as u32, c as u8, a < b);
         }
     });
-    edges.par_sort_unstable();
-    edges.truncate(edges.partition_point(|e| e.0 != u64::MAX));
+    let edges = sort_edges(edges);
     let forward = |e: &Edge| e.3;
     let tri_of = |e: &Edge| tris[e.1 as usize];
     // Corner slots (local triangle × 3 + corner) joined through the edges at their vertex.
