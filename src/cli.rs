@@ -138,6 +138,16 @@ pub struct Args {
     /// Multiply B's coordinates by F, as --scale-a.
     #[arg(long, value_name = "F", allow_hyphen_values = true)]
     pub scale_b: Option<f64>,
+    /// Scene mode: also check every selected part against itself (self-clashing triangle pairs
+    /// and mesh health, as `meshclash self`), in a `self` block of the report. A crossing
+    /// self-clash pair fails the run under --fail-on clash (any self-clash pair under touching
+    /// or clearance); health findings fail it when named in --self-fail-on.
+    #[arg(long = "self")]
+    pub self_check: bool,
+    /// With --self: also fail on these (comma-separated): open, non-manifold, duplicates,
+    /// degenerate, winding, touching, self-clash.
+    #[arg(long, value_enum, value_delimiter = ',', value_name = "WHAT", requires = "self_check")]
+    pub self_fail_on: Vec<crate::report::self_report::SelfFailOn>,
     /// Output flags: --format, --junit, --baseline, --export-glb.
     #[command(flatten)]
     pub outputs: crate::output::OutputArgs,
@@ -257,6 +267,8 @@ pub struct Config {
     pub split_bodies: bool,
     /// `--penetration`.
     pub penetration: bool,
+    /// `--self` (scene mode): the conditions that fail the run on self-clash and health.
+    pub self_check: Option<Vec<crate::report::self_report::SelfFailOn>>,
 }
 
 /// A unit of length (`--units`, `--units-a`, `--units-b`).
@@ -499,6 +511,12 @@ impl Args {
         }
         // `meshclash scene FILE`: the word `scene` in place of A (use `./scene` for a file so named).
         let scene_mode = self.a.as_deref() == Some(std::path::Path::new("scene"));
+        if self.self_check && !scene_mode {
+            return Err(Error::Usage(
+                "--self works with scene (meshclash scene FILE --self); for one mesh use meshclash self FILE"
+                    .into(),
+            ));
+        }
         if scene_mode && self.cross_check.is_some() {
             return Err(Error::Usage("--cross-check works on two files, not with scene".into()));
         }
@@ -557,6 +575,15 @@ impl Args {
                     abs: nonneg("distance-abs-err", self.distance_abs_err)?,
                 },
             },
+            self_check: self.self_check.then(|| {
+                let base = match self.fail_on {
+                    FailOnArg::Clash => FailOn::Clash,
+                    FailOnArg::Touching => FailOn::Touching,
+                    FailOnArg::Clearance => FailOn::Clearance,
+                    FailOnArg::Never | FailOnArg::New => FailOn::Never,
+                };
+                crate::report::self_report::scene_fail_on(base, &self.self_fail_on)
+            }),
             fail_on: match self.fail_on {
                 FailOnArg::Clash => FailOn::Clash,
                 FailOnArg::Touching => FailOn::Touching,
@@ -744,6 +771,18 @@ pub fn check_staged(
         assembly,
     };
     let mut rep = report::build(&ctx, &result);
+    if let Some(fail_on) = &cfg.self_check {
+        let (sel, bvh) = (&cfg.selection, cfg.settings.bvh);
+        report::self_report::attach_scene_self(
+            &mut rep,
+            &a.mesh,
+            sel,
+            bvh,
+            fail_on,
+            cfg.max_pairs,
+            cfg.deterministic,
+        );
+    }
     let [ua, ub] = units;
     rep.inputs.a.units = ua;
     rep.inputs.b.units = ub;

@@ -40,6 +40,8 @@ mod part_pairs;
 mod safety;
 #[path = "self_clash.rs"]
 mod self_clash;
+#[path = "self_scene.rs"]
+mod self_scene;
 #[path = "tri_tri_oracle.rs"]
 mod tri_tri_oracle;
 #[path = "trust.rs"]

@@ -518,7 +518,7 @@ pub fn check_part_list(
         let ((health, pairs), from) = match derived {
             Some((r, l)) => (r, Some(l)),
             // Not derivable after all (never expected): check it itself.
-            None => match checked[i].take() {
+            None => match checked[i].clone() {
                 Some(r) => (r, None),
                 None => (
                     (
