@@ -6,7 +6,8 @@ same-run ratio with `meshclash-bench self` (issue 16).
 Needs `pip install trueform numpy`. Times (wall clock, best of the runs, ms): reading the OBJ
 (trueform's reader, f64, not in the ratios), then on a fresh `Mesh(...)` each (so its lazy
 tree and topology builds are counted, as meshclash's tree and merge are) `has_self_intersections` (stops at the first contact) and
-`self_intersection_curves` (every self-intersection curve, exact, the full answer), and the CPU
+`self_intersection_curves` (every self-intersection curve, exact, the full answer), then
+`self_intersection_curves` again on a warm mesh (its tree and topology already built), and the CPU
 time of the process over each timed call (user + system, all threads).
 """
 import argparse
@@ -61,6 +62,12 @@ def main():
           f"{has_ms:.1f} ms wall, {has_cpu:.0f} ms CPU")
     print(f"self_intersection_curves (fresh mesh, every curve): {n_paths} paths, "
           f"{cur_ms:.1f} ms wall, {cur_cpu:.0f} ms CPU")
+    # The same calls on one mesh whose lazy structures the first call built (query only).
+    warm = fresh()
+    tf.self_intersection_curves(warm)
+    _, wcur_ms, wcur_cpu = timed(a.reps, lambda: tf.self_intersection_curves(warm))
+    print(f"self_intersection_curves (warm mesh: tree and topology already built): "
+          f"{wcur_ms:.1f} ms wall, {wcur_cpu:.0f} ms CPU")
 
 
 if __name__ == "__main__":
