@@ -330,7 +330,7 @@ fn instances_reuse_only_exact_translates_and_give_the_same_results() {
     let f = [[0u32, 2, 3], [0, 3, 1], [2, 4, 5], [2, 5, 3], [4, 5, 7], [4, 7, 6]];
     let (c, s) = (30f64.to_radians().cos(), 30f64.to_radians().sin());
     let place: [Box<dyn Fn([f64; 3]) -> DVec3>; 3] = [
-        Box::new(|p| DVec3::from_array(p)),
+        Box::new(DVec3::from_array),
         Box::new(|p| DVec3::from_array(p) + DVec3::new(16.0, 0.5, -2.0)),
         Box::new(move |p| DVec3::new(c * p[0] - s * p[1] + 40.0, s * p[0] + c * p[1], p[2])),
     ];
