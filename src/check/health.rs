@@ -79,36 +79,40 @@ pub struct Health {
 /// sentinel entries with key `u64::MAX`.
 type Edge = (u64, u32, u8, bool);
 
-/// The edges without the sentinels, sorted. When the low ends are dense (at most 4 ids per
-/// edge, as in any part that is most of its mesh), a counting sort on the low end (one pass to
-/// count, one to scatter) and an insertion sort of each low end's few entries; otherwise a
-/// comparison sort. Both give the same total order.
-fn sort_edges(mut edges: Vec<Edge>) -> Vec<Edge> {
-    let real = edges.par_iter().filter(|e| e.0 != u64::MAX).count();
-    let lo = |e: &Edge| (e.0 >> 32) as usize;
-    let max_lo = edges.par_iter().filter(|e| e.0 != u64::MAX).map(lo).max().unwrap_or(0);
-    if real == 0 || max_lo / 4 > real {
-        edges.par_sort_unstable();
-        edges.truncate(real);
-        return edges;
+/// `items` without those `bucket` maps to None (sentinels), sorted (total order of `T`), where
+/// `bucket` is the item's leading sort key (`x < y` implies `bucket(x) <= bucket(y)`): a vertex
+/// id. When the buckets are dense (at most 4 ids per item, as in any part that is most of its
+/// mesh), a counting sort on the bucket (one pass to count, one to scatter) and a sort of each
+/// bucket's few entries; otherwise a comparison sort. Both give the same order.
+fn bucket_sort<T: Ord + Copy + Send + Sync>(
+    mut items: Vec<T>,
+    bucket: impl Fn(&T) -> Option<usize> + Sync,
+) -> Vec<T> {
+    let real = items.par_iter().filter(|e| bucket(e).is_some()).count();
+    let max = items.par_iter().filter_map(&bucket).max().unwrap_or(0);
+    if real == 0 || max / 4 > real {
+        items.par_sort_unstable();
+        items.truncate(real);
+        return items;
     }
-    let mut start = vec![0u32; max_lo + 2];
-    for e in edges.iter().filter(|e| e.0 != u64::MAX) {
-        start[lo(e) + 1] += 1;
+    let mut next = vec![0u32; max + 2];
+    for b in items.iter().filter_map(&bucket) {
+        next[b + 1] += 1;
     }
-    for i in 1..start.len() {
-        start[i] += start[i - 1];
+    for i in 1..next.len() {
+        next[i] += next[i - 1];
     }
-    let mut next = start.clone();
-    let mut out: Vec<Edge> = vec![(u64::MAX, 0, 0, false); real];
-    for e in edges.into_iter().filter(|e| e.0 != u64::MAX) {
-        let at = &mut next[lo(&e)];
-        out[*at as usize] = e;
-        *at += 1;
+    let Some(&fill) = items.iter().find(|e| bucket(e).is_some()) else { return Vec::new() };
+    let mut out: Vec<T> = vec![fill; real];
+    for e in items {
+        if let Some(b) = bucket(&e) {
+            out[next[b] as usize] = e;
+            next[b] += 1;
+        }
     }
-    drop((next, start));
-    // Each low end's run (a handful of entries) in full tuple order.
-    out.par_chunk_by_mut(|x, y| x.0 >> 32 == y.0 >> 32).for_each(|run| run.sort_unstable());
+    drop(next);
+    // Each bucket's run (a handful of entries) in full order.
+    out.par_chunk_by_mut(|x, y| bucket(x) == bucket(y)).for_each(|run| run.sort_unstable());
     out
 }
 
@@ -127,7 +131,7 @@ pub fn health(mesh: &Mesh, merged: &[u32], tris: &[u32], first_n: usize) -> Heal
     let zero_area_triangles = Finding::of(zero.len() as u64, zero, first_n);
 
     // Duplicates: sorted vertex sets of the triangles with three distinct vertices.
-    let mut faces: Vec<([u32; 3], u32)> = (0..tris.len())
+    let faces: Vec<([u32; 3], u32)> = (0..tris.len())
         .into_par_iter()
         .filter_map(|k| {
             let mut v = ids(k);
@@ -135,7 +139,7 @@ pub fn health(mesh: &Mesh, merged: &[u32], tris: &[u32], first_n: usize) -> Heal
             (v[0] != v[1] && v[1] != v[2]).then_some((v, tris[k]))
         })
         .collect();
-    faces.par_sort_unstable();
+    let faces = bucket_sort(faces, |f| Some(f.0[0] as usize));
     let mut dup = Vec::new();
     for run in faces.chunk_by(|x, y| x.0 == y.0) {
         dup.extend(run[1..].iter().map(|x| x.1));
@@ -155,7 +159,7 @@ pub fn health(mesh: &Mesh, merged: &[u32], tris: &[u32], first_n: usize) -> Heal
             *e = ((a.min(b) as u64) << 32 | a.max(b) as u64, k as u32, c as u8, a < b);
         }
     });
-    let edges = sort_edges(edges);
+    let edges = bucket_sort(edges, |e| (e.0 != u64::MAX).then_some((e.0 >> 32) as usize));
     let forward = |e: &Edge| e.3;
     let tri_of = |e: &Edge| tris[e.1 as usize];
     // Corner slots (local triangle × 3 + corner) joined through the edges at their vertex.
