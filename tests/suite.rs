@@ -46,6 +46,8 @@ mod part_pairs;
 mod safety;
 #[path = "self_clash.rs"]
 mod self_clash;
+#[path = "self_scene.rs"]
+mod self_scene;
 #[path = "shard.rs"]
 mod shard;
 #[path = "tri_tri_oracle.rs"]

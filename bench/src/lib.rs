@@ -25,6 +25,7 @@
 pub mod cases;
 pub mod layout;
 pub mod parry32;
+pub mod self_case;
 pub mod svg;
 
 use meshclash::bvh::traverse;

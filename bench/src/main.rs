@@ -4,6 +4,7 @@
 
 use clap::Parser;
 use meshclash_bench::cases::{self, CasesArgs, GenArgs};
+use meshclash_bench::self_case::{self, SelfCaseArgs};
 use meshclash_bench::BenchArgs;
 use std::io::Write;
 use std::process::ExitCode;
@@ -26,6 +27,10 @@ enum Command {
     /// Time the issue-12 cases in a directory written by `gen`: meshclash against parry3d f64
     /// and f32, phase by phase, with same-run ratios.
     Cases(CasesArgs),
+    /// Self-clash and mesh health (issue 16) on a generated folded torus (1M triangles) and on
+    /// given files, phase by phase.
+    #[command(name = "self")]
+    SelfCase(SelfCaseArgs),
 }
 
 fn main() -> ExitCode {
@@ -46,6 +51,7 @@ fn main() -> ExitCode {
         None => meshclash_bench::run_command(&cli.phases),
         Some(Command::Gen(g)) => cases::generate(g),
         Some(Command::Cases(c)) => cases::run_cases(c),
+        Some(Command::SelfCase(c)) => self_case::run_self_case(c),
     };
     match out {
         Ok(text) => {

@@ -210,3 +210,35 @@ fn cases_rejects_unknown_case_and_empty_dir() {
     assert_eq!(code, Some(2));
     assert!(err.contains("meshclash-bench gen"), "{err}");
 }
+
+/// `meshclash-bench self` through the real binary: the folded torus's phases are timed and its
+/// answer is the fold's crossing pairs; the bunny (open, no self-clash) is clear.
+#[test]
+fn self_case_times_the_phases_and_gives_the_answer() {
+    let bunny =
+        std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../../shared/meshes/stanford-bunny.obj");
+    let out = Command::cargo_bin("meshclash-bench")
+        .unwrap()
+        .args(["self", "--triangles", "20k", "--reps", "1", "--json", "--mesh"])
+        .arg(&bunny)
+        .timeout(std::time::Duration::from_secs(120))
+        .output()
+        .unwrap();
+    assert!(out.status.success(), "stderr: {}", String::from_utf8_lossy(&out.stderr));
+    let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    let rows = v.as_array().unwrap();
+    assert_eq!(rows.len(), 2);
+    let torus = &rows[0];
+    assert!(torus["name"].as_str().unwrap().starts_with("folded torus"));
+    assert!(torus["crossing"].as_u64().unwrap() > 0, "the fold crosses the tube");
+    for key in ["merge_ms", "health_ms", "tree_ms", "walk_ms", "check_ms"] {
+        assert!(torus[key].as_f64().unwrap() >= 0.0, "{key}");
+    }
+    assert!(torus["load_ms"].is_null());
+    let b = &rows[1];
+    assert_eq!(
+        (b["triangles"].as_u64(), b["crossing"].as_u64(), b["touching"].as_u64()),
+        (Some(69451), Some(0), Some(0))
+    );
+    assert!(b["load_ms"].as_f64().unwrap() >= 0.0);
+}

@@ -2,10 +2,10 @@
 //! enums. Validation into a [`super::config::Config`] is in [`super::config`].
 
 use clap::{Parser, ValueEnum};
-use meshclash::check::self_parts::SelfFailOn;
 use meshclash::error::{Error, Result};
 use meshclash::output::bcf::Topics;
 use meshclash::output::{Format, OutputOptions};
+use meshclash::report::self_report::SelfFailOn;
 use std::path::PathBuf;
 
 /// Do two meshes clash, where, and how close do they come? Reads OBJ, STL (ASCII or binary) and
@@ -142,6 +142,16 @@ pub struct CheckArgs {
     /// Multiply B's coordinates by F, as --scale-a.
     #[arg(long, value_name = "F", allow_hyphen_values = true)]
     pub scale_b: Option<f64>,
+    /// Scene mode: also check every selected part against itself (self-clashing triangle pairs
+    /// and mesh health, as `meshclash self`), in a `self` block of the report. A crossing
+    /// self-clash pair fails the run under --fail-on clash (any self-clash pair under touching
+    /// or clearance); health findings fail it when named in --self-fail-on.
+    #[arg(long = "self")]
+    pub self_check: bool,
+    /// With --self: also fail on these (comma-separated): open, non-manifold, duplicates,
+    /// degenerate, winding, touching, self-clash.
+    #[arg(long, value_enum, value_delimiter = ',', value_name = "WHAT", requires = "self_check")]
+    pub self_fail_on: Vec<SelfFailOnArg>,
     /// Output flags: --format, --junit, --baseline, --export-glb.
     #[command(flatten)]
     pub outputs: OutputArgs,

@@ -50,6 +50,8 @@ pub struct Config {
     pub split_bodies: bool,
     /// `--penetration`.
     pub penetration: bool,
+    /// `--self` (scene mode): the conditions that fail the run on self-clash and health.
+    pub self_check: Option<Vec<meshclash::report::self_report::SelfFailOn>>,
 }
 
 /// Units and raw scales, validated. Indices follow [`Config::inputs`] (in scene mode the file is
@@ -237,6 +239,12 @@ impl CheckArgs {
         if !(1..=64).contains(&self.leaf_size) {
             return Err(Error::Usage(format!("--leaf-size must be 1..=64, got {}", self.leaf_size)));
         }
+        if self.self_check && !scene_mode {
+            return Err(Error::Usage(
+                "--self works with scene (meshclash scene FILE --self); for one mesh use meshclash self FILE"
+                    .into(),
+            ));
+        }
         if scene_mode && self.cross_check.is_some() {
             return Err(Error::Usage("--cross-check works on two files, not with scene".into()));
         }
@@ -295,6 +303,17 @@ impl CheckArgs {
                     abs: nonneg("distance-abs-err", self.distance_abs_err)?,
                 },
             },
+            self_check: self.self_check.then(|| {
+                let base = match self.fail_on {
+                    FailOnArg::Clash => FailOn::Clash,
+                    FailOnArg::Touching => FailOn::Touching,
+                    FailOnArg::Clearance => FailOn::Clearance,
+                    FailOnArg::Never | FailOnArg::New => FailOn::Never,
+                };
+                let extra: Vec<meshclash::report::self_report::SelfFailOn> =
+                    self.self_fail_on.iter().map(|&f| f.into()).collect();
+                meshclash::report::self_report::scene_fail_on(base, &extra)
+            }),
             fail_on: match self.fail_on {
                 FailOnArg::Clash => FailOn::Clash,
                 FailOnArg::Touching => FailOn::Touching,

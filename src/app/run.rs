@@ -188,6 +188,18 @@ pub fn check_staged(
         assembly,
     };
     let mut rep = report::build(&ctx, &result);
+    if let Some(fail_on) = &cfg.self_check {
+        let (sel, bvh) = (&cfg.selection, cfg.settings.bvh);
+        report::self_report::attach_scene_self(
+            &mut rep,
+            &a.mesh,
+            sel,
+            bvh,
+            fail_on,
+            cfg.max_pairs,
+            cfg.deterministic,
+        );
+    }
     let [ua, ub] = units;
     rep.inputs.a.units = ua;
     rep.inputs.b.units = ub;

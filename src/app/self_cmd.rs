@@ -10,8 +10,9 @@ pub use super::args::{SelfArgs, SelfFormat};
 use glam::DMat4;
 use meshclash::bvh::{BuildOptions, Strategy};
 use meshclash::check::query::{self, InputSpec};
-use meshclash::check::self_parts::{check_parts, PartChoice, PartResult, SelfFailOn};
+use meshclash::check::self_clash::{check_parts, PartChoice, PartResult};
 use meshclash::error::{Error, Result};
+use meshclash::report::self_report::SelfFailOn;
 use meshclash::report::self_report::{self as rep, SelfReport};
 use std::time::Instant;
 

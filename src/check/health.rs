@@ -74,6 +74,48 @@ pub struct Health {
     pub volume: Option<f64>,
 }
 
+/// An edge of a proper triangle: (key `lo << 32 | hi`, local triangle, edge number `c` (from
+/// corner `c` to corner `c + 1`), whether corner `c` is the low end); zero-area triangles leave
+/// sentinel entries with key `u64::MAX`.
+type Edge = (u64, u32, u8, bool);
+
+/// `items` without those `bucket` maps to None (sentinels), sorted (total order of `T`), where
+/// `bucket` is the item's leading sort key (`x < y` implies `bucket(x) <= bucket(y)`): a vertex
+/// id. When the buckets are dense (at most 4 ids per item, as in any part that is most of its
+/// mesh), a counting sort on the bucket (one pass to count, one to scatter) and a sort of each
+/// bucket's few entries; otherwise a comparison sort. Both give the same order.
+fn bucket_sort<T: Ord + Copy + Send + Sync>(
+    mut items: Vec<T>,
+    bucket: impl Fn(&T) -> Option<usize> + Sync,
+) -> Vec<T> {
+    let real = items.par_iter().filter(|e| bucket(e).is_some()).count();
+    let max = items.par_iter().filter_map(&bucket).max().unwrap_or(0);
+    if real == 0 || max / 4 > real {
+        items.par_sort_unstable();
+        items.truncate(real);
+        return items;
+    }
+    let mut next = vec![0u32; max + 2];
+    for b in items.iter().filter_map(&bucket) {
+        next[b + 1] += 1;
+    }
+    for i in 1..next.len() {
+        next[i] += next[i - 1];
+    }
+    let Some(&fill) = items.iter().find(|e| bucket(e).is_some()) else { return Vec::new() };
+    let mut out: Vec<T> = vec![fill; real];
+    for e in items {
+        if let Some(b) = bucket(&e) {
+            out[next[b] as usize] = e;
+            next[b] += 1;
+        }
+    }
+    drop(next);
+    // Each bucket's run (a handful of entries) in full order.
+    out.par_chunk_by_mut(|x, y| bucket(x) == bucket(y)).for_each(|run| run.sort_unstable());
+    out
+}
+
 /// How many triangles go into one chunk of the volume sum (fixed, for determinism).
 const VOLUME_CHUNK: usize = 4096;
 
@@ -89,7 +131,7 @@ pub fn health(mesh: &Mesh, merged: &[u32], tris: &[u32], first_n: usize) -> Heal
     let zero_area_triangles = Finding::of(zero.len() as u64, zero, first_n);
 
     // Duplicates: sorted vertex sets of the triangles with three distinct vertices.
-    let mut faces: Vec<([u32; 3], u32)> = (0..tris.len())
+    let faces: Vec<([u32; 3], u32)> = (0..tris.len())
         .into_par_iter()
         .filter_map(|k| {
             let mut v = ids(k);
@@ -97,7 +139,7 @@ pub fn health(mesh: &Mesh, merged: &[u32], tris: &[u32], first_n: usize) -> Heal
             (v[0] != v[1] && v[1] != v[2]).then_some((v, tris[k]))
         })
         .collect();
-    faces.par_sort_unstable();
+    let faces = bucket_sort(faces, |f| Some(f.0[0] as usize));
     let mut dup = Vec::new();
     for run in faces.chunk_by(|x, y| x.0 == y.0) {
         dup.extend(run[1..].iter().map(|x| x.1));
@@ -109,7 +151,6 @@ pub fn health(mesh: &Mesh, merged: &[u32], tris: &[u32], first_n: usize) -> Heal
     // c to corner c + 1), whether corner c is the low end), 16 bytes. Zero-area triangles get
     // sentinel keys (above every real key: lo < hi <= u32::MAX), cut off after the sort;
     // filling a preallocated array keeps the collection indexed and parallel.
-    type Edge = (u64, u32, u8, bool);
     let mut edges: Vec<Edge> = vec![(u64::MAX, 0, 0, false); 3 * tris.len()];
     edges.par_chunks_mut(3).enumerate().filter(|(k, _)| proper[*k]).for_each(|(k, out)| {
         let v = ids(k);
@@ -118,8 +159,7 @@ pub fn health(mesh: &Mesh, merged: &[u32], tris: &[u32], first_n: usize) -> Heal
             *e = ((a.min(b) as u64) << 32 | a.max(b) as u64, k as u32, c as u8, a < b);
         }
     });
-    edges.par_sort_unstable();
-    edges.truncate(edges.partition_point(|e| e.0 != u64::MAX));
+    let edges = bucket_sort(edges, |e| (e.0 != u64::MAX).then_some((e.0 >> 32) as usize));
     let forward = |e: &Edge| e.3;
     let tri_of = |e: &Edge| tris[e.1 as usize];
     // Corner slots (local triangle × 3 + corner) joined through the edges at their vertex.

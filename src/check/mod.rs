@@ -12,4 +12,3 @@ pub mod health;
 pub mod query;
 pub mod regions;
 pub mod self_clash;
-pub mod self_parts;

@@ -140,6 +140,19 @@ fn meets_beyond_edge(u: DVec3, w: DVec3, a: DVec3, b: DVec3) -> bool {
 /// (exact-position) vertex ids of `ta`, `tb`. `None` unless they meet beyond what they share
 /// (see the module docs); then the classification of the whole pair.
 pub fn classify_adjacent(ta: &[DVec3; 3], ia: [u32; 3], tb: &[DVec3; 3], ib: [u32; 3]) -> Option<Hit> {
+    classify_adjacent_with(ta, ia, tb, ib, None)
+}
+
+/// [`classify_adjacent`], given the plane filter of one of the two triangles when the caller
+/// already has it (`(true, f)`: `f` is `ta`'s; `(false, f)`: `tb`'s), so that a triangle tested
+/// against several others builds its filter once.
+fn classify_adjacent_with(
+    ta: &[DVec3; 3],
+    ia: [u32; 3],
+    tb: &[DVec3; 3],
+    ib: [u32; 3],
+    known: Option<(bool, &PlaneFilter)>,
+) -> Option<Hit> {
     // Ids first (cheap); positions are gathered only for the pairs the filters cannot settle.
     let distinct_count = |i: [u32; 3]| 1 + (i[1] != i[0]) as usize + (i[2] != i[0] && i[2] != i[1]) as usize;
     let (na, nb) = (distinct_count(ia), distinct_count(ib));
@@ -167,7 +180,12 @@ pub fn classify_adjacent(ta: &[DVec3; 3], ia: [u32; 3], tb: &[DVec3; 3], ib: [u3
         }
         side != 0
     };
-    if off_plane(&PlaneFilter::new(ta), tb, ib, ia) || off_plane(&PlaneFilter::new(tb), ta, ia, ib) {
+    let settled = match known {
+        Some((true, fa)) => off_plane(fa, tb, ib, ia) || off_plane(&PlaneFilter::new(tb), ta, ia, ib),
+        Some((false, fb)) => off_plane(fb, ta, ia, ib) || off_plane(&PlaneFilter::new(ta), tb, ib, ia),
+        None => off_plane(&PlaneFilter::new(ta), tb, ib, ia) || off_plane(&PlaneFilter::new(tb), ta, ia, ib),
+    };
+    if settled {
         return None;
     }
     let (da, na) = distinct(ta, ia);
@@ -203,6 +221,17 @@ pub fn classify_adjacent(ta: &[DVec3; 3], ia: [u32; 3], tb: &[DVec3; 3], ib: [u3
     } else {
         None
     }
+}
+
+/// One triangle as a pair test reads it (see [`self_pairs_timed`]).
+#[derive(Debug, Clone, Copy)]
+struct Slot {
+    /// Its corners.
+    p: [DVec3; 3],
+    /// Their merged (exact-position) ids.
+    ids: [u32; 3],
+    /// Its index in the mesh.
+    t: u32,
 }
 
 /// Walk `tree` against itself: `leaf_self` gets each leaf once, `leaf_pair` each unordered pair
@@ -286,52 +315,83 @@ where
 /// `(a, b)`. `merged` gives each vertex of `mesh` its exact-position id
 /// ([`crate::scene::bodies::merge_vertices`]).
 pub fn self_pairs(mesh: &Mesh, merged: &[u32], tris: &[u32], opts: BuildOptions) -> Vec<SelfPair> {
+    self_pairs_timed(mesh, merged, tris, opts).0
+}
+
+/// Milliseconds spent by one [`self_pairs_timed`] call, by phase.
+#[derive(Debug, Clone, Copy, Default, PartialEq)]
+pub struct SelfTimes {
+    /// Triangle boxes and the tree.
+    pub tree_ms: f64,
+    /// The walk with every pair test, and the final sort.
+    pub walk_ms: f64,
+}
+
+/// [`self_pairs`], with the time of each phase.
+pub fn self_pairs_timed(
+    mesh: &Mesh,
+    merged: &[u32],
+    tris: &[u32],
+    opts: BuildOptions,
+) -> (Vec<SelfPair>, SelfTimes) {
+    let t0 = std::time::Instant::now();
     let boxes: Vec<Aabb> =
         tris.par_iter().map(|&t| Aabb::of_triangle(&crate::bvh::triangle(mesh, t))).collect();
     let tree = Bvh::build_from_boxes(&boxes, opts);
     drop(boxes);
     // What a pair test reads, laid out in the tree's leaf order so that a leaf is one run of
-    // memory: (box, merged ids, triangle index in `mesh`). 64 bytes per triangle.
-    let slots: Vec<(Aabb, [u32; 3], u32)> = tree
+    // memory and no pair test reaches into the mesh: the corners, their merged ids and the
+    // triangle index in `mesh` (88 bytes per triangle). Boxes are recomputed from the corners
+    // (cheaper than reading them).
+    let slots: Vec<Slot> = tree
         .prims
         .par_iter()
         .map(|&k| {
             let t = tris[k as usize];
             let v = mesh.triangles[t as usize];
-            (Aabb::of_triangle(&crate::bvh::triangle(mesh, t)), v.map(|i| merged[i as usize]), t)
+            Slot { p: v.map(|i| mesh.positions[i as usize]), ids: v.map(|i| merged[i as usize]), t }
         })
         .collect();
-    let test = |x: &(Aabb, [u32; 3], u32), y: &(Aabb, [u32; 3], u32), out: &mut Vec<SelfPair>| {
-        if !x.0.overlaps(&y.0) {
+    let tree_ms = t0.elapsed().as_secs_f64() * 1e3;
+    let t1 = std::time::Instant::now();
+    // `x`'s box and plane filter are computed once per `x` and reused for every `y` it meets.
+    let test = |x: &Slot, (bx, fx): &(Aabb, PlaneFilter), y: &Slot, out: &mut Vec<SelfPair>| {
+        if !bx.overlaps(&Aabb::of_triangle(&y.p)) {
             return;
         }
         // Lower triangle first, so the listed segment does not depend on the tree.
-        let (x, y) = if x.2 < y.2 { (x, y) } else { (y, x) };
-        let (ta, tb) = (crate::bvh::triangle(mesh, x.2), crate::bvh::triangle(mesh, y.2));
-        if let Some(hit) = classify_adjacent(&ta, x.1, &tb, y.1) {
-            out.push(SelfPair { a: x.2, b: y.2, hit });
+        let hit = if x.t < y.t {
+            classify_adjacent_with(&x.p, x.ids, &y.p, y.ids, Some((true, fx)))
+        } else {
+            classify_adjacent_with(&y.p, y.ids, &x.p, x.ids, Some((false, fx)))
+        };
+        if let Some(hit) = hit {
+            out.push(SelfPair { a: x.t.min(y.t), b: x.t.max(y.t), hit });
         }
     };
+    let prep = |x: &Slot| (Aabb::of_triangle(&x.p), PlaneFilter::new(&x.p));
     let mut pairs = self_walk(
         &tree,
         |leaf, out| {
             let leaf = &slots[leaf];
             for (k, x) in leaf.iter().enumerate() {
+                let px = prep(x);
                 for y in &leaf[k + 1..] {
-                    test(x, y, out);
+                    test(x, &px, y, out);
                 }
             }
         },
         |la, lb, out| {
             for x in &slots[la] {
+                let px = prep(x);
                 for y in &slots[lb.clone()] {
-                    test(x, y, out);
+                    test(x, &px, y, out);
                 }
             }
         },
     );
     pairs.par_sort_unstable_by_key(|p| (p.a, p.b));
-    pairs
+    (pairs, SelfTimes { tree_ms, walk_ms: t1.elapsed().as_secs_f64() * 1e3 })
 }
 
 /// The same answer as [`self_pairs`] by testing every pair (quadratic; for tests).
@@ -349,6 +409,231 @@ pub fn self_pairs_brute_force(mesh: &Mesh, merged: &[u32], tris: &[u32]) -> Vec<
         }
     }
     out
+}
+
+/// The result for one part.
+#[derive(Debug, Clone, PartialEq)]
+pub struct PartResult {
+    /// Object index in the (possibly split) mesh; None for `--whole-file`.
+    pub object: Option<u32>,
+    /// Its name.
+    pub name: String,
+    /// Its triangles (indices into the mesh).
+    pub triangles: usize,
+    /// Its self-clashing pairs, sorted by (a, b).
+    pub pairs: Vec<SelfPair>,
+    /// How many of them cross.
+    pub crossing: u64,
+    /// Its health.
+    pub health: crate::check::health::Health,
+    /// With instance reuse ([`check_part_list`]): the index (in the result list) of the part
+    /// whose check this one's result was derived from, because its placed coordinates are an
+    /// exact translate of that part's; None when it was checked itself.
+    pub same_as: Option<usize>,
+}
+
+/// Which parts [`check_parts`] checks.
+pub enum PartChoice<'a> {
+    /// Every object (object order) whose name passes the filter.
+    Objects(&'a dyn Fn(&str) -> bool),
+    /// All triangles as one part with this name.
+    Whole(&'a str),
+}
+
+/// One part to check: its object (None: the whole file), name and triangles (indices into the
+/// mesh, ascending).
+pub type PartSpec = (Option<u32>, String, Vec<u32>);
+
+/// Self-clash and health of the chosen parts of `mesh`, with the milliseconds spent on health
+/// (with the vertex merge) and on the self-clash walks (the two run at the same time, so their
+/// times overlap).
+pub fn check_parts(
+    mesh: &crate::scene::mesh::Mesh,
+    choice: PartChoice,
+    opts: BuildOptions,
+    first_n: usize,
+) -> (Vec<PartResult>, f64, f64) {
+    let parts: Vec<PartSpec> = match choice {
+        PartChoice::Objects(keep) => crate::check::assembly::parts_of(mesh, 0)
+            .into_iter()
+            .filter(|p| keep(&p.name))
+            .map(|p| (Some(p.object), p.name, p.triangles))
+            .collect(),
+        PartChoice::Whole(name) => vec![(None, name.to_string(), (0..mesh.triangles.len() as u32).collect())],
+    };
+    check_part_list(mesh, parts, opts, first_n, false)
+}
+
+/// [`check_parts`] for a given list of parts. With `reuse` (scene mode), a part whose triangles
+/// index the mesh like an earlier checked part's, shifted by one vertex offset (instances of one
+/// glTF mesh), and whose placed coordinates are an *exact* translate of that part's
+/// ([`crate::geom::predicates::exact_translation`]) is not walked again: every orientation sign
+/// is the same for both, so are the vertex merge, the self-clash verdicts and every health count;
+/// its pairs are re-classified on its own coordinates (for its own contact segments) and its
+/// health findings renumbered. Any other part (an instance rotated or scaled, whose coordinates
+/// were rounded differently) is checked on its own placed coordinates, so the answer is always
+/// exactly the one a separate check of each part gives.
+pub fn check_part_list(
+    mesh: &crate::scene::mesh::Mesh,
+    parts: Vec<PartSpec>,
+    opts: BuildOptions,
+    first_n: usize,
+    reuse: bool,
+) -> (Vec<PartResult>, f64, f64) {
+    let t = std::time::Instant::now();
+    let (merged, _) = crate::scene::bodies::merge_vertices(&mesh.positions);
+    let same_as: Vec<Option<usize>> = if reuse { translates(mesh, &parts) } else { vec![None; parts.len()] };
+    let merge_ms = t.elapsed().as_secs_f64() * 1e3;
+    let leaders: Vec<usize> = (0..parts.len()).filter(|&i| same_as[i].is_none()).collect();
+    // Health and the self-clash walks run side by side: parts of the health pass are
+    // sequential (union-find), and the walk fills the other cores meanwhile.
+    let ms = |t: std::time::Instant| t.elapsed().as_secs_f64() * 1e3;
+    let ((healths, health_ms), (found, query_ms)) = rayon::join(
+        || {
+            let t = std::time::Instant::now();
+            let h: Vec<crate::check::health::Health> = leaders
+                .par_iter()
+                .map(|&i| crate::check::health::health(mesh, &merged, &parts[i].2, first_n))
+                .collect();
+            (h, ms(t))
+        },
+        || {
+            let t = std::time::Instant::now();
+            let f: Vec<Vec<SelfPair>> =
+                leaders.par_iter().map(|&i| self_pairs(mesh, &merged, &parts[i].2, opts)).collect();
+            (f, ms(t))
+        },
+    );
+    let mut checked: Vec<Option<(crate::check::health::Health, Vec<SelfPair>)>> = vec![None; parts.len()];
+    for (&i, r) in leaders.iter().zip(healths.into_iter().zip(found)) {
+        checked[i] = Some(r);
+    }
+    let t = std::time::Instant::now();
+    let mut results: Vec<PartResult> = Vec::with_capacity(parts.len());
+    for (i, (object, name, tris)) in parts.iter().enumerate() {
+        let derived = same_as[i].and_then(|l| {
+            let (health, pairs) = checked[l].as_ref().expect("leaders come first");
+            derive(mesh, &merged, &parts[l].2, tris, health, pairs).map(|r| (r, l))
+        });
+        let ((health, pairs), from) = match derived {
+            Some((r, l)) => (r, Some(l)),
+            // Not derivable after all (never expected): check it itself.
+            None => match checked[i].clone() {
+                Some(r) => (r, None),
+                None => (
+                    (
+                        crate::check::health::health(mesh, &merged, tris, first_n),
+                        self_pairs(mesh, &merged, tris, opts),
+                    ),
+                    None,
+                ),
+            },
+        };
+        let crossing = pairs.iter().filter(|q| q.hit.crossing).count() as u64;
+        results.push(PartResult {
+            object: *object,
+            name: name.clone(),
+            triangles: tris.len(),
+            pairs,
+            crossing,
+            health,
+            same_as: from,
+        });
+    }
+    (results, merge_ms + health_ms, query_ms + ms(t))
+}
+
+/// For each part, an earlier part (one that is checked itself) whose result it can take over:
+/// the same number of triangles, each corner index the other's plus one common offset, and the
+/// placed corners an exact translate of the other's. At most [`REUSE_CANDIDATES`] earlier parts
+/// with the same glTF mesh are tried per part.
+fn translates(mesh: &crate::scene::mesh::Mesh, parts: &[PartSpec]) -> Vec<Option<usize>> {
+    let corners = |tris: &[u32]| -> Vec<DVec3> {
+        tris.iter().flat_map(|&t| crate::bvh::triangle(mesh, t)).collect::<Vec<DVec3>>()
+    };
+    let shifted = |l: &[u32], i: &[u32]| {
+        let first = |t: &[u32]| mesh.triangles[t[0] as usize][0] as i64;
+        let shift = first(i) - first(l);
+        l.len() == i.len()
+            && l.iter().zip(i).all(|(&a, &b)| {
+                let (a, b) = (mesh.triangles[a as usize], mesh.triangles[b as usize]);
+                (0..3).all(|k| b[k] as i64 == a[k] as i64 + shift)
+            })
+    };
+    let key = |p: &PartSpec| p.0.and_then(|o| mesh.objects[o as usize].gltf_mesh).map(|m| (m, p.2.len()));
+    let mut leaders: std::collections::HashMap<(u32, usize), Vec<usize>> = std::collections::HashMap::new();
+    let mut out = vec![None; parts.len()];
+    for (i, p) in parts.iter().enumerate() {
+        let Some(k) = key(p).filter(|k| k.1 > 0) else { continue };
+        let group = leaders.entry(k).or_default();
+        let mine = std::cell::OnceCell::new();
+        let found = group.iter().take(REUSE_CANDIDATES).copied().find(|&l| {
+            shifted(&parts[l].2, &p.2)
+                && crate::geom::predicates::exact_translation(
+                    &corners(&parts[l].2),
+                    mine.get_or_init(|| corners(&p.2)),
+                )
+                .is_some()
+        });
+        match found {
+            Some(l) => out[i] = Some(l),
+            None => group.push(i),
+        }
+    }
+    out
+}
+
+/// How many earlier checked parts of the same glTF mesh a part is compared with.
+const REUSE_CANDIDATES: usize = 4;
+
+/// The result of part `inst` from that of `leader` (an exact translate with the same index
+/// pattern, see [`translates`]): the same pairs and findings, renumbered, the pairs re-classified
+/// on `inst`'s own coordinates. None if a pair does not classify the same (never expected).
+fn derive(
+    mesh: &crate::scene::mesh::Mesh,
+    merged: &[u32],
+    leader: &[u32],
+    inst: &[u32],
+    health: &crate::check::health::Health,
+    pairs: &[SelfPair],
+) -> Option<(crate::check::health::Health, Vec<SelfPair>)> {
+    // Both lists ascend, so the map keeps order (and the first N ids stay the first N).
+    let map = |t: u32| leader.binary_search(&t).ok().map(|k| inst[k]);
+    let ids = |t: u32| mesh.triangles[t as usize].map(|v| merged[v as usize]);
+    let mut out = Vec::with_capacity(pairs.len());
+    for q in pairs {
+        let (a, b) = (map(q.a)?, map(q.b)?);
+        let hit = classify_adjacent(
+            &crate::bvh::triangle(mesh, a),
+            ids(a),
+            &crate::bvh::triangle(mesh, b),
+            ids(b),
+        )?;
+        if hit.crossing != q.hit.crossing || hit.contact != q.hit.contact {
+            return None;
+        }
+        out.push(SelfPair { a, b, hit });
+    }
+    let f = |x: &crate::check::health::Finding| -> Option<crate::check::health::Finding> {
+        Some(crate::check::health::Finding {
+            count: x.count,
+            triangles: x.triangles.iter().map(|&t| map(t)).collect::<Option<Vec<u32>>>()?,
+        })
+    };
+    let h = crate::check::health::Health {
+        closed: health.closed,
+        duplicate_faces: f(&health.duplicate_faces)?,
+        zero_area_triangles: f(&health.zero_area_triangles)?,
+        non_manifold_edges: f(&health.non_manifold_edges)?,
+        non_manifold_vertices: f(&health.non_manifold_vertices)?,
+        boundary_edges: f(&health.boundary_edges)?,
+        boundary_loops: health.boundary_loops,
+        inconsistent_winding_edges: f(&health.inconsistent_winding_edges)?,
+        // Σ (a−o)·((b−o)×(c−o)): each difference is the same real for both parts (an exact
+        // translate), so the same f64, and the sum is bit-identical.
+        volume: health.volume,
+    };
+    Some((h, out))
 }
 
 #[cfg(test)]

@@ -417,6 +417,28 @@ pub fn line_axis(p: DVec3, q: DVec3) -> usize {
     }
 }
 
+/// Exact: is every `b[i]` the point `a[i]` translated by one common vector `t`, in real
+/// arithmetic (`b[i] = a[i] + t` with no rounding)? Then `Some(t)`. Each coordinate sum is
+/// checked with Knuth's TwoSum, whose error term is exact for finite inputs without overflow:
+/// the sum is exact iff its rounded value is `b` and the error is zero. An exact translation
+/// preserves every orientation sign (the coordinate differences are the same reals), so every
+/// verdict built from them is the same for `a` and `b`.
+pub fn exact_translation(a: &[DVec3], b: &[DVec3]) -> Option<DVec3> {
+    if a.len() != b.len() || a.is_empty() {
+        return None;
+    }
+    let exact_sum = |x: f64, y: f64, want: f64| {
+        let s = x + y;
+        let yy = s - x;
+        let err = (x - (s - yy)) + (y - yy);
+        s == want && err == 0.0 && s.is_finite()
+    };
+    let t = b[0] - a[0];
+    let ok = (0..3).all(|k| exact_sum(a[0][k], t[k], b[0][k]))
+        && a.iter().zip(b).all(|(p, q)| (0..3).all(|k| exact_sum(p[k], t[k], q[k])));
+    ok.then_some(t)
+}
+
 /// The predicates a classification is built from. [`Exact`] is the product; [`Adaptive`] the
 /// same exact signs without our filters (the reference they are tested against); [`Float`]
 /// exists to measure what exactness costs and buys (`--mode fast`).

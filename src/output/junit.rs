@@ -133,6 +133,9 @@ pub fn cases(r: &Report) -> Vec<Case> {
     if r.assembly.mode == "parts" || r.parts.len() > 2 {
         cases.extend(part_pair_cases(r));
     }
+    if let Some(x) = &r.self_check {
+        cases.extend(crate::report::self_report::scene_junit_cases(x));
+    }
     cases
 }
 

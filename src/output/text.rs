@@ -294,6 +294,9 @@ pub fn render(r: &Report, color: bool) -> String {
             let _ = writeln!(s, "    {}{rest}", c.p(style, kind));
         }
     }
+    if let Some(x) = &r.self_check {
+        s.push_str(&crate::report::self_report::scene_text(x));
+    }
     if let Some(b) = &r.baseline {
         let _ = writeln!(
             s,

@@ -300,6 +300,10 @@ pub struct Report {
     /// With `--baseline`: the comparison with the earlier report; absent otherwise.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub baseline: Option<crate::report::baseline::BaselineReport>,
+    /// `scene --self`: every part checked against itself (see
+    /// [`self_report::SceneSelfReport`]); absent otherwise.
+    #[serde(rename = "self", default, skip_serializing_if = "Option::is_none")]
+    pub self_check: Option<self_report::SceneSelfReport>,
 }
 
 /// How deep one part reaches into the other at a region.
@@ -950,6 +954,7 @@ pub fn build(ctx: &Context, r: &ClashResult) -> Report {
             total,
         }),
         baseline: None,
+        self_check: None,
     }
 }
 

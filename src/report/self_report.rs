@@ -43,9 +43,83 @@
 
 use crate::check::health::{Finding, Health};
 use crate::check::query::Input;
-use crate::check::self_parts::{PartResult, SelfFailOn};
+use crate::check::self_clash::PartResult;
 use crate::report::{ObjectReport, PairReport, ReportContact, ReportPairKind, ReportVerdict, Tool};
 use serde::{Deserialize, Serialize};
+
+/// `--fail-on` values of `self`.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord)]
+pub enum SelfFailOn {
+    /// Crossing self-clash pairs (the default).
+    SelfClash,
+    /// Any self-clash pair, crossing or touching.
+    Touching,
+    /// A part that is not closed.
+    Open,
+    /// Non-manifold edges or vertices.
+    NonManifold,
+    /// Duplicate faces.
+    Duplicates,
+    /// Zero-area triangles.
+    Degenerate,
+    /// Edges used twice in the same direction.
+    Winding,
+    /// Never fail on findings.
+    Never,
+}
+
+impl SelfFailOn {
+    /// Name on the command line and in the report.
+    pub fn name(self) -> &'static str {
+        match self {
+            SelfFailOn::SelfClash => "self-clash",
+            SelfFailOn::Touching => "touching",
+            SelfFailOn::Open => "open",
+            SelfFailOn::NonManifold => "non-manifold",
+            SelfFailOn::Duplicates => "duplicates",
+            SelfFailOn::Degenerate => "degenerate",
+            SelfFailOn::Winding => "winding",
+            SelfFailOn::Never => "never",
+        }
+    }
+
+    /// The condition named `name` (as [`SelfFailOn::name`] writes it; `clash` is `self-clash`).
+    pub fn from_name(name: &str) -> Option<SelfFailOn> {
+        const ALL: [SelfFailOn; 8] = [
+            SelfFailOn::SelfClash,
+            SelfFailOn::Touching,
+            SelfFailOn::Open,
+            SelfFailOn::NonManifold,
+            SelfFailOn::Duplicates,
+            SelfFailOn::Degenerate,
+            SelfFailOn::Winding,
+            SelfFailOn::Never,
+        ];
+        if name == "clash" {
+            return Some(SelfFailOn::SelfClash);
+        }
+        ALL.into_iter().find(|f| f.name() == name)
+    }
+
+    /// Does this part's result meet the condition?
+    pub fn hit(self, part: &PartResult) -> bool {
+        self.met(part.crossing, part.pairs.len() as u64 - part.crossing, &health_report(&part.health))
+    }
+
+    /// Does a part with these self-clash counts and this health meet the condition?
+    pub fn met(self, crossing: u64, touching: u64, h: &HealthReport) -> bool {
+        match self {
+            SelfFailOn::SelfClash => crossing > 0,
+            SelfFailOn::Touching => crossing + touching > 0,
+            SelfFailOn::Open => !h.closed,
+            SelfFailOn::NonManifold => h.non_manifold_edges.count + h.non_manifold_vertices.count > 0,
+            SelfFailOn::Duplicates => h.duplicate_faces.count > 0,
+            SelfFailOn::Degenerate => h.zero_area_triangles.count > 0,
+            SelfFailOn::Winding => h.inconsistent_winding_edges.count > 0,
+            SelfFailOn::Never => false,
+        }
+    }
+}
 
 /// The schema identifier of a self report.
 pub const SELF_SCHEMA: &str = "meshclash.self/1";
@@ -274,20 +348,17 @@ fn health_report(h: &Health) -> HealthReport {
     }
 }
 
-/// The report: a projection of the results, nothing computed here but sums.
-pub fn build(ctx: &Context) -> SelfReport {
-    let mesh = &ctx.input.mesh;
-    let mut objects: Vec<ObjectReport> =
-        mesh.objects.iter().map(|o| ObjectReport { name: o.name.clone(), triangles: 0 }).collect();
-    for &o in &mesh.tri_object {
-        objects[o as usize].triangles += 1;
-    }
-    let mut all: Vec<&crate::check::self_clash::SelfPair> = ctx.parts.iter().flat_map(|p| &p.pairs).collect();
+/// The listed pairs (sorted by (a, b), at most `max_pairs`) and whether the list was cut.
+fn pairs_of(
+    mesh: &crate::scene::mesh::Mesh,
+    parts: &[PartResult],
+    max_pairs: usize,
+) -> (Vec<PairReport>, bool) {
+    let mut all: Vec<&crate::check::self_clash::SelfPair> = parts.iter().flat_map(|p| &p.pairs).collect();
     all.sort_unstable_by_key(|q| (q.a, q.b));
-    let pairs_truncated = all.len() > ctx.max_pairs;
     let pairs = all
         .iter()
-        .take(ctx.max_pairs)
+        .take(max_pairs)
         .map(|q| PairReport {
             a: q.a,
             b: q.b,
@@ -301,15 +372,18 @@ pub fn build(ctx: &Context) -> SelfReport {
             status: None,
         })
         .collect();
-    let sum = |f: &dyn Fn(&PartResult) -> u64| ctx.parts.iter().map(f).sum::<u64>();
-    let crossing_pairs = sum(&|p| p.crossing);
-    let touching_pairs = sum(&|p| p.pairs.len() as u64 - p.crossing);
-    let summary = SelfSummary {
-        parts: ctx.parts.len(),
-        crossing_pairs,
-        touching_pairs,
-        parts_with_self_clash: ctx.parts.iter().filter(|p| !p.pairs.is_empty()).count(),
-        open_parts: ctx.parts.iter().filter(|p| !p.health.closed).count(),
+    (pairs, all.len() > max_pairs)
+}
+
+/// Sums over the parts.
+fn summary_of(parts: &[PartResult]) -> SelfSummary {
+    let sum = |f: &dyn Fn(&PartResult) -> u64| parts.iter().map(f).sum::<u64>();
+    SelfSummary {
+        parts: parts.len(),
+        crossing_pairs: sum(&|p| p.crossing),
+        touching_pairs: sum(&|p| p.pairs.len() as u64 - p.crossing),
+        parts_with_self_clash: parts.iter().filter(|p| !p.pairs.is_empty()).count(),
+        open_parts: parts.iter().filter(|p| !p.health.closed).count(),
         duplicate_faces: sum(&|p| p.health.duplicate_faces.count),
         zero_area_triangles: sum(&|p| p.health.zero_area_triangles.count),
         non_manifold_edges: sum(&|p| p.health.non_manifold_edges.count),
@@ -317,14 +391,31 @@ pub fn build(ctx: &Context) -> SelfReport {
         boundary_edges: sum(&|p| p.health.boundary_edges.count),
         boundary_loops: sum(&|p| p.health.boundary_loops),
         inconsistent_winding_edges: sum(&|p| p.health.inconsistent_winding_edges.count),
-    };
-    let verdict = if crossing_pairs > 0 {
+    }
+}
+
+/// `clash` if a pair crosses, `touching` if pairs only touch, else `clear`.
+fn verdict_of(s: &SelfSummary) -> ReportVerdict {
+    if s.crossing_pairs > 0 {
         ReportVerdict::Clash
-    } else if touching_pairs > 0 {
+    } else if s.touching_pairs > 0 {
         ReportVerdict::Touching
     } else {
         ReportVerdict::Clear
-    };
+    }
+}
+
+/// The report: a projection of the results, nothing computed here but sums.
+pub fn build(ctx: &Context) -> SelfReport {
+    let mesh = &ctx.input.mesh;
+    let mut objects: Vec<ObjectReport> =
+        mesh.objects.iter().map(|o| ObjectReport { name: o.name.clone(), triangles: 0 }).collect();
+    for &o in &mesh.tri_object {
+        objects[o as usize].triangles += 1;
+    }
+    let (pairs, pairs_truncated) = pairs_of(mesh, ctx.parts, ctx.max_pairs);
+    let summary = summary_of(ctx.parts);
+    let verdict = verdict_of(&summary);
     let names = |v: &[SelfFailOn]| v.iter().map(|f| f.name().to_string()).collect::<Vec<_>>();
     SelfReport {
         schema: SELF_SCHEMA.into(),
@@ -458,4 +549,301 @@ pub fn text(r: &SelfReport) -> String {
         );
     }
     out
+}
+
+// ---------------------------------------------------------------------------------------------
+// `meshclash scene FILE --self`: the `self` block of a two-mesh (`meshclash.report/2`) report.
+// ---------------------------------------------------------------------------------------------
+
+/// The `self` block of a scene report (`--self`): every selected part checked against itself.
+/// Additive: absent without `--self`, and nothing else in the report changes meaning — `verdict`,
+/// `summary` and `pairs` stay part against part; this block has its own `verdict`, and
+/// `failed` (top level) is also true when this block's `failed` is.
+///
+/// ```text
+/// "self": {"fail_on": ["self-clash", ...], "verdict": "clash|touching|clear", "failed", "failed_on",
+///          "checks",                      // parts walked; the others are exact translates of one
+///          "summary": {...as in meshclash.self/1...},
+///          "pairs": [{"a", "b", "a_object", "b_object", "kind", "contact", "distance", "segment"}],
+///          "pairs_truncated",
+///          "parts": [{"part", "object", "name", "triangles", "crossing_pairs", "touching_pairs",
+///                     "same_as": part | null, "health": {...as in meshclash.self/1...}}],
+///          "time_ms": number | null}
+/// ```
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, schemars::JsonSchema)]
+#[serde(deny_unknown_fields)]
+pub struct SceneSelfReport {
+    /// The conditions that fail the run: `self-clash` (with `--fail-on clash`), `touching`
+    /// (with `--fail-on touching` or `clearance`), and those of `--self-fail-on`, sorted.
+    pub fail_on: Vec<String>,
+    /// `clash` (a crossing self-clash pair), `touching` (only touching ones) or `clear`.
+    pub verdict: ReportVerdict,
+    /// True if something in `fail_on` was found (then the run fails: exit code 1).
+    pub failed: bool,
+    /// The `fail_on` conditions that were met.
+    pub failed_on: Vec<String>,
+    /// Parts whose check ran; every other part's result was taken over from a part its placed
+    /// coordinates are an exact translate of (`same_as`).
+    pub checks: usize,
+    /// Sums over the parts, as in a `meshclash self` report (complete even when `pairs` is cut).
+    pub summary: SelfSummary,
+    /// Self-clashing pairs (`a < b`, both triangles of one part, indices into the file), sorted
+    /// by (a, b), at most `settings.max_pairs`.
+    pub pairs: Vec<PairReport>,
+    /// True if `pairs` was cut at `settings.max_pairs`.
+    pub pairs_truncated: bool,
+    /// Every checked part, in part order.
+    pub parts: Vec<SceneSelfPart>,
+    /// Milliseconds spent (null with `--no-timings`).
+    pub time_ms: Option<f64>,
+}
+
+/// One part of the `self` block.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, schemars::JsonSchema)]
+#[serde(deny_unknown_fields)]
+pub struct SceneSelfPart {
+    /// Index into the report's `parts`.
+    pub part: usize,
+    /// Object index (`inputs.a.objects`).
+    pub object: u32,
+    /// Its name.
+    pub name: String,
+    /// Its triangle count.
+    pub triangles: usize,
+    /// Its crossing self-clash pairs.
+    pub crossing_pairs: u64,
+    /// Its touching self-clash pairs.
+    pub touching_pairs: u64,
+    /// The part (index into the report's `parts`) whose check this result was taken over from
+    /// (an instance of the same mesh whose placed coordinates are an exact translate of this
+    /// one's: every verdict is the same), or null when it was checked itself.
+    pub same_as: Option<usize>,
+    /// Its health.
+    pub health: HealthReport,
+}
+
+/// What `--fail-on` of a scene means for self-clash: `clash` fails on crossing self-clash pairs,
+/// `touching` and `clearance` on any self-clash pair, `never` (and `new`, which compares part
+/// pairs with a baseline) on none. `extra` (`--self-fail-on`) adds health conditions.
+pub fn scene_fail_on(fail_on: crate::check::query::FailOn, extra: &[SelfFailOn]) -> Vec<SelfFailOn> {
+    use crate::check::query::FailOn;
+    let mut v: Vec<SelfFailOn> = match fail_on {
+        FailOn::Clash => vec![SelfFailOn::SelfClash],
+        FailOn::Touching | FailOn::Clearance => vec![SelfFailOn::Touching],
+        FailOn::Never => Vec::new(),
+    };
+    v.extend_from_slice(extra);
+    v.sort_unstable();
+    v.dedup();
+    v
+}
+
+/// Check every selected part of `mesh` (the scene's one file, parts in
+/// [`crate::check::assembly::parts_of`] order, which is the report's `parts` order) against
+/// itself and build the `self` block. `keep` selects parts by name. Instances are checked once
+/// per distinct placed geometry ([`crate::check::self_clash::check_part_list`]).
+pub fn scene_self(
+    mesh: &crate::scene::mesh::Mesh,
+    keep: &dyn Fn(&str) -> bool,
+    opts: crate::bvh::BuildOptions,
+    fail_on: &[SelfFailOn],
+    max_pairs: usize,
+    deterministic: bool,
+) -> SceneSelfReport {
+    let t = std::time::Instant::now();
+    let all = crate::check::assembly::parts_of(mesh, 0);
+    let chosen: Vec<usize> = (0..all.len()).filter(|&i| keep(&all[i].name)).collect();
+    let specs = chosen
+        .iter()
+        .map(|&i| (Some(all[i].object), all[i].name.clone(), all[i].triangles.clone()))
+        .collect();
+    let (results, _, _) =
+        crate::check::self_clash::check_part_list(mesh, specs, opts, crate::output::junit::FIRST, true);
+    let (pairs, pairs_truncated) = pairs_of(mesh, &results, max_pairs);
+    let summary = summary_of(&results);
+    let failed_on: Vec<SelfFailOn> =
+        fail_on.iter().copied().filter(|f| results.iter().any(|p| f.hit(p))).collect();
+    let names = |v: &[SelfFailOn]| v.iter().map(|f| f.name().to_string()).collect::<Vec<_>>();
+    SceneSelfReport {
+        fail_on: names(fail_on),
+        verdict: verdict_of(&summary),
+        failed: !failed_on.is_empty(),
+        failed_on: names(&failed_on),
+        checks: results.iter().filter(|p| p.same_as.is_none()).count(),
+        summary,
+        pairs,
+        pairs_truncated,
+        parts: results
+            .iter()
+            .zip(&chosen)
+            .map(|(p, &i)| SceneSelfPart {
+                part: i,
+                object: all[i].object,
+                name: p.name.clone(),
+                triangles: p.triangles,
+                crossing_pairs: p.crossing,
+                touching_pairs: p.pairs.len() as u64 - p.crossing,
+                same_as: p.same_as.map(|l| chosen[l]),
+                health: health_report(&p.health),
+            })
+            .collect(),
+        time_ms: (!deterministic).then(|| t.elapsed().as_secs_f64() * 1e3),
+    }
+}
+
+/// What is wrong with one part, for a person: `3 crossing pairs, 12 boundary edges, ...`.
+fn part_problems(crossing: u64, touching: u64, h: &HealthReport) -> Vec<String> {
+    let mut v = Vec::new();
+    let mut add = |n: u64, what: &str| {
+        if n > 0 {
+            v.push(format!("{n} {what}"));
+        }
+    };
+    add(crossing, "crossing pairs");
+    add(touching, "touching pairs");
+    add(h.boundary_edges.count, "boundary edges");
+    add(h.non_manifold_edges.count, "non-manifold edges");
+    add(h.non_manifold_vertices.count, "non-manifold vertices");
+    add(h.duplicate_faces.count, "duplicate faces");
+    add(h.zero_area_triangles.count, "zero-area triangles");
+    add(h.inconsistent_winding_edges.count, "inconsistent winding edges");
+    if h.volume.is_some_and(|x| x < 0.0) {
+        v.push("negative volume (inside out)".into());
+    }
+    v
+}
+
+/// How many parts with findings the scene summary names.
+const SCENE_TEXT_PARTS: usize = 5;
+
+/// The summary lines of the `self` block (for the scene's text summary): the verdict and
+/// counts, the health sums and the first parts with findings; each line starts with two spaces.
+pub fn scene_text(x: &SceneSelfReport) -> String {
+    use std::fmt::Write;
+    let s = &x.summary;
+    let mut out = String::new();
+    let _ = writeln!(
+        out,
+        "  self: {} — {} crossing, {} touching self-clash pairs in {} of {} part(s){}",
+        x.verdict,
+        s.crossing_pairs,
+        s.touching_pairs,
+        s.parts_with_self_clash,
+        s.parts,
+        if x.failed { format!(" — FAILED on {}", x.failed_on.join(", ")) } else { String::new() }
+    );
+    let _ = writeln!(
+        out,
+        "  self health: {} open part(s), {} boundary edges, {} non-manifold edges, {} non-manifold vertices, \
+         {} duplicate faces, {} zero-area triangles, {} inconsistent winding edges",
+        s.open_parts,
+        s.boundary_edges,
+        s.non_manifold_edges,
+        s.non_manifold_vertices,
+        s.duplicate_faces,
+        s.zero_area_triangles,
+        s.inconsistent_winding_edges
+    );
+    let listed: Vec<(&SceneSelfPart, Vec<String>)> = x
+        .parts
+        .iter()
+        .map(|p| (p, part_problems(p.crossing_pairs, p.touching_pairs, &p.health)))
+        .filter(|(_, v)| !v.is_empty())
+        .collect();
+    for (p, v) in listed.iter().take(SCENE_TEXT_PARTS) {
+        let _ = writeln!(out, "    {}: {}", p.name, v.join(", "));
+    }
+    if listed.len() > SCENE_TEXT_PARTS {
+        let _ = writeln!(out, "    … and {} more parts with findings", listed.len() - SCENE_TEXT_PARTS);
+    }
+    out
+}
+
+/// JUnit cases of the `self` block: one per part with a finding (a self-clash pair or any
+/// health finding), named `<part> (self)`, failed when the part meets a `fail_on` condition.
+pub fn scene_junit_cases(x: &SceneSelfReport) -> Vec<crate::output::junit::Case> {
+    use crate::output::junit::{Case, FIRST};
+    let fail_on: Vec<SelfFailOn> = x.fail_on.iter().filter_map(|n| SelfFailOn::from_name(n)).collect();
+    x.parts
+        .iter()
+        .filter_map(|p| {
+            let problems = part_problems(p.crossing_pairs, p.touching_pairs, &p.health);
+            if problems.is_empty() {
+                return None;
+            }
+            let mut findings: Vec<String> = x
+                .pairs
+                .iter()
+                .filter(|q| q.a_object == p.object)
+                .take(FIRST)
+                .map(|q| {
+                    format!(
+                        "triangles {} × {}: {} ({})",
+                        q.a,
+                        q.b,
+                        q.kind,
+                        q.contact.map_or("-", ReportContact::name)
+                    )
+                })
+                .collect();
+            let h = &p.health;
+            let mut health_kinds = 0; // one line per kind of health finding
+            for (what, f) in [
+                ("boundary edges", &h.boundary_edges),
+                ("non-manifold edges", &h.non_manifold_edges),
+                ("non-manifold vertices", &h.non_manifold_vertices),
+                ("duplicate faces", &h.duplicate_faces),
+                ("zero-area triangles", &h.zero_area_triangles),
+                ("inconsistent winding edges", &h.inconsistent_winding_edges),
+            ] {
+                if f.count > 0 {
+                    health_kinds += 1;
+                    findings.push(format!("{} {what}, first triangles {:?}", f.count, f.triangles));
+                }
+            }
+            let verdict = if p.crossing_pairs > 0 {
+                "clash"
+            } else if p.touching_pairs > 0 {
+                "touching"
+            } else {
+                "clear"
+            };
+            Some(Case {
+                name: format!("{} (self)", p.name),
+                verdict: verdict.into(),
+                counts: format!(
+                    "{} crossing, {} touching self-clash pairs; {}",
+                    p.crossing_pairs,
+                    p.touching_pairs,
+                    if h.closed { "closed" } else { "open" }
+                ),
+                total: p.crossing_pairs + p.touching_pairs + health_kinds,
+                findings,
+                failed: fail_on.iter().any(|f| f.met(p.crossing_pairs, p.touching_pairs, &p.health)),
+                time_s: 0.0,
+                output: String::new(),
+            })
+        })
+        .collect()
+}
+
+/// Attach the `self` block to a finished scene report: `rep.failed` also becomes true when the
+/// block fails. Parts are those the selection checks (`--select-a`, `--select-b`, `--exclude`).
+pub fn attach_scene_self(
+    rep: &mut crate::report::Report,
+    mesh: &crate::scene::mesh::Mesh,
+    sel: &crate::check::assembly::Selection,
+    opts: crate::bvh::BuildOptions,
+    fail_on: &[SelfFailOn],
+    max_pairs: usize,
+    deterministic: bool,
+) {
+    use crate::check::assembly::glob_match;
+    let keep = |name: &str| {
+        let any = |g: &[String]| g.iter().any(|p| glob_match(p, name));
+        !any(&sel.exclude) && (sel.select_a.is_empty() || any(&sel.select_a) || any(&sel.select_b))
+    };
+    let block = scene_self(mesh, &keep, opts, fail_on, max_pairs, deterministic);
+    rep.failed |= block.failed;
+    rep.self_check = Some(block);
 }

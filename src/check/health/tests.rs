@@ -146,3 +146,43 @@ fn cubes_sharing_an_edge_have_one_non_manifold_edge_and_lists_are_capped() {
     assert!(!h.closed);
     assert_eq!(h.boundary_edges.count, 0);
 }
+
+/// A small part of a large mesh has sparse vertex ids (the comparison-sort path of the edge
+/// sort); its health is the same as that of the part copied out on its own (dense ids, the
+/// counting-sort path), triangle ids aside.
+#[test]
+fn sparse_and_dense_edge_sorts_agree() {
+    let mut m = Mesh::default();
+    for k in 0..40 {
+        cube(&mut m, [3.0 * k as f64, 0.0, 0.0]);
+    }
+    // Make the last cube open and non-manifold: drop a triangle, add a fin on an edge.
+    let last = m.triangles.len() - 1;
+    m.triangles.remove(last);
+    m.tri_object.pop();
+    let fin = m.positions.len() as u32;
+    m.positions.push(DVec3::new(3.0 * 39.0 + 0.5, -1.0, 0.5));
+    let e = m.triangles[m.triangles.len() - 11]; // the last cube's first triangle
+    m.triangles.push([e[0], e[1], fin]);
+    m.tri_object.push(0);
+    m.objects.push(Object { name: "m".into(), ..Default::default() });
+    let part: Vec<u32> = ((m.triangles.len() - 12) as u32..m.triangles.len() as u32).collect();
+    let (merged, _) = crate::scene::bodies::merge_vertices(&m.positions);
+    let sparse = health(&m, &merged, &part, 100);
+    let alone = m.sub_mesh(&part);
+    let (merged2, _) = crate::scene::bodies::merge_vertices(&alone.positions);
+    let all: Vec<u32> = (0..alone.triangles.len() as u32).collect();
+    let dense = health(&alone, &merged2, &all, 100);
+    let shift = |f: &Finding| f.triangles.iter().map(|&t| t + part[0]).collect::<Vec<u32>>();
+    assert_eq!((sparse.closed, dense.closed), (false, false));
+    for (s, d) in [
+        (&sparse.boundary_edges, &dense.boundary_edges),
+        (&sparse.non_manifold_edges, &dense.non_manifold_edges),
+        (&sparse.inconsistent_winding_edges, &dense.inconsistent_winding_edges),
+        (&sparse.non_manifold_vertices, &dense.non_manifold_vertices),
+    ] {
+        assert_eq!((s.count, s.triangles.clone()), (d.count, shift(d)));
+    }
+    assert!(sparse.boundary_edges.count > 0 && sparse.non_manifold_edges.count > 0);
+    assert_eq!(sparse.boundary_loops, dense.boundary_loops);
+}

@@ -293,3 +293,72 @@ fn a_tube_swept_along_a_figure_eight_overlaps_itself_only_at_the_crossing() {
     // A thinner tube still crosses itself there.
     assert!(pairs(&gen::figure_eight_tube(u, v, 0.02)).iter().any(|p| p.2));
 }
+
+#[test]
+fn exact_translation_holds_only_when_every_sum_is_exact() {
+    use crate::geom::predicates::exact_translation;
+    let a = [DVec3::new(0.5, 1.25, -3.0), DVec3::new(1.0, 2.0, 4.0)];
+    let t = DVec3::new(1000.0, -0.25, 8.0);
+    let b: Vec<DVec3> = a.iter().map(|&p| p + t).collect();
+    assert_eq!(exact_translation(&a, &b), Some(t));
+    // 0.1 + 0.2 rounds: b is not an exact translate of a although each b[i] = fl(a[i] + t).
+    let (a, t) = ([DVec3::splat(0.1), DVec3::splat(1.0)], DVec3::splat(0.2));
+    let b: Vec<DVec3> = a.iter().map(|&p| p + t).collect();
+    assert_eq!(exact_translation(&a, &b), None);
+    // Different offsets, lengths, nothing.
+    let a = [DVec3::ZERO, DVec3::ONE];
+    assert_eq!(exact_translation(&a, &[DVec3::ONE, DVec3::splat(3.0)]), None);
+    assert_eq!(exact_translation(&a, &a[..1]), None);
+    assert_eq!(exact_translation(&[], &[]), None);
+}
+
+/// Three instances of one folded strip (one glTF mesh): the original, an exact translate and a
+/// copy turned by 30° about z (rounded). With reuse the translate takes over the original's
+/// result and the turned copy is checked itself; every result equals a separate check.
+#[test]
+fn instances_reuse_only_exact_translates_and_give_the_same_results() {
+    let strip = [
+        [0., 0., 0.],
+        [0., 1., 0.],
+        [2., 0., 0.],
+        [2., 1., 0.],
+        [1., 0., 1.],
+        [1., 1., 1.],
+        [1., 0., -1.],
+        [1., 1., -1.],
+    ];
+    let f = [[0u32, 2, 3], [0, 3, 1], [2, 4, 5], [2, 5, 3], [4, 5, 7], [4, 7, 6]];
+    let (c, s) = (30f64.to_radians().cos(), 30f64.to_radians().sin());
+    let place: [Box<dyn Fn([f64; 3]) -> DVec3>; 3] = [
+        Box::new(DVec3::from_array),
+        Box::new(|p| DVec3::from_array(p) + DVec3::new(16.0, 0.5, -2.0)),
+        Box::new(move |p| DVec3::new(c * p[0] - s * p[1] + 40.0, s * p[0] + c * p[1], p[2])),
+    ];
+    let mut m = Mesh::default();
+    for (k, at) in place.iter().enumerate() {
+        let base = m.positions.len() as u32;
+        m.positions.extend(strip.iter().map(|&p| at(p)));
+        m.triangles.extend(f.iter().map(|t| t.map(|i| base + i)));
+        m.tri_object.extend([k as u32; 6]);
+        m.objects.push(Object { name: format!("strip{k}"), gltf_mesh: Some(7), ..Default::default() });
+    }
+    let specs = || -> Vec<PartSpec> {
+        crate::check::assembly::parts_of(&m, 0)
+            .into_iter()
+            .map(|p| (Some(p.object), p.name, p.triangles))
+            .collect()
+    };
+    let (with, _, _) = check_part_list(&m, specs(), BuildOptions::default(), 10, true);
+    let (without, _, _) = check_part_list(&m, specs(), BuildOptions::default(), 10, false);
+    assert_eq!(with.iter().map(|p| p.same_as).collect::<Vec<_>>(), [None, Some(0), None]);
+    assert!(without.iter().all(|p| p.same_as.is_none()));
+    for (x, y) in with.iter().zip(&without) {
+        assert_eq!((&x.pairs, &x.health, x.crossing), (&y.pairs, &y.health, y.crossing), "{}", x.name);
+    }
+    assert_eq!(
+        with[1].pairs.iter().map(|q| (q.a, q.b)).collect::<Vec<_>>(),
+        [(6, 10), (6, 11), (7, 10), (7, 11)] // the original's (0, 4), (0, 5), (1, 4), (1, 5), shifted by 6
+    );
+    assert_eq!(with[0].crossing, with[1].crossing);
+    assert!(with[1].crossing > 0);
+}
