@@ -134,7 +134,7 @@ pub fn cases(r: &Report) -> Vec<Case> {
         cases.extend(part_pair_cases(r));
     }
     if let Some(x) = &r.self_check {
-        cases.extend(crate::report::self_report::scene_junit_cases(x));
+        cases.extend(scene_junit_cases(x));
     }
     cases
 }
@@ -187,6 +187,75 @@ fn part_pair_cases(r: &Report) -> Vec<Case> {
 /// The JUnit XML of a report.
 pub fn from_report(r: &Report) -> String {
     render("meshclash", &cases(r))
+}
+
+/// JUnit cases of the `self` block: one per part with a finding (a self-clash pair or any
+/// health finding), named `<part> (self)`, failed when the part meets a `fail_on` condition.
+pub fn scene_junit_cases(x: &crate::report::self_report::SceneSelfReport) -> Vec<Case> {
+    use crate::report::self_report::{part_problems, SelfFailOn};
+    use crate::report::ReportContact;
+    let fail_on: Vec<SelfFailOn> = x.fail_on.iter().filter_map(|n| SelfFailOn::from_name(n)).collect();
+    x.parts
+        .iter()
+        .filter_map(|p| {
+            let problems = part_problems(p.crossing_pairs, p.touching_pairs, &p.health);
+            if problems.is_empty() {
+                return None;
+            }
+            let mut findings: Vec<String> = x
+                .pairs
+                .iter()
+                .filter(|q| q.a_object == p.object)
+                .take(FIRST)
+                .map(|q| {
+                    format!(
+                        "triangles {} × {}: {} ({})",
+                        q.a,
+                        q.b,
+                        q.kind,
+                        q.contact.map_or("-", ReportContact::name)
+                    )
+                })
+                .collect();
+            let h = &p.health;
+            let mut health_kinds = 0; // one line per kind of health finding
+            for (what, f) in [
+                ("boundary edges", &h.boundary_edges),
+                ("non-manifold edges", &h.non_manifold_edges),
+                ("non-manifold vertices", &h.non_manifold_vertices),
+                ("duplicate faces", &h.duplicate_faces),
+                ("zero-area triangles", &h.zero_area_triangles),
+                ("inconsistent winding edges", &h.inconsistent_winding_edges),
+            ] {
+                if f.count > 0 {
+                    health_kinds += 1;
+                    findings.push(format!("{} {what}, first triangles {:?}", f.count, f.triangles));
+                }
+            }
+            let verdict = if p.crossing_pairs > 0 {
+                "clash"
+            } else if p.touching_pairs > 0 {
+                "touching"
+            } else {
+                "clear"
+            };
+            Some(Case {
+                name: format!("{} (self)", p.name),
+                verdict: verdict.into(),
+                counts: format!(
+                    "{} crossing, {} touching self-clash pairs; {}",
+                    p.crossing_pairs,
+                    p.touching_pairs,
+                    if h.closed { "closed" } else { "open" }
+                ),
+                total: p.crossing_pairs + p.touching_pairs + health_kinds,
+                findings,
+                failed: fail_on.iter().any(|f| f.met(p.crossing_pairs, p.touching_pairs, &p.health)),
+                time_s: 0.0,
+                output: String::new(),
+            })
+        })
+        .collect()
 }
 
 #[cfg(test)]

@@ -657,8 +657,7 @@ pub fn scene_self(
         .iter()
         .map(|&i| (Some(all[i].object), all[i].name.clone(), all[i].triangles.clone()))
         .collect();
-    let (results, _, _) =
-        crate::check::self_clash::check_part_list(mesh, specs, opts, crate::output::junit::FIRST, true);
+    let (results, _, _) = crate::check::self_clash::check_part_list(mesh, specs, opts, SCENE_FIRST_N, true);
     let (pairs, pairs_truncated) = pairs_of(mesh, &results, max_pairs);
     let summary = summary_of(&results);
     let failed_on: Vec<SelfFailOn> =
@@ -692,7 +691,7 @@ pub fn scene_self(
 }
 
 /// What is wrong with one part, for a person: `3 crossing pairs, 12 boundary edges, ...`.
-fn part_problems(crossing: u64, touching: u64, h: &HealthReport) -> Vec<String> {
+pub fn part_problems(crossing: u64, touching: u64, h: &HealthReport) -> Vec<String> {
     let mut v = Vec::new();
     let mut add = |n: u64, what: &str| {
         if n > 0 {
@@ -712,6 +711,9 @@ fn part_problems(crossing: u64, touching: u64, h: &HealthReport) -> Vec<String> 
     }
     v
 }
+
+/// Triangle ids listed per health finding of a part in a scene's `self` block.
+pub const SCENE_FIRST_N: usize = 10;
 
 /// How many parts with findings the scene summary names.
 const SCENE_TEXT_PARTS: usize = 5;
@@ -757,74 +759,6 @@ pub fn scene_text(x: &SceneSelfReport) -> String {
         let _ = writeln!(out, "    … and {} more parts with findings", listed.len() - SCENE_TEXT_PARTS);
     }
     out
-}
-
-/// JUnit cases of the `self` block: one per part with a finding (a self-clash pair or any
-/// health finding), named `<part> (self)`, failed when the part meets a `fail_on` condition.
-pub fn scene_junit_cases(x: &SceneSelfReport) -> Vec<crate::output::junit::Case> {
-    use crate::output::junit::{Case, FIRST};
-    let fail_on: Vec<SelfFailOn> = x.fail_on.iter().filter_map(|n| SelfFailOn::from_name(n)).collect();
-    x.parts
-        .iter()
-        .filter_map(|p| {
-            let problems = part_problems(p.crossing_pairs, p.touching_pairs, &p.health);
-            if problems.is_empty() {
-                return None;
-            }
-            let mut findings: Vec<String> = x
-                .pairs
-                .iter()
-                .filter(|q| q.a_object == p.object)
-                .take(FIRST)
-                .map(|q| {
-                    format!(
-                        "triangles {} × {}: {} ({})",
-                        q.a,
-                        q.b,
-                        q.kind,
-                        q.contact.map_or("-", ReportContact::name)
-                    )
-                })
-                .collect();
-            let h = &p.health;
-            let mut health_kinds = 0; // one line per kind of health finding
-            for (what, f) in [
-                ("boundary edges", &h.boundary_edges),
-                ("non-manifold edges", &h.non_manifold_edges),
-                ("non-manifold vertices", &h.non_manifold_vertices),
-                ("duplicate faces", &h.duplicate_faces),
-                ("zero-area triangles", &h.zero_area_triangles),
-                ("inconsistent winding edges", &h.inconsistent_winding_edges),
-            ] {
-                if f.count > 0 {
-                    health_kinds += 1;
-                    findings.push(format!("{} {what}, first triangles {:?}", f.count, f.triangles));
-                }
-            }
-            let verdict = if p.crossing_pairs > 0 {
-                "clash"
-            } else if p.touching_pairs > 0 {
-                "touching"
-            } else {
-                "clear"
-            };
-            Some(Case {
-                name: format!("{} (self)", p.name),
-                verdict: verdict.into(),
-                counts: format!(
-                    "{} crossing, {} touching self-clash pairs; {}",
-                    p.crossing_pairs,
-                    p.touching_pairs,
-                    if h.closed { "closed" } else { "open" }
-                ),
-                total: p.crossing_pairs + p.touching_pairs + health_kinds,
-                findings,
-                failed: fail_on.iter().any(|f| f.met(p.crossing_pairs, p.touching_pairs, &p.health)),
-                time_s: 0.0,
-                output: String::new(),
-            })
-        })
-        .collect()
 }
 
 /// Attach the `self` block to a finished scene report: `rep.failed` also becomes true when the
