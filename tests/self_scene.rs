@@ -185,3 +185,28 @@ fn engine_self_block_matches_meshclash_self_and_threads() {
         assert!(p.same_as.unwrap() < p.part);
     }
 }
+
+/// `--fail-on new` replaced the run's failure with the baseline comparison alone, so a
+/// `--self-fail-on` condition of `scene --self` no longer failed the run.
+#[test]
+fn fail_on_new_keeps_a_failing_self_block_failing() {
+    let engine =
+        std::path::PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../shared/meshes/2CylinderEngine.glb");
+    let dir = tempfile::tempdir().unwrap();
+    let base = dir.path().join("base.json");
+    let run = |extra: &[&str]| {
+        assert_cmd::Command::cargo_bin("meshclash")
+            .unwrap()
+            .arg("scene")
+            .arg(&engine)
+            .args(["--self", "--self-fail-on", "degenerate", "--no-timings", "-q"])
+            .args(extra)
+            .output()
+            .unwrap()
+    };
+    // The baseline is the same run: nothing new, but the engine has zero-area triangles.
+    let first = run(&["--fail-on", "never", "-o", base.to_str().unwrap()]);
+    assert_eq!(first.status.code(), Some(1), "zero-area triangles fail under --self-fail-on degenerate");
+    let again = run(&["--baseline", base.to_str().unwrap(), "--fail-on", "new"]);
+    assert_eq!(again.status.code(), Some(1), "{}", String::from_utf8_lossy(&again.stderr));
+}

@@ -127,3 +127,34 @@ fn text_summary_names_clashing_part_pairs_candidates_and_first_hit_lower_bounds(
     let t = text_of(&["scene".as_ref(), scene.as_os_str(), "--first-hit".as_ref()]);
     assert!(t.contains("at least 1 crossing") && t.contains("lower bounds"), "{t}");
 }
+
+/// Closedness, containment and volume overlap were decided per input: `Box.glb` is an exact
+/// copy of one of the two cubes of `shared.STL`, and with `--split-bodies` the check said
+/// `touching` (exit 0) where the same cube saved alone gives `clash` (`volumes_overlap`). They
+/// are now decided per part pair in file mode too, and the pair is listed in `part_pairs`.
+#[test]
+fn duplicated_body_inside_a_multi_part_file_is_a_clash_per_part() {
+    let run = |args: &[&std::ffi::OsStr]| {
+        let out = Command::cargo_bin("meshclash").unwrap().args(args).arg("--no-timings").output().unwrap();
+        let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+        (out.status.code(), v)
+    };
+    let (boxes, shared_stl) = (shared("Box.glb"), shared("shared.STL"));
+    let (code, r) = run(&[boxes.as_os_str(), shared_stl.as_os_str(), "--split-bodies".as_ref()]);
+    assert_eq!(code, Some(1), "{r}");
+    assert_eq!(r["verdict"], "clash");
+    assert_eq!(r["summary"]["contained"], "volumes_overlap");
+    assert_eq!(r["summary"]["crossing_pairs"], 0);
+    let pp = r["part_pairs"].as_array().unwrap();
+    let dup: Vec<_> = pp.iter().filter(|p| p["contained"] == "volumes_overlap").collect();
+    assert_eq!(dup.len(), 1, "{pp:?}");
+    assert_eq!(dup[0]["verdict"], "clash");
+    // The other body only touches the box along shared faces with opposite normals.
+    assert!(pp.iter().any(|p| p["verdict"] == "touching" && p["contained"].is_null()), "{pp:?}");
+    // The same answer as the cube against itself, and as the scene check of the bodies.
+    let (code_alone, alone) = run(&[boxes.as_os_str(), boxes.as_os_str()]);
+    assert_eq!(
+        (code_alone, &alone["summary"]["contained"]),
+        (Some(1), &serde_json::json!("volumes_overlap"))
+    );
+}

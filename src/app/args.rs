@@ -268,7 +268,7 @@ pub struct OutputArgs {
     /// a WebGL viewer of the parts involved (no network needed to open it).
     #[arg(long, value_name = "FILE")]
     pub html: Option<PathBuf>,
-    /// Write the clashes as BCF 2.1 topics to FILE (.bcfzip), for BIM tools: one topic per
+    /// Write the clashes as BCF topics to FILE (.bcfzip; 2.1 or 3.0: --bcf-version), for BIM tools: one topic per
     /// clash region or part pair (--bcf-topics), with a camera, the parts and the witness line.
     #[arg(long, value_name = "FILE")]
     pub bcf: Option<PathBuf>,

@@ -821,8 +821,9 @@ fn run_checked(a: &Mesh, b: &Mesh, sel: &Selection, settings: &Settings) -> Resu
         return o;
     }
     if !sel.by_parts() {
-        let result = crate::check::query::check(a, b, settings);
-        let part_pairs = group_by_part(&parts, a, b, &result);
+        let mut result = crate::check::query::check(a, b, settings);
+        let mut part_pairs = group_by_part(&parts, a, b, &result);
+        per_part_containment(&parts, a, b, &mut result, &mut part_pairs, settings);
         let info = AssemblyInfo {
             mode: "files",
             selected: [sa.len(), sb.len()],
@@ -892,6 +893,57 @@ fn run_checked(a: &Mesh, b: &Mesh, sel: &Selection, settings: &Settings) -> Resu
         timings: crate::check::query::Timings { build_ms: ar.build_ms, query_ms: ar.query_ms },
     };
     Ok(Outcome { result, parts: ar.parts, part_pairs, info })
+}
+
+/// File mode with a file of several parts (objects, or bodies with `--split-bodies`), when no
+/// pair crosses: closedness, outward winding, containment and face-to-face volume overlap are
+/// decided per part pair, as scene mode decides them, not per file. A part duplicated inside a
+/// multi-part file (its faces coinciding with the other file's part, outward normals agreeing)
+/// or hidden inside one closed part of a file whose other parts are open is a clash like the
+/// same part alone; such a pair is listed in `part_pairs` even when no triangles meet. The
+/// file-level containment stands when it already is a clash.
+fn per_part_containment(
+    parts: &[Part],
+    a: &Mesh,
+    b: &Mesh,
+    result: &mut ClashResult,
+    part_pairs: &mut Vec<PartPairSummary>,
+    settings: &Settings,
+) {
+    let side = |input: u8| (0..parts.len()).filter(|&i| parts[i].input == input).collect::<Vec<_>>();
+    let (sa, sb) = (side(0), side(1));
+    if (sa.len() <= 1 && sb.len() <= 1) || result.counts.crossing > 0 || settings.first_hit {
+        return;
+    }
+    let ar = check_parts([a, b], parts.to_vec(), &sa, &sb, Pairing::Cross, settings);
+    let mut first: Option<Containment> = None;
+    for pp in ar.part_pairs.iter().filter(|pp| pp.result.containment.is_clash()) {
+        let c = pp.result.containment.clone();
+        first.get_or_insert_with(|| c.clone());
+        match part_pairs.iter_mut().find(|s| (s.a, s.b) == (pp.a, pp.b)) {
+            Some(s) => {
+                s.containment = c;
+                s.verdict = Verdict::Clash;
+            }
+            None => part_pairs.push(PartPairSummary {
+                a: pp.a,
+                b: pp.b,
+                verdict: Verdict::Clash,
+                counts: pp.result.counts,
+                min_distance: pp.result.closest.map(|c| c.distance),
+                containment: c,
+                closest: pp.result.closest,
+                pairs: Vec::new(),
+            }),
+        }
+    }
+    part_pairs.sort_by_key(|s| (s.a, s.b));
+    if let Some(c) = first {
+        if !result.containment.is_clash() {
+            result.containment = c;
+        }
+        result.verdict = Verdict::Clash;
+    }
 }
 
 /// File mode: group the pairs of a whole-file check by the parts they belong to (also used by

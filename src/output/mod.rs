@@ -83,7 +83,10 @@ pub fn finish(
     }
     if opts.fail_on_new {
         rep.settings.fail_on = "new".into();
-        rep.failed = rep.baseline.as_ref().is_some_and(baseline::fails_on_new);
+        // `--fail-on new` replaces the verdict's condition; a failing `self` block (scene --self,
+        // its own --self-fail-on) still fails the run.
+        rep.failed = rep.baseline.as_ref().is_some_and(baseline::fails_on_new)
+            || rep.self_check.as_ref().is_some_and(|s| s.failed);
     }
     if let Some(path) = &opts.junit {
         staged.stage(path, junit::from_report(rep).as_bytes())?;
