@@ -366,3 +366,118 @@ fn report_is_streamed_not_held_as_text() {
         );
     }
 }
+
+/// Issue 11 item 7: a scene of thousands of one-triangle parts stacked in one place made every
+/// pair of them a candidate, collected into one vector first (2^20 such nodes needed 4 GiB and
+/// aborted). Beyond `MAX_CANDIDATE_PART_PAIRS` the scene is refused with exit 2 naming the file,
+/// before any pair is collected; under the cap the same construction runs.
+#[test]
+fn stacked_parts_beyond_the_candidate_pair_cap_are_refused_not_collected() {
+    use base64::Engine;
+    // One triangle (f32 positions, u16 indices), placed by `n` nodes at the same spot.
+    let stacked = |n: usize| -> Vec<u8> {
+        let mut buf: Vec<u8> = [[0f32, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]]
+            .iter()
+            .flatten()
+            .flat_map(|x| x.to_le_bytes())
+            .collect();
+        buf.extend([0u16, 1, 2, 0].iter().flat_map(|i| i.to_le_bytes()));
+        let data = base64::engine::general_purpose::STANDARD.encode(&buf);
+        let nodes: Vec<String> = (0..n).map(|i| format!(r#"{{"name":"p{i}","mesh":0}}"#)).collect();
+        format!(
+            r#"{{"asset":{{"version":"2.0"}},"scene":0,"scenes":[{{"nodes":{:?}}}],"nodes":[{}],
+"meshes":[{{"primitives":[{{"attributes":{{"POSITION":0}},"indices":1}}]}}],
+"buffers":[{{"byteLength":44,"uri":"data:application/octet-stream;base64,{data}"}}],
+"bufferViews":[{{"buffer":0,"byteOffset":0,"byteLength":36}},{{"buffer":0,"byteOffset":36,"byteLength":6}}],
+"accessors":[{{"bufferView":0,"componentType":5126,"count":3,"type":"VEC3","min":[0,0,0],"max":[1,1,0]}},
+{{"bufferView":1,"componentType":5123,"count":3,"type":"SCALAR"}}]}}"#,
+            (0..n).collect::<Vec<_>>(),
+            nodes.join(",")
+        )
+        .into_bytes()
+    };
+    let cap = meshclash::check::assembly::MAX_CANDIDATE_PART_PAIRS;
+    let d = tree();
+    // 4,200 parts: 8,817,900 pairs, just over the cap (2^23 = 8,388,608).
+    let over = d.path().join("stacked.gltf");
+    std::fs::write(&over, stacked(4_200)).unwrap();
+    assert!(4_200 * 4_199 / 2 > cap);
+    let (code, err) = under_memory_limit(1 << 20, &["scene", s(&over), "--no-timings", "-o", "/dev/null"]);
+    assert!(!err.contains("memory allocation"), "aborted: {err}");
+    assert_eq!(code, Some(2), "{err}");
+    assert!(err.contains(s(&over)) && err.contains("candidate part pairs"), "{err}");
+    assert_eq!(err.trim_end().lines().count(), 1, "{err}");
+    // Under the cap: the same stack of 300 parts is checked (every pair touches: exit 0).
+    let under = d.path().join("small_stack.gltf");
+    std::fs::write(&under, stacked(300)).unwrap();
+    let out = bin().args(["scene", s(&under), "--no-timings", "--max-pairs", "0"]).output().unwrap();
+    assert_eq!(out.status.code(), Some(0), "{}", String::from_utf8_lossy(&out.stderr));
+}
+
+/// Issue 11 item 9: a small glTF placing one mesh on many nodes asked for more memory than the
+/// machine has (one 1M-triangle mesh on 250 nodes: 249.9M triangles, within the triangle cap)
+/// and aborted. The loader now estimates what the check of the scene needs after instancing
+/// (`load::CHECK_BYTES_PER_TRIANGLE`) against the memory this process may use and refuses
+/// with exit 2 before expanding anything; a scene that fits loads as before.
+#[test]
+fn instanced_scene_beyond_available_memory_is_refused_before_expanding() {
+    use base64::Engine;
+    // A strip of 20,000 triangles, placed by `n` nodes 0.5 apart in z.
+    let placed = |n: usize| -> Vec<u8> {
+        let quads = 10_000u32;
+        let mut buf: Vec<u8> = Vec::new();
+        for i in 0..=quads {
+            for y in [0f32, 1.0] {
+                buf.extend([i as f32, y, 0.0].iter().flat_map(|x| x.to_le_bytes()));
+            }
+        }
+        let pos_len = buf.len();
+        for i in 0..quads {
+            let v = 2 * i;
+            buf.extend([v, v + 2, v + 1, v + 1, v + 2, v + 3].iter().flat_map(|x| x.to_le_bytes()));
+        }
+        let idx_len = buf.len() - pos_len;
+        let data = base64::engine::general_purpose::STANDARD.encode(&buf);
+        let nodes: Vec<String> = (0..n)
+            .map(|i| format!(r#"{{"name":"p{i}","mesh":0,"translation":[0,0,{}]}}"#, i as f64 * 0.5))
+            .collect();
+        format!(
+            r#"{{"asset":{{"version":"2.0"}},"scene":0,"scenes":[{{"nodes":{:?}}}],"nodes":[{}],
+"meshes":[{{"primitives":[{{"attributes":{{"POSITION":0}},"indices":1}}]}}],
+"buffers":[{{"byteLength":{},"uri":"data:application/octet-stream;base64,{data}"}}],
+"bufferViews":[{{"buffer":0,"byteOffset":0,"byteLength":{pos_len}}},{{"buffer":0,"byteOffset":{pos_len},"byteLength":{idx_len}}}],
+"accessors":[{{"bufferView":0,"componentType":5126,"count":{},"type":"VEC3","min":[0,0,0],"max":[{quads},1,0]}},
+{{"bufferView":1,"componentType":5125,"count":{},"type":"SCALAR"}}]}}"#,
+            (0..n).collect::<Vec<_>>(),
+            nodes.join(","),
+            buf.len(),
+            2 * (quads + 1),
+            6 * quads
+        )
+        .into_bytes()
+    };
+    let d = tree();
+    // 13,000 placements: 260M triangles (under the 2^28 cap), ~26 GB to check.
+    let big = d.path().join("many_placements.gltf");
+    std::fs::write(&big, placed(13_000)).unwrap();
+    let good = root().join("meshes/fcl_rob.obj");
+    for args in [vec!["scene", s(&big)], vec![s(&good), s(&big)]] {
+        for limited in [false, true] {
+            let (code, err) = if limited {
+                under_memory_limit(1 << 20, &args)
+            } else {
+                let out = bin().args(&args).output().unwrap();
+                (out.status.code(), String::from_utf8_lossy(&out.stderr).into_owned())
+            };
+            assert!(!err.contains("memory allocation"), "aborted: {err}");
+            assert_eq!(code, Some(2), "{args:?}: {err}");
+            assert!(err.contains(s(&big)) && err.contains("260000000 triangles after instancing"), "{err}");
+            assert_eq!(err.trim_end().lines().count(), 1, "{err}");
+        }
+    }
+    // Two placements (40,000 triangles) load and check under the same 1 GiB limit.
+    let small = d.path().join("two_placements.gltf");
+    std::fs::write(&small, placed(2)).unwrap();
+    let (code, err) = under_memory_limit(1 << 20, &["scene", s(&small), "--no-timings", "-o", "/dev/null"]);
+    assert_eq!(code, Some(0), "{err}");
+}

@@ -835,6 +835,13 @@ fn run_checked(a: &Mesh, b: &Mesh, sel: &Selection, settings: &Settings) -> Resu
         return Ok(Outcome { result, parts, part_pairs, info });
     }
     let pairing = if sel.scene && sel.select_b.is_empty() { Pairing::AllVsAll } else { Pairing::Cross };
+    if candidates_exceed(&parts, &sa, &sb, pairing, settings, MAX_CANDIDATE_PART_PAIRS) {
+        return Err(format!(
+            "more than {MAX_CANDIDATE_PART_PAIRS} candidate part pairs (parts whose boxes come within the search \
+             margin of each other), the most meshclash checks in one run: narrow it with \
+             --select-a/--select-b/--exclude, or shard it (meshclash plan)"
+        ));
+    }
     let keep = |x, y| sel.hook.as_ref().is_none_or(|h| h.0.keep(x, y));
     let ar = check_parts_kept([a, if sel.scene { a } else { b }], parts, &sa, &sb, pairing, settings, &keep);
     let mut pairs_seen = std::collections::HashSet::new();
@@ -893,6 +900,56 @@ fn run_checked(a: &Mesh, b: &Mesh, sel: &Selection, settings: &Settings) -> Resu
         timings: crate::check::query::Timings { build_ms: ar.build_ms, query_ms: ar.query_ms },
     };
     Ok(Outcome { result, parts: ar.parts, part_pairs, info })
+}
+
+/// The most candidate part pairs (part boxes within the search margin of each other) one run
+/// checks. Each costs its result (a few hundred bytes, more with findings) until the report is
+/// written, so 2^23 pairs keep a scene within a few GB; a scene beyond it (a million parts
+/// stacked in one place, say) is refused with exit 2 before any pair is collected, instead of
+/// exhausting memory.
+pub const MAX_CANDIDATE_PART_PAIRS: usize = 1 << 23;
+
+/// Would the broad phase of `sel_a` against `sel_b` find more than `cap` candidate part pairs?
+/// A counting walk over the part boxes that stops as soon as the count passes `cap` and keeps
+/// nothing.
+fn candidates_exceed(
+    parts: &[Part],
+    sel_a: &[usize],
+    sel_b: &[usize],
+    pairing: Pairing,
+    settings: &Settings,
+    cap: usize,
+) -> bool {
+    use std::sync::atomic::{AtomicUsize, Ordering};
+    // Cheap bound first: fewer possible pairs than the cap cannot exceed it.
+    if sel_a.len().saturating_mul(sel_b.len()) <= cap {
+        return false;
+    }
+    let tol = settings.tolerances;
+    let boxes = |sel: &[usize]| sel.iter().map(|&i| parts[i].bounds).collect::<Vec<_>>();
+    let opts = BuildOptions { leaf_size: 1, ..settings.bvh };
+    let (ba, bb) = (Bvh::build_from_boxes(&boxes(sel_a), opts), Bvh::build_from_boxes(&boxes(sel_b), opts));
+    let count = AtomicUsize::new(0);
+    let _: Vec<()> = traverse::collect_pairs(
+        &ba,
+        &bb,
+        |x, y| count.load(Ordering::Relaxed) <= cap && tol.boxes_may_meet(x, y),
+        |la, lb, _| {
+            let mut n = 0;
+            for &i in la {
+                for &j in lb {
+                    let (pa, pb) = (sel_a[i as usize], sel_b[j as usize]);
+                    let counted = match pairing {
+                        Pairing::Cross => true,
+                        Pairing::AllVsAll => pa < pb,
+                    };
+                    n += (counted && tol.boxes_may_meet(&parts[pa].bounds, &parts[pb].bounds)) as usize;
+                }
+            }
+            count.fetch_add(n, Ordering::Relaxed);
+        },
+    );
+    count.load(Ordering::Relaxed) > cap
 }
 
 /// File mode with a file of several parts (objects, or bodies with `--split-bodies`), when no

@@ -136,6 +136,24 @@ pub(crate) fn load(path: &Path, bytes: &[u8]) -> Result<Loaded> {
             ));
         }
     }
+    // Instancing multiplies what a small file asks for: refuse up front, before anything is
+    // expanded, a scene whose check cannot fit in the memory this process may use.
+    let need = (total_v as u64)
+        .saturating_mul(24)
+        .saturating_add((total_t as u64).saturating_mul(super::CHECK_BYTES_PER_TRIANGLE));
+    if let Some(avail) = super::available_memory().filter(|&a| need > a) {
+        const GIB: f64 = (1u64 << 30) as f64;
+        return Err(Error::input(
+            path,
+            format!(
+                "glTF scene has {total_t} triangles after instancing; checking them needs about {:.1} GiB \
+                 (~{} bytes per triangle), more than the {:.1} GiB this process may use",
+                need as f64 / GIB,
+                super::CHECK_BYTES_PER_TRIANGLE,
+                avail as f64 / GIB
+            ),
+        ));
+    }
 
     let mut mesh = Mesh {
         positions: Vec::with_capacity(total_v),

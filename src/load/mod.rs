@@ -28,6 +28,46 @@ pub const MAX_TRIANGLES: usize = 1 << 28;
 
 pub use obj::MAX_FACE_VERTICES;
 
+/// What a check needs per triangle of a glTF scene after instancing, beyond the 24 bytes per
+/// vertex of its world positions: the triangle and its part id (16 bytes) plus trees, topology
+/// and pair lists (measured: ~90–100 bytes per triangle in all at peak on generated 1M-triangle
+/// tori and on 2CylinderEngine instanced 100 times). An estimate, used only to refuse up front a
+/// scene that cannot fit.
+pub const CHECK_BYTES_PER_TRIANGLE: u64 = 100;
+
+/// The memory this process may still use, in bytes: the least of the machine's available
+/// memory (`MemAvailable`), the cgroup's limit less its usage, and the address-space limit
+/// (`ulimit -v`) less what is mapped. `None` where none of them can be read.
+pub fn available_memory() -> Option<u64> {
+    fn read(p: &str) -> Option<String> {
+        std::fs::read_to_string(p).ok()
+    }
+    fn field_kib(text: &str, key: &str) -> Option<u64> {
+        let line = text.lines().find(|l| l.starts_with(key))?;
+        line[key.len()..].split_whitespace().next()?.parse::<u64>().ok().map(|k| k * 1024)
+    }
+    let mut best: Option<u64> = None;
+    let mut take = |v: Option<u64>| {
+        if let Some(v) = v {
+            best = Some(best.map_or(v, |b| b.min(v)));
+        }
+    };
+    take(read("/proc/meminfo").and_then(|t| field_kib(&t, "MemAvailable:")));
+    let cg = |f: &str| read(&format!("/sys/fs/cgroup/{f}")).and_then(|t| t.trim().parse::<u64>().ok());
+    if let (Some(max), Some(cur)) = (cg("memory.max"), cg("memory.current")) {
+        take(Some(max.saturating_sub(cur)));
+    }
+    let limit = read("/proc/self/limits").and_then(|t| {
+        let l = t.lines().find(|l| l.starts_with("Max address space"))?.to_string();
+        l["Max address space".len()..].split_whitespace().next()?.parse::<u64>().ok()
+    });
+    if let Some(limit) = limit {
+        let mapped = read("/proc/self/status").and_then(|t| field_kib(&t, "VmSize:")).unwrap_or(0);
+        take(Some(limit.saturating_sub(mapped)));
+    }
+    best
+}
+
 mod gltf;
 mod gltf_data;
 mod obj;
