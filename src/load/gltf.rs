@@ -203,9 +203,21 @@ fn add_instance(
 ) -> Result<()> {
     let object = mesh.objects.len() as u32;
     mesh.objects.push(Object { name, gltf_mesh: Some(inst.mesh as u32), world: Some(world) });
-    for p in prims.iter().filter(|p| !p.triangles.is_empty()) {
+    // Where each primitive's vertices start (a primitive sharing an earlier one's accessor
+    // uses that one's, placed once).
+    let mut bases: Vec<Option<u32>> = vec![None; prims.len()];
+    for (k, p) in prims.iter().enumerate() {
+        if p.triangles.is_empty() && p.shares.is_none() {
+            continue;
+        }
+        let owner = p.shares.unwrap_or(k);
+        if let Some(base) = bases[owner] {
+            bases[k] = Some(base);
+            continue;
+        }
         let base = mesh.positions.len() as u32;
-        for (i, &v) in p.positions.iter().enumerate() {
+        bases[k] = Some(base);
+        for (i, &v) in prims[owner].positions.iter().enumerate() {
             let w = world.transform_point3(v);
             if let Some(bad) = super::non_finite(w.to_array()) {
                 return Err(Error::input(
@@ -218,6 +230,9 @@ fn add_instance(
             }
             mesh.positions.push(w);
         }
+    }
+    for (p, base) in prims.iter().zip(bases) {
+        let Some(base) = base else { continue };
         for t in &p.triangles {
             mesh.triangles.push([base + t[0], base + t[1], base + t[2]]);
             mesh.tri_object.push(object);
@@ -297,8 +312,12 @@ struct Gpu {
 /// One decoded primitive in mesh-local space (triangles index `positions`).
 #[derive(Clone)]
 struct Prim {
+    /// Its positions; empty when it shares an earlier primitive's (`shares`).
     positions: Vec<DVec3>,
     triangles: Vec<[u32; 3]>,
+    /// The earlier primitive of the same mesh whose POSITION accessor this one uses too: its
+    /// vertices are placed once and both index them (`inputs.*.vertices` counts them once).
+    shares: Option<usize>,
 }
 
 fn node_names(doc: &Document) -> Vec<Cow<'_, str>> {
@@ -498,7 +517,8 @@ fn decode_mesh(r: &Reader, doc: &Document, m: usize, warnings: &mut Vec<String>)
     let Some(mesh) = doc.meshes().nth(m) else {
         return Ok(Vec::new());
     };
-    let mut out = Vec::new();
+    let mut out: Vec<Prim> = Vec::new();
+    let mut by_accessor: std::collections::HashMap<usize, usize> = std::collections::HashMap::new();
     for prim in mesh.primitives() {
         let what = format!("mesh {m} primitive {}", prim.index());
         let mode = prim.mode();
@@ -535,8 +555,17 @@ fn decode_mesh(r: &Reader, doc: &Document, m: usize, warnings: &mut Vec<String>)
             warnings
                 .push(format!("{what}: {leftover} trailing indices do not form a triangle and were ignored"));
         }
-        let positions = positions.into_iter().map(DVec3::from_array).collect();
-        out.push(Prim { positions, triangles });
+        // A POSITION accessor used by an earlier primitive (with triangles) is read once.
+        let shares = (!triangles.is_empty()).then(|| by_accessor.get(&acc.index()).copied()).flatten();
+        if !triangles.is_empty() && shares.is_none() {
+            by_accessor.insert(acc.index(), out.len());
+        }
+        let positions = if shares.is_some() {
+            Vec::new()
+        } else {
+            positions.into_iter().map(DVec3::from_array).collect()
+        };
+        out.push(Prim { positions, triangles, shares });
     }
     Ok(out)
 }

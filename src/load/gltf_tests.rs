@@ -138,10 +138,13 @@ fn strips_fans_and_skipped_modes() {
           {"attributes":{"POSITION":0},"mode":1}]}],
       "nodes":[{"mesh":0}],"scenes":[{"nodes":[0]}]"#;
     let l = ok(&gltf(&pos, body));
+    // The strip and the fan use one POSITION accessor: its 5 vertices are placed once and both
+    // index them (issue 10 item 6: `inputs.*.vertices` counted a shared accessor once per
+    // primitive, 10 here).
     let strip = [[0, 1, 2], [1, 3, 2], [2, 3, 4]];
-    let fan = [[5, 6, 7], [5, 7, 8], [5, 8, 9]];
+    let fan = [[0, 1, 2], [0, 2, 3], [0, 3, 4]];
     assert_eq!(l.mesh.triangles, [strip, fan].concat());
-    assert_eq!(l.mesh.positions.len(), 10);
+    assert_eq!(l.mesh.positions.len(), 5);
     assert_eq!(l.warnings.len(), 2, "{:?}", l.warnings);
     assert!(l.warnings[0].contains("mesh 0 primitive 2: skipped Points"), "{:?}", l.warnings);
     assert!(l.warnings[1].contains("Lines"), "{:?}", l.warnings);
@@ -167,7 +170,9 @@ fn u8_and_u32_indices_and_stride() {
       "meshes":[{"primitives":[{"attributes":{"POSITION":0},"indices":1},{"attributes":{"POSITION":0},"indices":2}]}],
       "nodes":[{"mesh":0}]"#;
     let l = ok(&gltf(&bin, body));
-    assert_eq!(l.mesh.triangles, vec![[2, 1, 0], [3, 5, 4]]);
+    // Both primitives index the one POSITION accessor, placed once.
+    assert_eq!(l.mesh.triangles, vec![[2, 1, 0], [0, 2, 1]]);
+    assert_eq!(l.mesh.positions.len(), 3);
     assert_eq!(l.mesh.positions[2], DVec3::new(0.0, 1.0, 0.0));
     assert_eq!(l.mesh.objects.len(), 1);
 }
