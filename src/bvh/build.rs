@@ -139,10 +139,7 @@ pub(super) fn build(n: usize, tri_box: impl Fn(u32) -> Aabb + Sync, opts: BuildO
         return Bvh { nodes: Vec::new(), prims: Vec::new() };
     }
     let n32 = u32::try_from(n).expect("triangle count fits in u32");
-    // The f32 boxes are relative to the centre of a sample of the triangles (at most 4096):
-    // a point inside the model, so f32 keeps its relative precision across it.
-    let stride = (n / 4096).max(1);
-    let origin = (0..n32).step_by(stride).fold(Aabb::EMPTY, |b, i| b.union(tri_box(i))).center();
+    let origin = sample_centre(n32, &tri_box);
     let mut items: Vec<Item> = (0..n32).into_par_iter().map(|i| Item::new(&tri_box(i), origin, i)).collect();
     let cb = items.par_chunks(PAR_BIN_CHUNK).map(centre_bounds).reduce(
         || Box32::EMPTY,
@@ -155,21 +152,29 @@ pub(super) fn build(n: usize, tri_box: impl Fn(u32) -> Aabb + Sync, opts: BuildO
 
     let prims: Vec<u32> = items.par_iter().map(Item::idx).collect();
     drop(items);
-    let mut nodes: Vec<Node> = topo
-        .par_iter()
-        .map(|t| {
-            let bounds = if t.count > 0 {
-                let range = t.a as usize..(t.a + t.count) as usize;
-                prims[range].iter().fold(Aabb::EMPTY, |b, &p| b.union(tri_box(p)))
-            } else {
-                Aabb::EMPTY
-            };
-            Node { bounds, a: t.a, count: t.count }
-        })
-        .collect();
+    let mut nodes: Vec<Node> = topo.par_iter().map(|t| node_of(t, &prims, &tri_box)).collect();
     drop(topo);
     fill_interior(&mut nodes, 0, 0);
     Bvh { nodes, prims }
+}
+
+/// The f32 boxes are relative to the centre of a sample of the triangles (at most 4096): a point
+/// inside the model, so f32 keeps its relative precision across it.
+fn sample_centre(n: u32, tri_box: &impl Fn(u32) -> Aabb) -> DVec3 {
+    let stride = (n as usize / 4096).max(1);
+    (0..n).step_by(stride).fold(Aabb::EMPTY, |b, i| b.union(tri_box(i))).center()
+}
+
+/// A node of the final tree from its split-phase record: a leaf gets the exact union of its
+/// triangles' boxes, an interior node an empty box (filled from its children afterwards).
+fn node_of(t: &Topo, prims: &[u32], tri_box: &impl Fn(u32) -> Aabb) -> Node {
+    let bounds = if t.count > 0 {
+        let range = t.a as usize..(t.a + t.count) as usize;
+        prims[range].iter().fold(Aabb::EMPTY, |b, &p| b.union(tri_box(p)))
+    } else {
+        Aabb::EMPTY
+    };
+    Node { bounds, a: t.a, count: t.count }
 }
 
 /// [`build`] on the calling thread alone (no rayon task is spawned or waited for, so it may run
@@ -181,8 +186,7 @@ pub(super) fn build_sequential(n: usize, tri_box: impl Fn(u32) -> Aabb, opts: Bu
         return Bvh { nodes: Vec::new(), prims: Vec::new() };
     }
     let n32 = u32::try_from(n).expect("triangle count fits in u32");
-    let stride = (n / 4096).max(1);
-    let origin = (0..n32).step_by(stride).fold(Aabb::EMPTY, |b, i| b.union(tri_box(i))).center();
+    let origin = sample_centre(n32, &tri_box);
     let mut items: Vec<Item> = (0..n32).map(|i| Item::new(&tri_box(i), origin, i)).collect();
     let cb = items.chunks(PAR_BIN_CHUNK).map(centre_bounds).fold(Box32::EMPTY, |mut a, b| {
         a.union(&b);
@@ -191,18 +195,7 @@ pub(super) fn build_sequential(n: usize, tri_box: impl Fn(u32) -> Aabb, opts: Bu
     let topo = sequential(opts, &mut items, cb, 0);
     let prims: Vec<u32> = items.iter().map(Item::idx).collect();
     drop(items);
-    let mut nodes: Vec<Node> = topo
-        .iter()
-        .map(|t| {
-            let bounds = if t.count > 0 {
-                let range = t.a as usize..(t.a + t.count) as usize;
-                prims[range].iter().fold(Aabb::EMPTY, |b, &p| b.union(tri_box(p)))
-            } else {
-                Aabb::EMPTY
-            };
-            Node { bounds, a: t.a, count: t.count }
-        })
-        .collect();
+    let mut nodes: Vec<Node> = topo.iter().map(|t| node_of(t, &prims, &tri_box)).collect();
     for i in (0..nodes.len()).rev() {
         if !nodes[i].is_leaf() {
             let r = nodes[i].a as usize;
