@@ -320,31 +320,9 @@ pub fn check_parts_kept(
     keep: &(dyn Fn(usize, usize) -> bool + Sync),
 ) -> AssemblyResult {
     let t0 = Instant::now();
-    let tol = settings.tolerances;
     // Broad phase: a tree over the selected parts' boxes on each side, walked together.
-    let boxes = |sel: &[usize]| sel.iter().map(|&i| parts[i].bounds).collect::<Vec<_>>();
-    let opts = BuildOptions { leaf_size: 1, ..settings.bvh };
-    let (ba, bb) = (Bvh::build_from_boxes(&boxes(sel_a), opts), Bvh::build_from_boxes(&boxes(sel_b), opts));
-    let mut candidates: Vec<(usize, usize)> = traverse::collect_pairs(
-        &ba,
-        &bb,
-        |x, y| tol.boxes_may_meet(x, y),
-        |la, lb, out| {
-            for &i in la {
-                for &j in lb {
-                    let (pa, pb) = (sel_a[i as usize], sel_b[j as usize]);
-                    if !tol.boxes_may_meet(&parts[pa].bounds, &parts[pb].bounds) {
-                        continue;
-                    }
-                    match pairing {
-                        Pairing::Cross => out.push((pa, pb)),
-                        Pairing::AllVsAll if pa < pb => out.push((pa, pb)),
-                        Pairing::AllVsAll => {}
-                    }
-                }
-            }
-        },
-    );
+    let mut candidates: Vec<(usize, usize)> =
+        part_box_walk(&parts, sel_a, sel_b, pairing, settings, &|| true, |pa, pb, out| out.push((pa, pb)));
     candidates.sort_unstable();
     candidates.dedup();
     candidates.retain(|&(a, b)| keep(a, b));
@@ -909,6 +887,44 @@ fn run_checked(a: &Mesh, b: &Mesh, sel: &Selection, settings: &Settings) -> Resu
 /// exhausting memory.
 pub const MAX_CANDIDATE_PART_PAIRS: usize = 1 << 23;
 
+/// The broad phase over part boxes: a tree over each side's selected part boxes, walked together;
+/// `each(a, b, out)` gets every candidate part pair (boxes within the search margin; in
+/// all-vs-all pairing each unordered pair once, `a < b`). The walk stops descending once
+/// `go_on` says no.
+fn part_box_walk<T: Send>(
+    parts: &[Part],
+    sel_a: &[usize],
+    sel_b: &[usize],
+    pairing: Pairing,
+    settings: &Settings,
+    go_on: &(dyn Fn() -> bool + Sync),
+    each: impl Fn(usize, usize, &mut Vec<T>) + Sync,
+) -> Vec<T> {
+    let tol = settings.tolerances;
+    let boxes = |sel: &[usize]| sel.iter().map(|&i| parts[i].bounds).collect::<Vec<_>>();
+    let opts = BuildOptions { leaf_size: 1, ..settings.bvh };
+    let (ba, bb) = (Bvh::build_from_boxes(&boxes(sel_a), opts), Bvh::build_from_boxes(&boxes(sel_b), opts));
+    traverse::collect_pairs(
+        &ba,
+        &bb,
+        |x, y| go_on() && tol.boxes_may_meet(x, y),
+        |la, lb, out| {
+            for &i in la {
+                for &j in lb {
+                    let (pa, pb) = (sel_a[i as usize], sel_b[j as usize]);
+                    let wanted = match pairing {
+                        Pairing::Cross => true,
+                        Pairing::AllVsAll => pa < pb,
+                    };
+                    if wanted && tol.boxes_may_meet(&parts[pa].bounds, &parts[pb].bounds) {
+                        each(pa, pb, out);
+                    }
+                }
+            }
+        },
+    )
+}
+
 /// Would the broad phase of `sel_a` against `sel_b` find more than `cap` candidate part pairs?
 /// A counting walk over the part boxes that stops as soon as the count passes `cap` and keeps
 /// nothing.
@@ -925,28 +941,16 @@ fn candidates_exceed(
     if sel_a.len().saturating_mul(sel_b.len()) <= cap {
         return false;
     }
-    let tol = settings.tolerances;
-    let boxes = |sel: &[usize]| sel.iter().map(|&i| parts[i].bounds).collect::<Vec<_>>();
-    let opts = BuildOptions { leaf_size: 1, ..settings.bvh };
-    let (ba, bb) = (Bvh::build_from_boxes(&boxes(sel_a), opts), Bvh::build_from_boxes(&boxes(sel_b), opts));
     let count = AtomicUsize::new(0);
-    let _: Vec<()> = traverse::collect_pairs(
-        &ba,
-        &bb,
-        |x, y| count.load(Ordering::Relaxed) <= cap && tol.boxes_may_meet(x, y),
-        |la, lb, _| {
-            let mut n = 0;
-            for &i in la {
-                for &j in lb {
-                    let (pa, pb) = (sel_a[i as usize], sel_b[j as usize]);
-                    let counted = match pairing {
-                        Pairing::Cross => true,
-                        Pairing::AllVsAll => pa < pb,
-                    };
-                    n += (counted && tol.boxes_may_meet(&parts[pa].bounds, &parts[pb].bounds)) as usize;
-                }
-            }
-            count.fetch_add(n, Ordering::Relaxed);
+    let _: Vec<()> = part_box_walk(
+        parts,
+        sel_a,
+        sel_b,
+        pairing,
+        settings,
+        &|| count.load(Ordering::Relaxed) <= cap,
+        |_, _, _| {
+            count.fetch_add(1, Ordering::Relaxed);
         },
     );
     count.load(Ordering::Relaxed) > cap
