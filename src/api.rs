@@ -18,7 +18,7 @@ use crate::bvh::{BuildOptions, Bvh, Node};
 use crate::check::assembly::{self, Selection};
 use crate::check::containment::{self, Containment, Topology};
 use crate::check::query::{
-    self, Closest, DistanceError, Input, InputSpec, Mode, PairFinding, PairKind, Settings,
+    self, Closest, Detail, DistanceError, Input, InputSpec, Mode, PairFinding, PairKind, Settings,
 };
 use crate::error::{Error, Result};
 use crate::geom::predicates::{self, BoxMap, Tolerances};
@@ -89,6 +89,8 @@ pub struct Options {
     pub mode: Mode,
     /// `--first-hit`.
     pub first_hit: bool,
+    /// `--detail`.
+    pub detail: Detail,
     /// `--bvh`, `--leaf-size`.
     pub bvh: BuildOptions,
     /// `--distance-rel-err`, `--distance-abs-err`.
@@ -113,6 +115,7 @@ impl Default for Options {
             max_pairs: 1000,
             mode: Mode::Exact,
             first_hit: false,
+            detail: Detail::Pairs,
             bvh: BuildOptions::default(),
             distance_error: DistanceError::default(),
             deterministic: false,
@@ -281,6 +284,7 @@ fn resolved_settings(a: &Mesh, b: &Mesh, opts: &Options) -> Result<(Settings, f6
         mode: opts.mode,
         first_hit: opts.first_hit,
         distance_error: opts.distance_error,
+        detail: opts.detail,
     };
     Ok((settings, size))
 }
@@ -318,6 +322,7 @@ fn finish_report(
             leaf_size: opts.bvh.leaf_size,
             max_pairs: opts.max_pairs,
             threads: (!opts.deterministic).then_some(threads),
+            detail: (opts.detail != Detail::Pairs).then(|| opts.detail.name().into()),
         },
         failed: query::FailOn::Clash.fails(result.verdict),
         times: (!opts.deterministic).then(|| (load_ms, t0.elapsed().as_secs_f64() * 1e3)),

@@ -116,3 +116,84 @@ fn file_mode_part_pairs_have_witnesses_from_their_pairs() {
     assert_eq!((ab["verdict"].as_str(), ab["min_distance"].as_f64()), (Some("clash"), Some(0.0)));
     std::fs::remove_dir_all(&dir).ok();
 }
+
+/// The report with every triangle-pair list and every region removed (what `--detail parts`
+/// keeps), plus the settings block without `detail`.
+fn without_lists(mut r: Value) -> Value {
+    r["pairs"] = Value::Array(vec![]);
+    r["pairs_truncated"] = Value::Null;
+    r["regions"] = Value::Array(vec![]);
+    r["settings"].as_object_mut().unwrap().remove("detail");
+    for p in r["part_pairs"].as_array_mut().unwrap() {
+        p["pairs"] = Value::Array(vec![]);
+        p["pairs_truncated"] = Value::Null;
+    }
+    r
+}
+
+#[test]
+fn detail_parts_keeps_every_verdict_count_and_witness_and_drops_only_the_lists() {
+    let engine = Path::new(env!("CARGO_MANIFEST_DIR")).join("../shared/meshes/2CylinderEngine.glb");
+    let dir = std::env::temp_dir().join(format!("meshclash-detail-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let boxes = dir.join("boxes.obj");
+    std::fs::write(&boxes, boxes_obj(&[A, B, C])).unwrap();
+    let (e, b) = (engine.to_str().unwrap(), boxes.to_str().unwrap());
+    for case in
+        [vec!["scene", e], vec!["scene", b], vec![b, b, "--split-bodies"], vec!["scene", e, "--threads", "1"]]
+    {
+        let (code_full, full) = run(&case);
+        let parts_args: Vec<&str> = case.iter().copied().chain(["--detail", "parts"]).collect();
+        let (code_parts, parts) = run(&parts_args);
+        assert_eq!(code_full, code_parts, "{case:?}");
+        assert_eq!(parts["settings"]["detail"], "parts");
+        assert!(full["settings"].get("detail").is_none(), "the default report has no detail field");
+        assert_eq!(parts["pairs"].as_array().unwrap().len(), 0);
+        assert_eq!(parts["regions"].as_array().unwrap().len(), 0);
+        let found = full["summary"]["crossing_pairs"].as_u64().unwrap()
+            + full["summary"]["touching_pairs"].as_u64().unwrap()
+            + full["summary"]["clearance_pairs"].as_u64().unwrap();
+        assert_eq!(parts["pairs_truncated"], found > 0, "{case:?}");
+        for p in parts["part_pairs"].as_array().unwrap() {
+            assert!(p["pairs"].as_array().unwrap().is_empty());
+            let n = p["crossing_pairs"].as_u64().unwrap() + p["touching_pairs"].as_u64().unwrap();
+            assert_eq!(p["pairs_truncated"], n > 0 || p["clearance_pairs"].as_u64().unwrap() > 0);
+        }
+        assert!(!full["part_pairs"].as_array().unwrap().is_empty() || case[1] == b, "{case:?}");
+        assert_eq!(without_lists(full), without_lists(parts), "{case:?}");
+    }
+    std::fs::remove_dir_all(&dir).ok();
+}
+
+#[test]
+fn detail_parts_refuses_the_outputs_that_need_triangle_pairs() {
+    let dir = std::env::temp_dir().join(format!("meshclash-detail-refuse-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let boxes = dir.join("boxes.obj");
+    std::fs::write(&boxes, boxes_obj(&[A, B])).unwrap();
+    let out_html = dir.join("r.html");
+    for (flag, value) in
+        [("--html", out_html.to_str().unwrap()), ("--export-glb", "r.glb"), ("--bcf", "r.bcfzip")]
+    {
+        let out = Command::new(env!("CARGO_BIN_EXE_meshclash"))
+            .args(["scene", boxes.to_str().unwrap(), "--detail", "parts", flag, value])
+            .output()
+            .unwrap();
+        assert_eq!(out.status.code(), Some(2), "{flag}");
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert!(err.contains(flag) && err.contains("--detail parts"), "{flag}: {err}");
+        assert_eq!(err.trim_end().lines().count(), 1, "{err}");
+    }
+    assert!(!out_html.exists(), "nothing is written on a usage error");
+    // Part-pair BCF topics need no triangle pairs.
+    let bcf = dir.join("r.bcfzip");
+    let out = Command::new(env!("CARGO_BIN_EXE_meshclash"))
+        .args(["scene", boxes.to_str().unwrap(), "--detail", "parts", "--bcf-topics", "part-pairs", "--bcf"])
+        .arg(&bcf)
+        .args(["-o", dir.join("r.json").to_str().unwrap()])
+        .output()
+        .unwrap();
+    assert_eq!(out.status.code(), Some(1), "{}", String::from_utf8_lossy(&out.stderr));
+    assert!(bcf.exists());
+    std::fs::remove_dir_all(&dir).ok();
+}

@@ -89,6 +89,13 @@ pub struct CheckArgs {
     /// no distance or containment is computed, and which pair is listed depends on timing.
     #[arg(long)]
     pub first_hit: bool,
+    /// What the report lists: `pairs` (default) every meeting triangle pair (up to
+    /// --max-pairs shown) and the clash regions made from them; `parts` only each part pair's
+    /// verdict, counts and closest points — the same verdicts and counts, memory that no longer
+    /// grows with the number of meeting triangle pairs, no regions (so no --html,
+    /// --export-glb, --baseline or region topics in --bcf).
+    #[arg(long, value_enum, value_name = "WHAT", default_value_t = DetailArg::Pairs)]
+    pub detail: DetailArg,
     /// Split every part into its connected bodies (triangles joined through edges used by
     /// exactly two triangles), named `part/body1`, `part/body2`, …: e.g. two cubes in one STL
     /// solid that touch along an edge become two parts.
@@ -231,6 +238,15 @@ pub enum ModeArg {
     Exact,
     /// Plain f64 determinants, no exact fallback.
     Fast,
+}
+
+/// `--detail` values.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
+pub enum DetailArg {
+    /// Every meeting triangle pair and the clash regions (default).
+    Pairs,
+    /// Part-pair verdicts, counts and closest points only.
+    Parts,
 }
 
 /// `--bvh` values.

@@ -165,6 +165,8 @@ pub struct CheckSpec {
     pub max_pairs: Option<Num>,
     /// `--first-hit`.
     pub first_hit: Option<bool>,
+    /// `--detail`: pairs, parts.
+    pub detail: Option<String>,
     /// `--split-bodies`.
     pub split_bodies: Option<bool>,
     /// `--penetration`.
@@ -279,6 +281,7 @@ fn merge(c: &mut CheckSpec, d: &CheckSpec) {
         leaf_size,
         max_pairs,
         first_hit,
+        detail,
         split_bodies,
         penetration,
         distance_rel_err,
@@ -327,7 +330,7 @@ pub fn argv(c: &CheckSpec, dir: &Path, run: &ClashSetArgs) -> std::result::Resul
     macro_rules! word {
         ($($f:ident => $name:literal),*) => { $( if let Some(x) = &c.$f { v.push(flag($name, x)); } )* };
     }
-    word!(fail_on => "fail-on", mode => "mode", bvh => "bvh", cross_check => "cross-check");
+    word!(fail_on => "fail-on", mode => "mode", bvh => "bvh", detail => "detail", cross_check => "cross-check");
     macro_rules! list {
         ($($f:ident => $name:literal),*) => { $( for g in c.$f.iter().flatten() { v.push(flag($name, g)); } )* };
     }

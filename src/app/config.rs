@@ -1,9 +1,9 @@
 //! Validation of the parsed command line into a [`Config`] (the library never sees clap).
 
-use super::args::{Args, BvhArg, CheckArgs, Command, FailOnArg, ModeArg, Unit};
+use super::args::{Args, BvhArg, CheckArgs, Command, DetailArg, FailOnArg, ModeArg, TopicsArg, Unit};
 use glam::{DMat4, DVec3, DVec4};
 use meshclash::bvh::{BuildOptions, Strategy};
-use meshclash::check::query::{DistanceError, FailOn, InputSpec, Mode, Settings};
+use meshclash::check::query::{Detail, DistanceError, FailOn, InputSpec, Mode, Settings};
 use meshclash::error::{Error, Result};
 use meshclash::geom::predicates::Tolerances;
 use meshclash::report;
@@ -245,6 +245,24 @@ impl CheckArgs {
                     .into(),
             ));
         }
+        if self.detail == DetailArg::Parts {
+            let o = &self.outputs;
+            let needs_regions = [
+                (o.html.is_some(), "--html"),
+                (o.export_glb.is_some(), "--export-glb"),
+                (o.baseline.is_some(), "--baseline"),
+                (
+                    o.bcf.is_some() && o.bcf_topics == TopicsArg::Regions,
+                    "--bcf (region topics; use --bcf-topics part-pairs)",
+                ),
+                (self.cross_check.is_some(), "--cross-check"),
+            ];
+            if let Some((_, flag)) = needs_regions.iter().find(|(given, _)| *given) {
+                return Err(Error::Usage(format!(
+                    "{flag} needs the triangle pairs that --detail parts does not keep: drop one of them"
+                )));
+            }
+        }
         if scene_mode && self.cross_check.is_some() {
             return Err(Error::Usage("--cross-check works on two files, not with scene".into()));
         }
@@ -298,6 +316,10 @@ impl CheckArgs {
                     ModeArg::Fast => Mode::Fast,
                 },
                 first_hit: self.first_hit,
+                detail: match self.detail {
+                    DetailArg::Pairs => Detail::Pairs,
+                    DetailArg::Parts => Detail::Parts,
+                },
                 distance_error: DistanceError {
                     rel: nonneg("distance-rel-err", self.distance_rel_err)?,
                     abs: nonneg("distance-abs-err", self.distance_abs_err)?,

@@ -181,6 +181,7 @@ pub fn check_staged(
             leaf_size: cfg.settings.bvh.leaf_size,
             max_pairs: cfg.max_pairs,
             threads: (!cfg.deterministic).then_some(threads),
+            detail: (cfg.settings.detail != query::Detail::Pairs).then(|| cfg.settings.detail.name().into()),
         },
         failed,
         times: (!cfg.deterministic).then(|| (load_ms, t0.elapsed().as_secs_f64() * 1e3)),

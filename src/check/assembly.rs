@@ -29,7 +29,7 @@ use crate::check::containment;
 use crate::check::containment::Containment;
 use crate::check::containment::Topology;
 use crate::check::query::{
-    closest_pair_within, pair_walk, ClashResult, PairFinding, PairPhase, Settings, Verdict,
+    closest_pair_within, pair_walk, ClashResult, Detail, PairFinding, PairPhase, Settings, Verdict,
 };
 use crate::geom::predicates::BoxMap;
 use crate::geom::{Aabb, DVec3};
@@ -435,8 +435,11 @@ pub fn check_parts_kept(
         .par_iter()
         .map(|&(a, b)| {
             let (va, vb, ta, tb) = (view(a), view(b), tree(a), tree(b));
-            let phase = pair_walk(&va, &ta, &vb, &tb, settings);
+            let mut phase = pair_walk(&va, &ta, &vb, &tb, settings);
             let needs = phase.needs_topology(&va, &ta, &vb, &tb, settings);
+            if settings.detail == Detail::Parts && !needs {
+                phase.forget_pairs();
+            }
             (phase, needs)
         })
         .collect();
@@ -802,6 +805,10 @@ fn run_checked(a: &Mesh, b: &Mesh, sel: &Selection, settings: &Settings) -> Resu
         let mut result = crate::check::query::check(a, b, settings);
         let mut part_pairs = group_by_part(&parts, a, b, &result);
         per_part_containment(&parts, a, b, &mut result, &mut part_pairs, settings);
+        if settings.detail == Detail::Parts {
+            result.pairs = Vec::new();
+            part_pairs.iter_mut().for_each(|p| p.pairs = Vec::new());
+        }
         let info = AssemblyInfo {
             mode: "files",
             selected: [sa.len(), sb.len()],
@@ -828,12 +835,27 @@ fn run_checked(a: &Mesh, b: &Mesh, sel: &Selection, settings: &Settings) -> Resu
     let mut closest: Option<crate::check::query::Closest> = None;
     let mut containment = Containment::None;
     let mut counts = crate::check::query::Counts::default();
-    for pp in &ar.part_pairs {
+    let detail = settings.detail;
+    let AssemblyResult {
+        parts: ar_parts,
+        part_pairs: ar_pairs,
+        built,
+        sah_builds,
+        sharing,
+        build_ms,
+        query_ms,
+    } = ar;
+    let candidate_part_pairs = ar_pairs.len();
+    merged.reserve_exact(ar_pairs.iter().map(|pp| pp.result.pairs.len()).sum());
+    for pp in ar_pairs {
         let (x, y) = (pp.a.min(pp.b), pp.a.max(pp.b));
         if x == y || !pairs_seen.insert((x, y)) {
             continue; // a part selected on both sides, or the mirror of a pair already done
         }
-        let r = &pp.result;
+        let mut r = pp.result;
+        if detail == Detail::Parts {
+            r.pairs = Vec::new();
+        }
         merged.extend(r.pairs.iter().copied());
         counts.merge(&r.counts);
         if let Some(c) = r.closest {
@@ -856,16 +878,17 @@ fn run_checked(a: &Mesh, b: &Mesh, sel: &Selection, settings: &Settings) -> Resu
                 pairs: r.pairs.iter().map(|p| (p.a, p.b)).collect(),
             });
         }
+        // r (and its pair list) is dropped here: each list is held once, in `merged`.
     }
     merged.sort_unstable_by_key(|p| (p.a, p.b));
     let verdict = part_pairs.iter().map(|p| p.verdict).max().unwrap_or(Verdict::Clear);
     let info = AssemblyInfo {
         mode: "parts",
         selected: [sa.len(), sb.len()],
-        candidate_part_pairs: ar.part_pairs.len(),
-        built_parts: Some(ar.built.iter().filter(|b| **b).count()),
-        sah_builds: Some(ar.sah_builds),
-        sharing: Some(ar.sharing),
+        candidate_part_pairs,
+        built_parts: Some(built.iter().filter(|b| **b).count()),
+        sah_builds: Some(sah_builds),
+        sharing: Some(sharing),
     };
     let result = ClashResult {
         pairs: merged,
@@ -875,9 +898,9 @@ fn run_checked(a: &Mesh, b: &Mesh, sel: &Selection, settings: &Settings) -> Resu
         containment,
         closed: [None, None],
         trees: Default::default(),
-        timings: crate::check::query::Timings { build_ms: ar.build_ms, query_ms: ar.query_ms },
+        timings: crate::check::query::Timings { build_ms, query_ms },
     };
-    Ok(Outcome { result, parts: ar.parts, part_pairs, info })
+    Ok(Outcome { result, parts: ar_parts, part_pairs, info })
 }
 
 /// The most candidate part pairs (part boxes within the search margin of each other) one run

@@ -46,6 +46,32 @@ pub struct Settings {
     /// Allowed error of the minimum distance: the reported distance `d` satisfies
     /// `d <= (1 + rel) * true + abs` (PQP-style). Zero (default) = the f64 minimum.
     pub distance_error: DistanceError,
+    /// Keep every triangle pair for the report ([`Detail::Pairs`], default) or only the part
+    /// pairs' verdicts, counts and witnesses ([`Detail::Parts`]).
+    pub detail: Detail,
+}
+
+/// How much of what a check finds is kept for the report. Verdicts, counts and closest points
+/// are the same in both; [`Detail::Parts`] gives up the triangle-pair lists (and the clash
+/// regions and finding ids made from them), so memory no longer grows with the number of
+/// meeting triangle pairs.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum Detail {
+    /// Every meeting triangle pair is kept (the report lists up to `max_pairs` of them).
+    #[default]
+    Pairs,
+    /// A pair's triangle list is dropped as soon as its verdict no longer needs it.
+    Parts,
+}
+
+impl Detail {
+    /// Name on the command line and in the report.
+    pub fn name(self) -> &'static str {
+        match self {
+            Detail::Pairs => "pairs",
+            Detail::Parts => "parts",
+        }
+    }
 }
 
 /// The speed/accuracy trade of the pair classification.
@@ -270,6 +296,11 @@ impl Counts {
         }
     }
 
+    /// Every counted pair (crossing, touching or clearance).
+    pub fn total(&self) -> u64 {
+        self.crossing + self.touching + self.clearance
+    }
+
     /// Add another set of counts.
     pub fn merge(&mut self, o: &Counts) {
         self.crossing += o.crossing;
@@ -481,6 +512,13 @@ where
 }
 
 impl PairPhase {
+    /// Drop the triangle-pair list (counts and the closest pair stay). Only for
+    /// [`Detail::Parts`], and only once [`PairPhase::needs_topology`] has said the verdict does
+    /// not need the pairs (face-to-face contact decides `volumes_overlap`).
+    pub fn forget_pairs(&mut self) {
+        self.pairs = Vec::new();
+    }
+
     /// True when no pair met exactly and the walk was not cut short: the closest pair has not
     /// been searched for yet.
     pub fn closest_pending(&self) -> bool {

@@ -470,7 +470,7 @@ pub fn assembly_view(
                 }
             }),
             pairs: pp.pairs.iter().take(max_pairs).map(|&(x, y)| [x, y]).collect(),
-            pairs_truncated: pp.pairs.len() > max_pairs,
+            pairs_truncated: pp.pairs.len() > max_pairs || (pp.pairs.is_empty() && pp.counts.total() > 0),
         })
         .collect();
     let i = &o.info;
@@ -677,6 +677,11 @@ pub struct SettingsReport {
     pub max_pairs: usize,
     /// Worker threads (null in deterministic mode).
     pub threads: Option<usize>,
+    /// `parts` with `--detail parts`: no triangle-pair lists (`pairs` and every
+    /// `part_pairs[].pairs` empty, `pairs_truncated` true where pairs were found), no regions.
+    /// Absent with the default, `pairs`.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub detail: Option<String>,
 }
 
 /// Counts.
@@ -912,7 +917,7 @@ pub fn build(ctx: &Context, r: &ClashResult) -> Report {
             b: Witness { triangle: c.b.0, object: ob[c.b.0 as usize], point: v3(c.b.1) },
         }),
         pairs: r.pairs.iter().take(max).map(|p| pair_report(p, oa, ob)).collect(),
-        pairs_truncated: r.pairs.len() > max,
+        pairs_truncated: r.pairs.len() > max || (r.pairs.is_empty() && r.counts.total() > 0),
         bvh: Trees { a: tree_report(&r.trees[0]), b: tree_report(&r.trees[1]) },
         cross_check: ctx.cross_check.clone(),
         assembly: ctx.assembly.0.clone(),
