@@ -103,6 +103,7 @@ def check(
     max_pairs=1000,
     mode="exact",
     first_hit=False,
+    detail="pairs",
     threads=0,
     timings=True,
     penetration=False,
@@ -123,7 +124,7 @@ def check(
     or a prepared :class:`Mesh`. The flags are the command line's: ``transform_a``/``_b`` a 4x4
     (or 3x4) affine matrix applied in f64; ``touch_tolerance`` and ``clearance`` a number or a
     string with a ``rel`` suffix (``"1e-6rel"``); ``mode`` ``"exact"`` or ``"fast"``;
-    ``threads`` 0 for one per core; ``timings=False`` is ``--no-timings`` (the same inputs then
+    ``detail`` ``"pairs"`` or ``"parts"`` (``--detail``: part-pair verdicts, counts and closest points without triangle-pair lists or regions); ``threads`` 0 for one per core; ``timings=False`` is ``--no-timings`` (the same inputs then
     give the same document as ``meshclash A B --no-timings``).
 
     The result has the report's keys and schema version (``meshclash schema`` prints the
@@ -143,6 +144,7 @@ def check(
         max_pairs=int(max_pairs),
         mode=mode,
         first_hit=bool(first_hit),
+        detail=detail,
         threads=int(threads),
         timings=bool(timings),
         penetration=bool(penetration),
@@ -166,6 +168,7 @@ def scene(
     max_pairs=1000,
     mode="exact",
     first_hit=False,
+    detail="pairs",
     threads=0,
     timings=True,
     penetration=False,
@@ -187,6 +190,7 @@ def scene(
         max_pairs=int(max_pairs),
         mode=mode,
         first_hit=bool(first_hit),
+        detail=detail,
         threads=int(threads),
         timings=bool(timings),
         penetration=bool(penetration),

@@ -6,7 +6,7 @@ use glam::{DMat4, DVec3, DVec4};
 use meshclash::api::{self, Options, Placed, Prepared, Source, Tolerance};
 use meshclash::bvh::{BuildOptions, Strategy};
 use meshclash::check::assembly::Selection;
-use meshclash::check::query::{DistanceError, Mode};
+use meshclash::check::query::{Detail, DistanceError, Mode};
 use meshclash::Error;
 use numpy::{PyReadonlyArray2, PyUntypedArrayMethods};
 use pyo3::exceptions::{PyOSError, PyValueError};
@@ -148,6 +148,7 @@ fn options(
     max_pairs: usize,
     mode: &str,
     first_hit: bool,
+    detail: &str,
     threads: usize,
     timings: bool,
     penetration: bool,
@@ -174,6 +175,11 @@ fn options(
         "fast" => Mode::Fast,
         m => return Err(PyValueError::new_err(format!("mode must be 'exact' or 'fast', got '{m}'"))),
     };
+    let detail = match detail {
+        "pairs" => Detail::Pairs,
+        "parts" => Detail::Parts,
+        d => return Err(PyValueError::new_err(format!("detail must be 'pairs' or 'parts', got '{d}'"))),
+    };
     let strategy = match bvh {
         "sah" => Strategy::Sah,
         "median" => Strategy::Median,
@@ -186,6 +192,7 @@ fn options(
         max_pairs,
         mode,
         first_hit,
+        detail,
         bvh: BuildOptions { strategy, leaf_size },
         distance_error: DistanceError { rel: distance_rel_err, abs: distance_abs_err },
         deterministic: !timings,
@@ -201,7 +208,7 @@ fn options(
 /// The report of `a` against `b` as JSON text (see `meshclash.check`).
 #[pyfunction]
 #[pyo3(signature = (a, b, *, transform_a=None, transform_b=None, touch_tolerance=None, clearance=None,
-    max_pairs=1000, mode="exact", first_hit=false, threads=0, timings=true, penetration=false,
+    max_pairs=1000, mode="exact", first_hit=false, detail="pairs", threads=0, timings=true, penetration=false,
     split_bodies=false, bvh="sah", leaf_size=4, distance_rel_err=0.0, distance_abs_err=0.0,
     select_a=vec![], select_b=vec![], exclude=vec![]))]
 #[allow(clippy::too_many_arguments)]
@@ -216,6 +223,7 @@ fn check_json(
     max_pairs: usize,
     mode: &str,
     first_hit: bool,
+    detail: &str,
     threads: usize,
     timings: bool,
     penetration: bool,
@@ -235,6 +243,7 @@ fn check_json(
         max_pairs,
         mode,
         first_hit,
+        detail,
         threads,
         timings,
         penetration,
@@ -280,7 +289,7 @@ fn check_json(
 /// The scene report of one file (see `meshclash.scene`).
 #[pyfunction]
 #[pyo3(signature = (path, *, touch_tolerance=None, clearance=None, max_pairs=1000, mode="exact",
-    first_hit=false, threads=0, timings=true, penetration=false, split_bodies=false, bvh="sah",
+    first_hit=false, detail="pairs", threads=0, timings=true, penetration=false, split_bodies=false, bvh="sah",
     leaf_size=4, distance_rel_err=0.0, distance_abs_err=0.0, select_a=vec![], select_b=vec![],
     exclude=vec![]))]
 #[allow(clippy::too_many_arguments)]
@@ -292,6 +301,7 @@ fn scene_json(
     max_pairs: usize,
     mode: &str,
     first_hit: bool,
+    detail: &str,
     threads: usize,
     timings: bool,
     penetration: bool,
@@ -311,6 +321,7 @@ fn scene_json(
         max_pairs,
         mode,
         first_hit,
+        detail,
         threads,
         timings,
         penetration,

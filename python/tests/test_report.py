@@ -28,6 +28,7 @@ def flat(m):
         ("pins.glb", "SimpleMeshes.gltf", ["--mode", "fast", "--penetration"], {"mode": "fast", "penetration": True}),
         ("pins.glb", "pins.glb", ["--select-a", "*", "--exclude", "node0*"], {"select_a": ["*"], "exclude": ["node0*"]}),
         ("joined_tetrahedra.obj", "joined_tetrahedra.obj", ["--first-hit"], {"first_hit": True}),
+        ("pins.glb", "pins.glb", ["--detail", "parts", "--split-bodies"], {"detail": "parts", "split_bodies": True}),
     ],
 )
 def test_check_files_equals_cli(a, b, flags, kwargs):
@@ -52,6 +53,16 @@ def test_scene_equals_cli(name):
     p = MESHES / name
     _, want, _ = run_cli("scene", p, "--no-timings")
     assert meshclash.scene(p, timings=False) == want
+
+
+def test_scene_detail_parts_equals_cli():
+    p = shared("2CylinderEngine.glb")
+    _, want, _ = run_cli("scene", p, "--no-timings", "--detail", "parts")
+    got = meshclash.scene(p, timings=False, detail="parts")
+    assert got == want
+    assert got["settings"]["detail"] == "parts" and got["pairs"] == [] and got["regions"] == []
+    with pytest.raises(ValueError, match="detail must be"):
+        meshclash.scene(p, detail="triangles")
 
 
 def test_scene_engine_equals_cli():
