@@ -79,6 +79,13 @@ const IGNORED: &[&[u8]] = &[
 
 /// Parses OBJ `bytes`; see the module doc. Validation of the result is done by the caller too.
 pub(crate) fn load(path: &Path, bytes: &[u8]) -> Result<Loaded> {
+    // The common file (vertices, plain faces, names, comments, ignored statements) is parsed in
+    // chunks on every core; anything else (an error, a warning, a continued line) is handed to
+    // the sequential parser, which gives the one answer both would give on the files the fast
+    // path accepts (tested: `chunked_parse_equals_the_sequential_parser`).
+    if let Some(loaded) = chunked::parse(bytes, MAX_TRIANGLES, chunked::CHUNK_BYTES) {
+        return Ok(loaded);
+    }
     Parser::new(path, MAX_TRIANGLES).run(bytes)
 }
 
@@ -392,6 +399,242 @@ impl<'a> Tokens<'a> {
         }
         self.pos = self.text.len();
         &t[..end]
+    }
+}
+
+/// The parallel fast path of [`load`]: the file cut into chunks at line ends, each chunk parsed
+/// on its own (rayon), the chunks joined in file order. It accepts only files on which the
+/// sequential [`Parser`] would succeed with no warning, and gives exactly its result there;
+/// on anything else it returns `None` and the sequential parser runs (and reports the problem
+/// with its line number).
+mod chunked {
+    use super::{plain_index, trim_end, Tokens, IGNORED, MAX_FACE_VERTICES};
+    use crate::scene::mesh::{Loaded, Mesh, Object};
+    use glam::DVec3;
+    use rayon::prelude::*;
+
+    /// Nominal chunk size (a chunk ends at the first line end after it). A cost knob only.
+    pub(super) const CHUNK_BYTES: usize = 1 << 18;
+
+    /// What one chunk holds; indices are resolved when the chunks are joined.
+    #[derive(Default)]
+    struct Chunk {
+        positions: Vec<DVec3>,
+        /// Triangles; an index that was negative (relative) holds a placeholder, see `relative`.
+        triangles: Vec<[u32; 3]>,
+        /// Per triangle: the `o`/`g` statements of this chunk before it.
+        names_before: Vec<u32>,
+        /// Names of this chunk's `o`/`g` statements, in order.
+        names: Vec<String>,
+        /// Relative indices: (slot in the flattened `triangles`, vertices of this chunk
+        /// before the face + the negative index); the chunk's vertex offset is added on join.
+        relative: Vec<(usize, i64)>,
+        /// The largest positive (1-based) index used (forward references are allowed up to the
+        /// file's vertex count).
+        max_index: u64,
+    }
+
+    /// Byte ranges of the chunks: each ends just after a `\n` (or at the end of the file).
+    fn cut(bytes: &[u8], size: usize) -> Vec<std::ops::Range<usize>> {
+        let mut out = Vec::new();
+        let mut start = 0;
+        while start < bytes.len() {
+            let nominal = (start + size).min(bytes.len());
+            let end = match memchr::memchr(b'\n', &bytes[nominal..]) {
+                Some(i) => nominal + i + 1,
+                None => bytes.len(),
+            };
+            out.push(start..end);
+            start = end;
+        }
+        out
+    }
+
+    /// Parses `bytes` if the fast path can (see the module doc); `None` otherwise.
+    pub(super) fn parse(bytes: &[u8], max_triangles: usize, chunk_bytes: usize) -> Option<Loaded> {
+        let chunks: Vec<Chunk> =
+            cut(bytes, chunk_bytes).into_par_iter().map(|r| chunk(&bytes[r])).collect::<Option<_>>()?;
+        join(chunks, max_triangles)
+    }
+
+    fn chunk(bytes: &[u8]) -> Option<Chunk> {
+        let mut c = Chunk::default();
+        let mut face: Vec<i64> = Vec::new();
+        let mut start = 0;
+        let ends = memchr::memchr_iter(b'\n', bytes).chain(std::iter::once(bytes.len()));
+        for end in ends {
+            let mut text = &bytes[start.min(end)..end];
+            start = end + 1;
+            if let [head @ .., b'\r'] = text {
+                text = head;
+            }
+            if trim_end(text).last() == Some(&b'\\') {
+                return None; // continued lines: the sequential parser joins them
+            }
+            let mut tokens = Tokens { text, pos: 0 };
+            let Some((_, keyword)) = tokens.next() else {
+                continue;
+            };
+            match keyword {
+                b"v" => {
+                    let mut p = [0.0f64; 3];
+                    for slot in &mut p {
+                        let (_, tok) = tokens.next()?;
+                        *slot = std::str::from_utf8(tok).ok()?.parse::<f64>().ok()?;
+                        if !slot.is_finite() {
+                            return None;
+                        }
+                    }
+                    c.positions.push(DVec3::from_array(p));
+                }
+                b"f" | b"fo" => {
+                    face.clear();
+                    while let Some((_, tok)) = tokens.next() {
+                        if face.len() == MAX_FACE_VERTICES {
+                            return None;
+                        }
+                        let v = tok.split(|&b| b == b'/').next().unwrap_or(tok);
+                        face.push(plain_index(v)?);
+                    }
+                    if face.len() < 3 {
+                        return None;
+                    }
+                    let defined = c.positions.len() as i64;
+                    let slot0 = c.triangles.len() * 3;
+                    let mut resolved = [0u32; 3];
+                    let at = |k: usize, corner: usize, c: &mut Chunk| -> Option<u32> {
+                        let i = face[k];
+                        if i > 0 {
+                            c.max_index = c.max_index.max(i as u64);
+                            u32::try_from(i - 1).ok()
+                        } else if i < 0 {
+                            c.relative.push((corner, defined + i));
+                            Some(0)
+                        } else {
+                            None
+                        }
+                    };
+                    let names = c.names.len() as u32;
+                    for i in 1..face.len() - 1 {
+                        let base = slot0 + (i - 1) * 3;
+                        for (corner, k) in [0, i, i + 1].into_iter().enumerate() {
+                            resolved[corner] = at(k, base + corner, &mut c)?;
+                        }
+                        c.triangles.push(resolved);
+                        c.names_before.push(names);
+                    }
+                }
+                b"o" | b"g" => {
+                    c.names.push(String::from_utf8_lossy(tokens.rest()).trim().to_string());
+                }
+                k if IGNORED.contains(&k) => {}
+                _ => return None, // `p`/`l` and unrecognised lines warn: the sequential parser
+            }
+        }
+        Some(c)
+    }
+
+    fn join(chunks: Vec<Chunk>, max_triangles: usize) -> Option<Loaded> {
+        let vertices: usize = chunks.iter().map(|c| c.positions.len()).sum();
+        let triangles: usize = chunks.iter().map(|c| c.triangles.len()).sum();
+        if triangles > max_triangles || vertices > u32::MAX as usize + 1 {
+            return None;
+        }
+        if chunks.iter().any(|c| c.max_index > vertices as u64) {
+            return None; // a face refers beyond the file's vertices
+        }
+        let mut mesh = Mesh {
+            positions: Vec::with_capacity(vertices),
+            triangles: Vec::with_capacity(triangles),
+            tri_object: Vec::with_capacity(triangles),
+            objects: vec![Object::default()],
+        };
+        for c in chunks {
+            let (v0, t0, o0) =
+                (mesh.positions.len() as i64, mesh.triangles.len(), mesh.objects.len() as u32 - 1);
+            mesh.positions.extend_from_slice(&c.positions);
+            mesh.triangles.extend_from_slice(&c.triangles);
+            for (slot, r) in c.relative {
+                let v = u32::try_from(v0 + r).ok()?;
+                mesh.triangles[t0 + slot / 3][slot % 3] = v;
+            }
+            mesh.tri_object.extend(c.names_before.iter().map(|&k| o0 + k));
+            mesh.objects.extend(c.names.into_iter().map(|name| Object { name, ..Default::default() }));
+        }
+        super::drop_empty_objects(&mut mesh);
+        for (i, o) in mesh.objects.iter_mut().enumerate() {
+            if o.name.is_empty() {
+                o.name = format!("object{i}");
+            }
+        }
+        Some(Loaded { mesh, warnings: Vec::new() })
+    }
+
+    #[cfg(test)]
+    mod tests {
+        use super::super::Parser;
+        use std::path::Path;
+
+        /// Both parsers on `src`: the fast path either declines or gives the sequential answer,
+        /// for every chunk size (1 byte: a chunk per line).
+        fn agree(src: &[u8]) -> bool {
+            let want = Parser::new(Path::new("t.obj"), 1 << 20).run(src);
+            let mut took = false;
+            for size in [1, 7, 64, 1 << 20] {
+                if let Some(got) = super::parse(src, 1 << 20, size) {
+                    let want = want.as_ref().expect("the fast path accepted a file the parser refuses");
+                    assert!(want.warnings.is_empty());
+                    assert_eq!(format!("{:?}", got.mesh), format!("{:?}", want.mesh), "chunk size {size}");
+                    took = true;
+                }
+            }
+            took
+        }
+
+        #[test]
+        fn chunked_parse_equals_the_sequential_parser() {
+            let taken: &[&[u8]] = &[
+                b"v 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 0 1\nf 1 2 3\nf 1 3 4\n",
+                b"# c\r\nv 0 0 0 1\r\nv 1 0 0\r\nv 0 1 0\r\nvn 0 0 1\r\no a # x\r\nf -3/1/1 -2//1 -1\r\ng\r\nf 1 2 3 1\r\n",
+                b"f 1 2 3\nv 0 0 0\nv 1 0 0\nv 0 1 0\n",
+                b"o first\nv 0 0 0\nv 1 0 0\nv 0 1 0\nv 1 1 0\nf 1 2 4 3\no empty\no last\nf -1 -2 -3\ns off\nusemtl m\n",
+                b"v 1e3 -2.5E-3 +4\nv .5 5. 0\nv 0 0 1\nf 1 2 3",
+            ];
+            for src in taken {
+                assert!(agree(src), "{}", String::from_utf8_lossy(src));
+            }
+            let declined: &[&[u8]] = &[
+                b"v 0 0 0\nv 1 0 0\nf 1 2\n",
+                b"v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 4\n",
+                b"v 0 0 0\nv 1 0 0\nv 0 1 0\nf 0 1 2\n",
+                b"v 0 0 0\nv 1 0 0\nv 0 1 0\nf -4 1 2\n",
+                b"v 0 0 nan\nv 1 0 0\nv 0 1 0\nf 1 2 3\n",
+                b"v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 \\\n 3\n",
+                b"6540 2180\nv 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n",
+                b"v 0 0 0\nv 1 0 0\nv 0 1 0\nl 1 2\nf 1 2 3\n",
+                b"v 0 0\nf 1 2 3\n",
+                b"v 0 0 0\nv 1 0 0\nv 0 1 0\nf +1 2 3\n",
+            ];
+            for src in declined {
+                assert!(!agree(src), "{}", String::from_utf8_lossy(src));
+            }
+        }
+
+        #[test]
+        fn chunked_parse_of_the_shared_meshes_equals_the_sequential_parser() {
+            for name in ["joined_tetrahedra.obj", "stanford-bunny.obj", "fcl_env.obj"] {
+                let Some(path) = crate::load::shared(name) else { continue };
+                let bytes = std::fs::read(&path).unwrap();
+                let want = Parser::new(&path, 1 << 28).run(&bytes).unwrap();
+                let got = super::parse(&bytes, 1 << 28, 4096);
+                if want.warnings.is_empty() {
+                    let got = got.unwrap_or_else(|| panic!("{name}: declined a file with no warnings"));
+                    assert_eq!(format!("{:?}", got.mesh), format!("{:?}", want.mesh), "{name}");
+                } else {
+                    assert!(got.is_none(), "{name}: took a file the parser warns about");
+                }
+            }
+        }
     }
 }
 
