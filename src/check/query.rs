@@ -686,7 +686,7 @@ fn contact_witness<A: TriMesh + ?Sized, B: TriMesh + ?Sized>(a: &A, b: &B, p: &P
 /// vertex below the node, so it pays only near the leaves, where a band of nearly equal
 /// distances (concentric parts) keeps boxes from pruning. Tuned on linked tori and
 /// 2CylinderEngine (64–512 all within 10%); a cost knob only: the answer does not depend on it.
-pub const ORIENTED_MAX_TRIANGLES: usize = 64;
+pub const ORIENTED_MAX_TRIANGLES: usize = 1024;
 
 /// Oriented bounds of one tree's nodes, computed on first use and shared by every thread of a
 /// search (each is a function of its node alone, so the order of computation does not matter).
@@ -797,19 +797,19 @@ where
         slack,
         |la, lb, bound| {
             let mut best: Option<Candidate<(DVec3, DVec3)>> = None;
+            // B's side once per leaf pair, not once per triangle of A.
+            let side_b: Vec<LeafTriangle> = lb.iter().map(|&j| LeafTriangle::new(b.triangle(j))).collect();
             for &i in la {
-                let ti = a.triangle(i);
-                let bi = Aabb::of_triangle(&ti);
-                let ni = slab::unit_normal(&ti);
-                for &j in lb {
-                    let tj = b.triangle(j);
-                    if bi.distance_sq(&Aabb::of_triangle(&tj)).sqrt() > bound {
+                let ta_ = LeafTriangle::new(a.triangle(i));
+                for (&j, tb_) in lb.iter().zip(&side_b) {
+                    // What this leaf pair found already bounds the search as the shared best
+                    // will once it is published (pairs within `slack` of it may still tie).
+                    let bound = best.as_ref().map_or(bound, |m| bound.min(m.distance + slack));
+                    if ta_.lower_bound(tb_, bound, margin) > bound {
                         continue;
                     }
-                    if slab::plane_gap(&ti, ni, &tj, slab::unit_normal(&tj)) - margin > bound {
-                        continue;
-                    }
-                    let d = triangle_distance(&ti, &tj);
+                    let (ti, tj) = (&ta_.t, &tb_.t);
+                    let d = triangle_distance(ti, tj);
                     let c = Candidate { distance: d.distance, key: (i, j), data: (d.on_a, d.on_b) };
                     if best.as_ref().is_none_or(|m| (c.distance, c.key) < (m.distance, m.key)) {
                         best = Some(c);
@@ -821,6 +821,50 @@ where
         shared_best,
     )?;
     Some(Closest { distance: best.distance, a: (best.key.0, best.data.0), b: (best.key.1, best.data.1) })
+}
+
+/// A triangle with what the closest-pair search's triangle-pair bounds read of it.
+struct LeafTriangle {
+    t: [DVec3; 3],
+    bounds: Aabb,
+    normal: DVec3,
+    centroid: DVec3,
+}
+
+impl LeafTriangle {
+    #[inline]
+    fn new(t: [DVec3; 3]) -> Self {
+        LeafTriangle {
+            bounds: Aabb::of_triangle(&t),
+            normal: slab::unit_normal(&t),
+            centroid: (t[0] + t[1] + t[2]) / 3.0,
+            t,
+        }
+    }
+
+    /// A lower bound on the distance of the two triangles, or any value above `bound` once one
+    /// of them exceeds it: the box gap, then (less the rounding `margin`) the gap between each
+    /// plane and the other triangle, then the gap between their projections on the line
+    /// through their centroids (the axis that separates side-by-side triangles on a surface
+    /// at a near-constant distance, where the planes are nearly parallel and their gaps say
+    /// nothing). Each is a true lower bound; the projections on a unit vector computed in f64
+    /// are within the oriented-bound margin of the exact ones
+    /// ([`predicates::oriented_bound_margin`]).
+    #[inline]
+    fn lower_bound(&self, o: &LeafTriangle, bound: f64, margin: f64) -> f64 {
+        let boxed = self.bounds.distance_sq(&o.bounds).sqrt();
+        if boxed > bound {
+            return boxed;
+        }
+        let planes = slab::plane_gap(&self.t, self.normal, &o.t, o.normal) - margin;
+        if planes > bound {
+            return planes;
+        }
+        let axis = (o.centroid - self.centroid).normalize_or_zero();
+        let hi = self.t.iter().map(|p| axis.dot(*p)).fold(f64::NEG_INFINITY, f64::max);
+        let lo = o.t.iter().map(|p| axis.dot(*p)).fold(f64::INFINITY, f64::min);
+        boxed.max(planes).max(lo - hi - margin)
+    }
 }
 
 /// The severity at which a run fails (exit code 1).

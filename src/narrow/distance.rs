@@ -93,7 +93,7 @@ pub fn closest_point_on_triangle(p: DVec3, a: DVec3, b: DVec3, c: DVec3) -> DVec
 /// Ericson §5.1.9 for segments `p1 + s·d1` and `p2 + t·d2`, `s, t ∈ [0, 1]`, given
 /// `a = |d1|²` and `e = |d2|²`; see [`closest_points_segments`].
 #[inline(always)]
-fn segments_core(p1: DVec3, d1: DVec3, a: f64, p2: DVec3, d2: DVec3, e: f64) -> (DVec3, DVec3) {
+pub(crate) fn segments_core(p1: DVec3, d1: DVec3, a: f64, p2: DVec3, d2: DVec3, e: f64) -> (DVec3, DVec3) {
     let r = p1 - p2;
     let f = d2.dot(r);
     let (s, t);
