@@ -389,10 +389,29 @@ pub fn orient2d(a: DVec3, b: DVec3, c: DVec3, axis: usize) -> Sign {
 
 /// Exact: are the three points collinear (or coincident)? True iff every component of
 /// `(b - a) × (c - a)` is exactly zero.
+///
+/// Float-filtered: a component whose f64 value exceeds Shewchuk's first error bound of the 2D
+/// orientation ([`CCW_ERRBOUND_A`], the bound `robust::orient2d` applies before its exact
+/// stages) is certainly non-zero, so a proper triangle is answered from three pairs of
+/// f64 products; only the components the bound cannot decide go to the exact predicate.
 #[inline]
 pub fn collinear(a: DVec3, b: DVec3, c: DVec3) -> bool {
+    let (u, v) = (b - a, c - a);
+    for (i, j) in [(0, 1), (1, 2), (2, 0)] {
+        // orient2d(b, c, a) on the plane of axes i, j (a cyclic turn of (a, b, c): same sign).
+        let (l, r) = (u[i] * v[j], u[j] * v[i]);
+        if (l - r).abs() > CCW_ERRBOUND_A * (l.abs() + r.abs()) {
+            return false;
+        }
+    }
     (0..3).all(|k| orient2d(a, b, c, k) == 0)
 }
+
+/// Shewchuk's `ccwerrboundA` = (3 + 16ε)ε with ε = 2⁻⁵³: when the f64 value of a 2D
+/// orientation determinant, computed from rounded coordinate differences, exceeds this times
+/// the sum of its two products' magnitudes, its sign is the exact sign (for coordinates within
+/// [`MIN_EXACT_MAGNITUDE`], [`MAX_EXACT_MAGNITUDE`], where nothing underflows).
+pub const CCW_ERRBOUND_A: f64 = (3.0 + 16.0 * (f64::EPSILON / 2.0)) * (f64::EPSILON / 2.0);
 
 /// An axis along which the triangle `(a, b, c)` projects without collapsing (its normal has a
 /// non-zero component there), preferring the largest component so projected shapes stay well
@@ -732,6 +751,45 @@ mod tests {
         let v =
             orient3d_value(a + off, b + off, c + off, DVec3::new(0.25, 0.5, 0.375 + 2f64.powi(-20)) + off);
         assert_eq!(v, 2f64.powi(-20));
+    }
+
+    #[test]
+    fn filtered_collinear_equals_the_exact_test() {
+        // Points on a line through random f64 coordinates, nudged by a few ulps (or not) in
+        // random coordinates, at scales from 2^-200 to 2^200: the filter may only answer
+        // "not collinear" where the exact test does.
+        let mut x = 0x9E37_79B9_7F4A_7C15u64;
+        let mut rnd = move || {
+            x ^= x << 13;
+            x ^= x >> 7;
+            x ^= x << 17;
+            x
+        };
+        let mut rnd2 = rnd;
+        let (mut degenerate, mut proper) = (0, 0);
+        for i in 0..20_000 {
+            let scale = 2f64.powi((i % 41) * 10 - 200);
+            let mut unit = || (rnd() >> 11) as f64 / (1u64 << 53) as f64 - 0.5;
+            let a = DVec3::new(unit(), unit(), unit()) * scale;
+            let d = DVec3::new(unit(), unit(), unit()) * scale;
+            let (s, t) = [(1.0, 2.0), (0.5, -3.0), (0.0, 1.0), (1.0, 1.0)][(i % 4) as usize];
+            let mut b = a + d * s;
+            let mut c = a + d * t;
+            match rnd2() % 4 {
+                0 => b.x = f64::from_bits(b.x.to_bits().wrapping_add(1 + rnd2() % 3)),
+                1 => c.z = f64::from_bits(c.z.to_bits().wrapping_add(1)),
+                2 => c = DVec3::new(unit(), unit(), unit()) * scale,
+                _ => {}
+            }
+            let exact = (0..3).all(|k| orient2d(a, b, c, k) == 0);
+            assert_eq!(collinear(a, b, c), exact, "{a} {b} {c}");
+            if exact {
+                degenerate += 1;
+            } else {
+                proper += 1;
+            }
+        }
+        assert!(degenerate > 1000 && proper > 1000, "{degenerate} {proper}");
     }
 
     #[test]
