@@ -32,7 +32,7 @@ use std::sync::OnceLock;
 /// Largest cell: ranges of the curve order with at most this many triangles are left unbuilt
 /// until a walk opens them. A cost knob only (no answer depends on it): smaller cells build less
 /// of what a walk never opens, larger ones keep more of the tree SAH-quality.
-pub const CELL_MAX: usize = 1024;
+pub const CELL_MAX: usize = 256;
 
 /// Ids are reserved per cell in blocks of `1 << BLOCK_SHIFT`.
 const BLOCK_SHIFT: u32 = 6;
