@@ -20,7 +20,7 @@ use crate::check::containment::{self, Containment, Topology};
 use crate::check::query::{
     self, Closest, Detail, DistanceError, Input, InputSpec, Mode, PairFinding, PairKind, Settings,
 };
-use crate::error::{Error, Result};
+use crate::error::{Error, InputProblem, Location, NonFinite, Result, UsageProblem};
 use crate::geom::predicates::{self, BoxMap, Tolerances};
 use crate::geom::{Aabb, DVec3};
 use crate::load::Format;
@@ -55,9 +55,7 @@ impl Tolerance {
         };
         match num.trim().parse::<f64>() {
             Ok(v) if v.is_finite() && v >= 0.0 => Ok(if rel { Tolerance::Rel(v) } else { Tolerance::Abs(v) }),
-            _ => Err(Error::Usage(format!(
-                "--{flag} must be a finite number >= 0, optionally with a 'rel' suffix (e.g. 0.01 or 1e-6rel), got '{s}'"
-            ))),
+            _ => Err(Error::bad_flag(flag, UsageProblem::BadTolerance { text: s.to_string() })),
         }
     }
 
@@ -131,13 +129,14 @@ impl Options {
     /// Reject what the command line rejects (leaf size, distance allowances).
     pub fn validate(&self) -> Result<()> {
         if !(1..=64).contains(&self.bvh.leaf_size) {
-            return Err(Error::Usage(format!("--leaf-size must be 1..=64, got {}", self.bvh.leaf_size)));
+            let problem = UsageProblem::OutOfRange { value: self.bvh.leaf_size.into(), min: 1, max: 64 };
+            return Err(Error::bad_flag("leaf-size", problem));
         }
         for (flag, v) in
             [("distance-rel-err", self.distance_error.rel), ("distance-abs-err", self.distance_error.abs)]
         {
             if !(v.is_finite() && v >= 0.0) {
-                return Err(Error::Usage(format!("--{flag} must be a finite number >= 0, got {v}")));
+                return Err(Error::bad_flag(flag, UsageProblem::NotNonNegative { value: v }));
             }
         }
         Ok(())
@@ -182,10 +181,12 @@ pub fn array_source(label: &Path, mesh: Mesh, transform: DMat4, split_bodies: bo
 /// loaders' message for an index out of range (`label` names the input).
 pub fn triangles_from<I>(label: &Path, flat: &[I], vertices: usize) -> Result<Vec<[u32; 3]>>
 where
-    I: Copy + TryInto<u32> + std::fmt::Display,
+    I: Copy + TryInto<u32> + TryInto<i128>,
 {
     let bad = |t: usize, v: I| {
-        Error::input(label, format!("triangle {t} refers to vertex {v} but there are {vertices} vertices"))
+        // Every primitive integer fits in i128.
+        let index = TryInto::<i128>::try_into(v).unwrap_or(i128::MAX);
+        Error::at(label, Location::Triangle(t), InputProblem::IndexOutOfRange { index, len: vertices })
     };
     flat.chunks_exact(3)
         .enumerate()
@@ -212,27 +213,18 @@ pub fn mesh_from_arrays(
     triangles: Vec<[u32; 3]>,
 ) -> Result<Mesh> {
     if triangles.is_empty() {
-        return Err(Error::input(label, "no triangles"));
+        return Err(Error::in_file(label, InputProblem::NoTriangles));
     }
     let n = positions.len();
     for (t, tri) in triangles.iter().enumerate() {
         if let Some(&v) = tri.iter().find(|&&v| v as usize >= n) {
-            return Err(Error::input(
-                label,
-                format!("triangle {t} refers to vertex {v} but there are {n} vertices"),
-            ));
+            let problem = InputProblem::IndexOutOfRange { index: v.into(), len: n };
+            return Err(Error::at(label, Location::Triangle(t), problem));
         }
     }
     for (i, p) in positions.iter().enumerate() {
-        if let Some(c) = p.to_array().into_iter().find(|c| !c.is_finite()) {
-            let bad = if c.is_nan() {
-                "NaN"
-            } else if c > 0.0 {
-                "inf"
-            } else {
-                "-inf"
-            };
-            return Err(Error::input(label, format!("vertex {i} has a non-finite coordinate ({bad})")));
+        if let Some(value) = NonFinite::first(p.to_array()) {
+            return Err(Error::at(label, Location::Vertex(i), InputProblem::NonFinite { value }));
         }
     }
     let name = if name.is_empty() { "object0" } else { name };
@@ -252,7 +244,7 @@ pub fn in_pool<T: Send>(threads: usize, f: impl FnOnce(usize) -> Result<T> + Sen
     let pool = rayon::ThreadPoolBuilder::new()
         .num_threads(threads)
         .build()
-        .map_err(|e| Error::Usage(format!("--threads: {e}")))?;
+        .map_err(|e| Error::bad_flag("threads", UsageProblem::Invalid(e.to_string())))?;
     pool.install(|| f(pool.current_num_threads()))
 }
 
@@ -265,7 +257,7 @@ pub fn report(a: &Source, b: Option<&Source>, opts: &Options) -> Result<Report> 
         let bs = b.unwrap_or(a);
         let outcome_of = |settings: &Settings| {
             assembly::run(&a.input.mesh, &bs.input.mesh, &opts.selection, settings)
-                .map_err(|e| Error::input(&bs.input.path, e))
+                .map_err(|e| Error::in_file(&bs.input.path, InputProblem::Selection(e)))
         };
         finish_report(a, bs, opts, threads, t0, outcome_of)
     })
@@ -276,7 +268,7 @@ fn resolved_settings(a: &Mesh, b: &Mesh, opts: &Options) -> Result<(Settings, f6
     let size = Aabb::of_points(&a.positions).union(Aabb::of_points(&b.positions)).extent().length();
     let tolerances = Tolerances { touch: opts.touch.resolve(size), clearance: opts.clearance.resolve(size) };
     if !tolerances.touch.is_finite() || !tolerances.clearance.is_finite() {
-        return Err(Error::Usage("relative tolerance overflows for this model size".into()));
+        return Err(Error::usage(UsageProblem::ToleranceOverflow));
     }
     let settings = Settings {
         tolerances,
@@ -380,16 +372,11 @@ impl Prepared {
         for (i, p) in local.iter().enumerate() {
             let w = m.transform_point3(*p);
             if !w.is_finite() {
-                return Err(Error::input(
-                    &self.label,
-                    format!("vertex {i} is not finite after the transform"),
-                ));
+                let problem = InputProblem::NonFiniteAfterTransform { value: None };
+                return Err(Error::at(&self.label, Location::Vertex(i), problem));
             }
             if w.abs().max_element() > predicates::MAX_EXACT_MAGNITUDE {
-                return Err(Error::input(
-                    &self.label,
-                    format!("vertex {i} has a coordinate beyond ±2^250 (about 1.8e75) after the transform, where verdicts stop being exact"),
-                ));
+                return Err(Error::at(&self.label, Location::Vertex(i), InputProblem::BeyondExactRange));
             }
             world.push(w);
         }
@@ -524,9 +511,9 @@ impl Placed {
 pub fn report_placed(a: &Placed, b: &Placed, opts: &Options) -> Result<Report> {
     opts.validate()?;
     if opts.selection.by_parts() || opts.split_bodies {
-        return Err(Error::Usage(
+        return Err(Error::usage(UsageProblem::Conflict(
             "prepared meshes are checked whole: selections, scene mode and --split-bodies need arrays or files".into(),
-        ));
+        )));
     }
     in_pool(opts.threads, |threads| {
         let t0 = Instant::now();

@@ -16,6 +16,8 @@ mod brute_force;
 mod clash_set;
 #[path = "cli.rs"]
 mod cli;
+#[path = "cli_errors.rs"]
+mod cli_errors;
 #[path = "cli_messages.rs"]
 mod cli_messages;
 #[path = "cli_subcommands.rs"]

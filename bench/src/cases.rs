@@ -28,11 +28,12 @@
 //! GJK per candidate (pairs), `query::distance` (distance). Scene cases (the engines) time the
 //! load and `assembly::run` in scene mode; parry has no counterpart there.
 
+use crate::usage;
 use meshclash::bvh::{BuildOptions, Bvh};
 use meshclash::check::assembly::{self, Selection};
 use meshclash::check::cross_check::{self, ParryResult};
 use meshclash::check::query::{self, InputSpec, Settings};
-use meshclash::error::{Error, Result};
+use meshclash::error::{Error, Result, UsageProblem};
 use meshclash::scene::mesh::Mesh;
 use serde::Serialize;
 use serde_json::{json, Value};
@@ -100,7 +101,7 @@ fn files_of(case: &str) -> &'static [&'static str] {
 }
 
 fn io_err(path: &Path, e: std::io::Error) -> Error {
-    Error::Usage(format!("{}: {e}", path.display()))
+    usage(format!("{}: {e}", path.display()))
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -400,16 +401,15 @@ pub fn generate(args: &GenArgs) -> Result<String> {
 
     if let Some(engine) = &args.engine {
         let bytes = std::fs::read(engine).map_err(|e| io_err(engine, e))?;
-        let (json, bin) =
-            split_glb(&bytes).map_err(|e| Error::Usage(format!("{}: {e}", engine.display())))?;
+        let (json, bin) = split_glb(&bytes).map_err(|e| usage(format!("{}: {e}", engine.display())))?;
         write("engine.glb", &bytes, "copy".into())?;
         let mut grids = vec![("engine_grid100.glb", grid(10, 10, 1, 1000.0))];
         if args.grid1000 {
             grids.push(("engine_grid1000.glb", grid(10, 10, 10, 1000.0)));
         }
         for (name, offsets) in grids {
-            let j = instance_grid(&json, &offsets)
-                .map_err(|e| Error::Usage(format!("{}: {e}", engine.display())))?;
+            let j =
+                instance_grid(&json, &offsets).map_err(|e| usage(format!("{}: {e}", engine.display())))?;
             write(name, &glb_bytes(&j, &bin), format!("{} instances, 1,000 apart", offsets.len()))?;
         }
     }
@@ -525,7 +525,7 @@ fn run_case(name: &str, dir: &Path, args: &CasesArgs) -> Result<CaseResult> {
         let load_ms = ms(t);
         let sel = Selection { scene: true, ..Default::default() };
         let t = Instant::now();
-        let out = assembly::run(&m, &m, &sel, &Settings::default()).map_err(Error::Usage)?;
+        let out = assembly::run(&m, &m, &sel, &Settings::default()).map_err(usage)?;
         let check_ms = ms(t);
         let n = m.triangles.len();
         return Ok(CaseResult {
@@ -601,10 +601,8 @@ fn run_case(name: &str, dir: &Path, args: &CasesArgs) -> Result<CaseResult> {
 /// default) whose files exist.
 fn selected(args: &CasesArgs) -> Result<Vec<&'static str>> {
     if !["clear", "all", "none"].contains(&args.parry_distance.as_str()) {
-        return Err(Error::Usage(format!(
-            "--parry-distance: '{}' is not clear, all or none",
-            args.parry_distance
-        )));
+        let msg = format!("--parry-distance: '{}' is not clear, all or none", args.parry_distance);
+        return Err(Error::bad_flag("parry-distance", UsageProblem::Other(msg)));
     }
     let want: Vec<&'static str> = match &args.only {
         None => CASES.to_vec(),
@@ -614,7 +612,8 @@ fn selected(args: &CasesArgs) -> Result<Vec<&'static str>> {
             .filter(|s| !s.is_empty())
             .map(|s| {
                 CASES.iter().copied().find(|c| *c == s).ok_or_else(|| {
-                    Error::Usage(format!("--only: no case '{s}' (cases: {})", CASES.join(", ")))
+                    let msg = format!("--only: no case '{s}' (cases: {})", CASES.join(", "));
+                    Error::bad_flag("only", UsageProblem::Other(msg))
                 })
             })
             .collect::<Result<_>>()?,
@@ -622,7 +621,7 @@ fn selected(args: &CasesArgs) -> Result<Vec<&'static str>> {
     let present: Vec<&'static str> =
         want.iter().copied().filter(|c| files_of(c).iter().all(|f| args.dir.join(f).is_file())).collect();
     if present.is_empty() {
-        return Err(Error::Usage(format!(
+        return Err(usage(format!(
             "{}: no case has its files (run `meshclash-bench gen {}` first)",
             args.dir.display(),
             args.dir.display()
@@ -630,11 +629,7 @@ fn selected(args: &CasesArgs) -> Result<Vec<&'static str>> {
     }
     if args.only.is_some() && present.len() < want.len() {
         let missing: Vec<&str> = want.iter().copied().filter(|c| !present.contains(c)).collect();
-        return Err(Error::Usage(format!(
-            "{}: files missing for {}",
-            args.dir.display(),
-            missing.join(", ")
-        )));
+        return Err(usage(format!("{}: files missing for {}", args.dir.display(), missing.join(", "))));
     }
     Ok(present)
 }
@@ -645,7 +640,7 @@ pub fn run_cases(args: &CasesArgs) -> Result<String> {
     let pool = rayon::ThreadPoolBuilder::new()
         .num_threads(args.threads)
         .build()
-        .map_err(|e| Error::Usage(format!("--threads: {e}")))?;
+        .map_err(|e| Error::bad_flag("threads", UsageProblem::Invalid(e.to_string())))?;
     let load0 = loadavg();
     let results = pool.install(|| {
         rayon::broadcast(|_| ()); // start the workers outside the timed regions

@@ -23,6 +23,13 @@
 //! its peak including transient buffers (and, for parry, its copy of the vertex buffers).
 
 pub mod cases;
+
+/// A problem of the harness's own (bad arguments, missing files, a failed check), as a sentence:
+/// exit 2 with `usage: ` and the sentence.
+pub(crate) fn usage(msg: impl Into<String>) -> Error {
+    Error::usage(UsageProblem::Other(msg.into()))
+}
+
 pub mod layout;
 pub mod parry32;
 pub mod self_case;
@@ -32,7 +39,7 @@ use meshclash::bvh::traverse;
 use meshclash::bvh::{self, BuildOptions, Bvh, Strategy};
 use meshclash::check::cross_check::{self, ParryResult};
 use meshclash::check::query::{self, ClashResult, DistanceError, Mode, Settings};
-use meshclash::error::{Error, Result};
+use meshclash::error::{Error, Result, UsageProblem};
 use meshclash::geom::predicates;
 use meshclash::geom::Aabb;
 use meshclash::narrow::tri_tri;
@@ -95,7 +102,10 @@ pub fn parse_sizes(s: &str) -> Result<Vec<usize>> {
             };
             match num.parse::<f64>() {
                 Ok(v) if v.is_finite() && v * mul >= 8.0 && v * mul <= 2e7 => Ok((v * mul).round() as usize),
-                _ => Err(Error::Usage(format!("--sizes: '{t}' is not a size from 8 to 20M (e.g. 10k, 1M)"))),
+                _ => Err(Error::bad_flag(
+                    "sizes",
+                    UsageProblem::Other(format!("--sizes: '{t}' is not a size from 8 to 20M (e.g. 10k, 1M)")),
+                )),
             }
         })
         .collect()
@@ -122,10 +132,7 @@ pub fn run_command(args: &BenchArgs) -> Result<String> {
         .map(|(t, r)| format!("{} {}", t.input, r.mode))
         .collect();
     if !bad.is_empty() {
-        return Err(Error::Usage(format!(
-            "approximate distance outside its guaranteed bound: {}",
-            bad.join(", ")
-        )));
+        return Err(usage(format!("approximate distance outside its guaranteed bound: {}", bad.join(", "))));
     }
     Ok(if args.json {
         let mut s = serde_json::to_string_pretty(&rep).expect("bench report serialises");
@@ -506,7 +513,7 @@ pub fn run(opts: &BenchOptions) -> Result<BenchReport> {
     let pool = rayon::ThreadPoolBuilder::new()
         .num_threads(opts.threads)
         .build()
-        .map_err(|e| Error::Usage(format!("--threads: {e}")))?;
+        .map_err(|e| Error::bad_flag("threads", UsageProblem::Invalid(e.to_string())))?;
     let t0 = Instant::now();
     let load0 = loadavg();
     let cases = cases(opts)?;

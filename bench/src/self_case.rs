@@ -13,7 +13,7 @@
 
 use meshclash::bvh::BuildOptions;
 use meshclash::check::self_clash::{self, PartChoice};
-use meshclash::error::{Error, Result};
+use meshclash::error::{Error, Result, UsageProblem};
 use meshclash::scene::mesh::Mesh;
 use serde::Serialize;
 use std::path::PathBuf;
@@ -160,13 +160,16 @@ pub fn run_self_case(args: &SelfCaseArgs) -> Result<String> {
         "sah" => meshclash::bvh::Strategy::Sah,
         "median" => meshclash::bvh::Strategy::Median,
         "equal" => meshclash::bvh::Strategy::Equal,
-        other => return Err(Error::Usage(format!("--bvh: sah, median or equal, not '{other}'"))),
+        other => {
+            let msg = format!("--bvh: sah, median or equal, not '{other}'");
+            return Err(Error::bad_flag("bvh", UsageProblem::Other(msg)));
+        }
     };
     let opts = BuildOptions { strategy, leaf_size: args.leaf_size.clamp(1, 64) };
     let pool = rayon::ThreadPoolBuilder::new()
         .num_threads(args.threads)
         .build()
-        .map_err(|e| Error::Usage(format!("--threads: {e}")))?;
+        .map_err(|e| Error::bad_flag("threads", UsageProblem::Invalid(e.to_string())))?;
     let results = pool.install(|| -> Result<Vec<SelfCaseResult>> {
         rayon::broadcast(|_| ()); // warm the pool
         let threads = rayon::current_num_threads();

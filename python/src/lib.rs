@@ -21,11 +21,7 @@ use std::sync::{Arc, Mutex};
 fn py_err(e: Error) -> PyErr {
     let line = e.to_string();
     match &e {
-        Error::Input { msg, .. }
-            if msg.starts_with("cannot read file") || msg.starts_with("not a regular file") =>
-        {
-            PyOSError::new_err(line)
-        }
+        _ if e.is_unreadable_file() => PyOSError::new_err(line),
         Error::Output { .. } => PyOSError::new_err(line),
         _ => PyValueError::new_err(line),
     }

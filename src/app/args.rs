@@ -2,7 +2,7 @@
 //! enums. Validation into a [`super::config::Config`] is in [`super::config`].
 
 use clap::{Parser, ValueEnum};
-use meshclash::error::{Error, Result};
+use meshclash::error::{Error, Result, UsageProblem};
 use meshclash::output::bcf::Topics;
 use meshclash::output::{Format, OutputOptions};
 use meshclash::report::self_report::SelfFailOn;
@@ -306,7 +306,8 @@ impl OutputArgs {
     /// Validate. `fail_on_new` is whether `--fail-on new` was given: it needs `--baseline`.
     pub fn into_options(self, fail_on_new: bool) -> Result<OutputOptions> {
         if fail_on_new && self.baseline.is_none() {
-            return Err(Error::Usage("--fail-on new needs --baseline REPORT".into()));
+            let why = "--fail-on new needs --baseline REPORT".to_string();
+            return Err(Error::bad_flag("fail-on", UsageProblem::Conflict(why)));
         }
         Ok(OutputOptions {
             format: self.format.map(Into::into),

@@ -35,7 +35,7 @@ use super::config;
 use super::progress::Phase;
 use super::run;
 use clap::Parser as _;
-use meshclash::error::{Error, Result};
+use meshclash::error::{CheckRef, Error, InputProblem, Location, Reading, Result, UsageProblem};
 use meshclash::output::junit;
 use meshclash::report;
 use serde::de::Error as _;
@@ -231,8 +231,9 @@ pub struct Check {
     pub config: config::Config,
 }
 
-fn err(file: &Path, msg: impl Into<String>) -> Error {
-    Error::input(file, msg)
+/// A rule of the clash-set format broken in `file` (at `at`).
+fn invalid(file: &Path, at: Option<Location>, msg: impl Into<String>) -> Error {
+    Error::located(file, at, InputProblem::Invalid(msg.into()))
 }
 
 /// A serde_json error inside the text `sub` (a slice of `text`), located in `text`.
@@ -251,10 +252,10 @@ fn located(text: &str, sub: &str, e: &serde_json::Error) -> String {
     format!("{msg} at line {line} column {col}")
 }
 
-fn check_label(raw: &RawValue, i: usize) -> String {
+fn check_label(raw: &RawValue, i: usize) -> CheckRef {
     match serde_json::from_str::<NameOnly>(raw.get()).ok().and_then(|n| n.name) {
-        Some(serde_json::Value::String(s)) => format!("check '{s}'"),
-        _ => format!("check #{}", i + 1),
+        Some(serde_json::Value::String(s)) => CheckRef::Name(s),
+        _ => CheckRef::Number(i + 1),
     }
 }
 
@@ -367,44 +368,54 @@ pub fn argv(c: &CheckSpec, dir: &Path, run: &ClashSetArgs) -> std::result::Resul
 /// turned into its command line and validated into a [`config::Config`]. Any problem is an
 /// [`Error::Input`] naming the file and the check.
 pub fn load(file: &Path, run: &ClashSetArgs) -> Result<Vec<Check>> {
-    let bytes = std::fs::read(file).map_err(|e| err(file, format!("cannot read: {e}")))?;
-    let text = String::from_utf8(bytes).map_err(|_| err(file, "not UTF-8 text"))?;
+    let bytes = std::fs::read(file).map_err(|e| {
+        let problem =
+            InputProblem::Unreadable { reading: Reading::ClashSet, kind: e.kind(), reason: e.to_string() };
+        Error::in_file(file, problem)
+    })?;
+    let text =
+        String::from_utf8(bytes).map_err(|_| Error::in_file(file, InputProblem::NotUtf8 { byte: None }))?;
     parse(file, &text, run)
 }
 
 /// [`load`] on the file's text.
 pub fn parse(file: &Path, text: &str, run: &ClashSetArgs) -> Result<Vec<Check>> {
-    let top: RawFile = serde_json::from_str(text).map_err(|e| err(file, located(text, text, &e)))?;
+    let syntax = |at: Option<Location>, sub: &str, e: &serde_json::Error| {
+        Error::located(file, at, InputProblem::Syntax(located(text, sub, e)))
+    };
+    let top: RawFile = serde_json::from_str(text).map_err(|e| syntax(None, text, &e))?;
     if top.version != VERSION {
-        return Err(err(
-            file,
-            format!("version {} is not supported (this meshclash reads version {VERSION})", top.version),
-        ));
+        let msg =
+            format!("version {} is not supported (this meshclash reads version {VERSION})", top.version);
+        return Err(invalid(file, None, msg));
     }
     if top.checks.is_empty() {
-        return Err(err(file, "\"checks\" is empty"));
+        return Err(invalid(file, None, "\"checks\" is empty"));
     }
     let mut defaults = match top.defaults {
         Some(raw) => serde_json::from_str::<CheckSpec>(raw.get())
-            .map_err(|e| err(file, format!("defaults: {}", located(text, raw.get(), &e))))?,
+            .map_err(|e| syntax(Some(Location::Defaults), raw.get(), &e))?,
         None => CheckSpec::default(),
     };
     if defaults.name.is_some() || defaults.a.is_some() || defaults.b.is_some() || defaults.scene.is_some() {
-        return Err(err(file, "defaults: \"name\", \"a\", \"b\" and \"scene\" belong to each check"));
+        let msg = "\"name\", \"a\", \"b\" and \"scene\" belong to each check";
+        return Err(invalid(file, Some(Location::Defaults), msg));
     }
     if let Some(u) = top.units {
         if defaults.units.is_some() {
-            return Err(err(file, "\"units\" is given both at the top level and in \"defaults\""));
+            return Err(invalid(file, None, "\"units\" is given both at the top level and in \"defaults\""));
         }
         defaults.units = Some(u);
     }
     let dir = file.parent().unwrap_or(Path::new(""));
     let mut checks: Vec<Check> = Vec::with_capacity(top.checks.len());
     for (i, raw) in top.checks.iter().enumerate() {
-        let label = check_label(raw, i);
-        let fail = |m: String| err(file, format!("{label}: {m}"));
+        let at = Some(Location::Check(check_label(raw, i)));
+        let fail = |m: String| invalid(file, at.clone(), m);
+        // The check's own error, as it would be on the command line.
+        let in_check = |e: Error| Error::located(file, at.clone(), InputProblem::InCheck(Box::new(e)));
         let mut spec: CheckSpec =
-            serde_json::from_str(raw.get()).map_err(|e| fail(located(text, raw.get(), &e)))?;
+            serde_json::from_str(raw.get()).map_err(|e| syntax(at.clone(), raw.get(), &e))?;
         let name = match spec.name.take() {
             Some(n) if !n.trim().is_empty() => n,
             Some(_) => return Err(fail("\"name\" is empty".into())),
@@ -417,19 +428,13 @@ pub fn parse(file: &Path, text: &str, run: &ClashSetArgs) -> Result<Vec<Check>> 
         let argv = argv(&spec, dir, run).map_err(&fail)?;
         let args = Args::try_parse_from(&argv).map_err(|e| {
             let m = e.to_string();
-            fail(m.lines().next().unwrap_or("bad value").trim_start_matches("error: ").trim().to_string())
+            let m = m.lines().next().unwrap_or("bad value").trim_start_matches("error: ").trim().to_string();
+            in_check(Error::usage(UsageProblem::Invalid(m)))
         })?;
-        let config = args.into_config().map_err(|e| fail(inner(e)))?;
+        let config = args.into_config().map_err(in_check)?;
         checks.push(Check { name, argv, config });
     }
     Ok(checks)
-}
-
-fn inner(e: Error) -> String {
-    match e {
-        Error::Usage(m) => m,
-        other => other.to_string(),
-    }
 }
 
 /// What the binary should do after a successful clash-set run.
@@ -459,7 +464,8 @@ pub fn schema_json(kind: SchemaKind) -> String {
 /// Run every check of `args.file`, then write the outputs. Bad input in any check is an error
 /// and nothing is written.
 pub fn run_with_progress(args: &ClashSetArgs, progress: &(dyn Fn(Phase) + Sync)) -> Result<SetOutcome> {
-    let file = args.file.as_deref().ok_or_else(|| Error::Usage("missing clash-set FILE".into()))?;
+    let file =
+        args.file.as_deref().ok_or_else(|| Error::usage(UsageProblem::Missing("clash-set FILE".into())))?;
     let checks = load(file, args)?;
     let outputs: Vec<meshclash::output::write::Named> = [("-o", &args.output), ("--junit", &args.junit)]
         .into_iter()
@@ -472,8 +478,10 @@ pub fn run_with_progress(args: &ClashSetArgs, progress: &(dyn Fn(Phase) + Sync))
         checks
             .iter()
             .map(|c| {
-                let rep = run::check_in_pool(&c.config, threads, progress)
-                    .map_err(|e| err(file, format!("check '{}': {}", c.name, inner(e))))?;
+                let rep = run::check_in_pool(&c.config, threads, progress).map_err(|e| {
+                    let at = Location::Check(CheckRef::Name(c.name.clone()));
+                    Error::at(file, at, InputProblem::InCheck(Box::new(e)))
+                })?;
                 Ok(CheckReport { name: c.name.clone(), report: rep })
             })
             .collect::<Result<Vec<_>>>()

@@ -4,7 +4,7 @@ use super::args::{Args, BvhArg, CheckArgs, Command, DetailArg, FailOnArg, ModeAr
 use glam::{DMat4, DVec3, DVec4};
 use meshclash::bvh::{BuildOptions, Strategy};
 use meshclash::check::query::{Detail, DistanceError, FailOn, InputSpec, Mode, Settings};
-use meshclash::error::{Error, Result};
+use meshclash::error::{Error, Result, UsageProblem};
 use meshclash::geom::predicates::Tolerances;
 use meshclash::report;
 use std::path::PathBuf;
@@ -13,7 +13,7 @@ fn nonneg(flag: &str, v: f64) -> Result<f64> {
     if v.is_finite() && v >= 0.0 {
         Ok(v)
     } else {
-        Err(Error::Usage(format!("--{flag} must be a finite number >= 0, got {v}")))
+        Err(Error::bad_flag(flag, UsageProblem::NotNonNegative { value: v }))
     }
 }
 
@@ -123,7 +123,7 @@ impl UnitsConfig {
 fn positive_scale(flag: &str, v: Option<f64>) -> Result<Option<f64>> {
     match v {
         Some(x) if !(x.is_finite() && x > 0.0) => {
-            Err(Error::Usage(format!("--{flag} must be a finite number > 0, got {x}")))
+            Err(Error::bad_flag(flag, UsageProblem::NotPositive { value: x }))
         }
         _ => Ok(v),
     }
@@ -135,7 +135,7 @@ fn numbers(flag: &str, s: &str) -> Result<Vec<f64>> {
             let t = t.trim();
             match t.parse::<f64>() {
                 Ok(v) if v.is_finite() => Ok(v),
-                _ => Err(Error::Usage(format!("--{flag}: '{t}' is not a finite number"))),
+                _ => Err(Error::bad_flag(flag, UsageProblem::NotANumber { text: t.to_string() })),
             }
         })
         .collect()
@@ -145,10 +145,10 @@ fn numbers(flag: &str, s: &str) -> Result<Vec<f64>> {
 pub fn parse_transform(flag: &str, s: &str) -> Result<DMat4> {
     let v = numbers(flag, s)?;
     if v.len() != 12 && v.len() != 16 {
-        return Err(Error::Usage(format!("--{flag} takes 12 or 16 numbers, got {}", v.len())));
+        return Err(Error::bad_flag(flag, UsageProblem::MatrixLength { got: v.len() }));
     }
     if v.len() == 16 && v[12..] != [0.0, 0.0, 0.0, 1.0] {
-        return Err(Error::Usage(format!("--{flag}: the last row must be 0,0,0,1 (affine only)")));
+        return Err(Error::bad_flag(flag, UsageProblem::NotAffine));
     }
     let row = |r: usize| DVec4::new(v[4 * r], v[4 * r + 1], v[4 * r + 2], v[4 * r + 3]);
     Ok(DMat4::from_cols(row(0), row(1), row(2), DVec4::W).transpose())
@@ -159,7 +159,7 @@ pub fn parse_translation(flag: &str, s: &str) -> Result<DVec3> {
     let v = numbers(flag, s)?;
     match v[..] {
         [x, y, z] => Ok(DVec3::new(x, y, z)),
-        _ => Err(Error::Usage(format!("--{flag} takes x,y,z, got {} numbers", v.len()))),
+        _ => Err(Error::bad_flag(flag, UsageProblem::NotATriple { got: v.len() })),
     }
 }
 
@@ -210,9 +210,7 @@ pub fn parse_tolerance(flag: &str, s: &str) -> Result<Tol> {
     };
     match num.trim().parse::<f64>() {
         Ok(v) if v.is_finite() && v >= 0.0 => Ok(if rel { Tol::Rel(v) } else { Tol::Abs(v) }),
-        _ => Err(Error::Usage(format!(
-            "--{flag} must be a finite number >= 0, optionally with a 'rel' suffix (e.g. 0.01 or 1e-6rel), got '{s}'"
-        ))),
+        _ => Err(Error::bad_flag(flag, UsageProblem::BadTolerance { text: s.to_string() })),
     }
 }
 
@@ -237,43 +235,50 @@ impl CheckArgs {
     /// each other).
     pub fn into_config(self, a: Option<PathBuf>, b: Option<PathBuf>, scene_mode: bool) -> Result<Config> {
         if !(1..=64).contains(&self.leaf_size) {
-            return Err(Error::Usage(format!("--leaf-size must be 1..=64, got {}", self.leaf_size)));
+            let problem = UsageProblem::OutOfRange { value: self.leaf_size.into(), min: 1, max: 64 };
+            return Err(Error::bad_flag("leaf-size", problem));
         }
         if self.self_check && !scene_mode {
-            return Err(Error::Usage(
-                "--self works with scene (meshclash scene FILE --self); for one mesh use meshclash self FILE"
-                    .into(),
+            return Err(Error::bad_flag(
+                "self",
+                UsageProblem::Conflict(
+                    "--self works with scene (meshclash scene FILE --self); for one mesh use meshclash self FILE"
+                        .into(),
+                ),
             ));
         }
         if self.detail == DetailArg::Parts {
             let o = &self.outputs;
             let needs_regions = [
-                (o.html.is_some(), "--html"),
-                (o.export_glb.is_some(), "--export-glb"),
-                (o.baseline.is_some(), "--baseline"),
+                (o.html.is_some(), "html", ""),
+                (o.export_glb.is_some(), "export-glb", ""),
+                (o.baseline.is_some(), "baseline", ""),
                 (
                     o.bcf.is_some() && o.bcf_topics == TopicsArg::Regions,
-                    "--bcf (region topics; use --bcf-topics part-pairs)",
+                    "bcf",
+                    " (region topics; use --bcf-topics part-pairs)",
                 ),
-                (self.cross_check.is_some(), "--cross-check"),
+                (self.cross_check.is_some(), "cross-check", ""),
             ];
-            if let Some((_, flag)) = needs_regions.iter().find(|(given, _)| *given) {
-                return Err(Error::Usage(format!(
-                    "{flag} needs the triangle pairs that --detail parts does not keep: drop one of them"
-                )));
+            if let Some((_, flag, note)) = needs_regions.iter().find(|(given, ..)| *given) {
+                let why = format!(
+                    "--{flag}{note} needs the triangle pairs that --detail parts does not keep: drop one of them"
+                );
+                return Err(Error::bad_flag(flag, UsageProblem::Conflict(why)));
             }
         }
         if scene_mode && self.cross_check.is_some() {
-            return Err(Error::Usage("--cross-check works on two files, not with scene".into()));
+            let why = "--cross-check works on two files, not with scene".to_string();
+            return Err(Error::bad_flag("cross-check", UsageProblem::Conflict(why)));
         }
         let touch = parse_tolerance("touch-tolerance", &self.touch_tolerance)?;
         let clearance = parse_tolerance("clearance", &self.clearance)?;
         let scale = [positive_scale("scale-a", self.scale_a)?, positive_scale("scale-b", self.scale_b)?];
         let units = if scene_mode {
             if self.units_b.is_some() || self.scale_b.is_some() {
-                return Err(Error::Usage(
-                    "scene has one file: give its units and scale with --units-a and --scale-a".into(),
-                ));
+                let flag = if self.units_b.is_some() { "units-b" } else { "scale-b" };
+                let why = "scene has one file: give its units and scale with --units-a and --scale-a";
+                return Err(Error::bad_flag(flag, UsageProblem::Conflict(why.into())));
             }
             UnitsConfig {
                 report: self.units.or(self.units_a),
@@ -290,11 +295,11 @@ impl CheckArgs {
         Ok(Config {
             inputs: [
                 InputSpec {
-                    path: a.ok_or_else(|| Error::Usage("missing mesh A".into()))?,
+                    path: a.ok_or_else(|| Error::usage(UsageProblem::Missing("mesh A".into())))?,
                     transform: placement('a', &self.transform_a, &self.translate_a)?,
                 },
                 InputSpec {
-                    path: b.ok_or_else(|| Error::Usage("missing mesh B".into()))?,
+                    path: b.ok_or_else(|| Error::usage(UsageProblem::Missing("mesh B".into())))?,
                     transform: placement('b', &self.transform_b, &self.translate_b)?,
                 },
             ],

@@ -3,7 +3,7 @@
 use super::config::Config;
 use super::progress::Phase;
 use meshclash::check::query;
-use meshclash::error::{Error, Result};
+use meshclash::error::{Error, InputProblem, Result, UsageProblem};
 use meshclash::geom::predicates::Tolerances;
 use meshclash::report::{self, SettingsReport};
 use std::time::Instant;
@@ -44,7 +44,7 @@ pub fn in_pool<T: Send>(threads: usize, f: impl FnOnce(usize) -> Result<T> + Sen
     let pool = rayon::ThreadPoolBuilder::new()
         .num_threads(threads)
         .build()
-        .map_err(|e| Error::Usage(format!("--threads: {e}")))?;
+        .map_err(|e| Error::bad_flag("threads", UsageProblem::Invalid(e.to_string())))?;
     pool.install(|| f(pool.current_num_threads()))
 }
 
@@ -145,18 +145,20 @@ pub fn check_staged(
     settings.tolerances =
         Tolerances { touch: cfg.touch.resolve(size), clearance: cfg.clearance.resolve(size) };
     if !settings.tolerances.touch.is_finite() || !settings.tolerances.clearance.is_finite() {
-        return Err(Error::Usage("relative tolerance overflows for this model size".into()));
+        return Err(Error::usage(UsageProblem::ToleranceOverflow));
     }
     progress(Phase::Check);
-    let outcome = meshclash::check::assembly::run(&a.mesh, &b.mesh, &cfg.selection, &settings)
-        .map_err(|e| Error::input(&cfg.inputs[problem_side(cfg, &a.mesh)].path, e))?;
+    let outcome =
+        meshclash::check::assembly::run(&a.mesh, &b.mesh, &cfg.selection, &settings).map_err(|e| {
+            Error::in_file(&cfg.inputs[problem_side(cfg, &a.mesh)].path, InputProblem::Selection(e))
+        })?;
     let assembly = report::assembly_view(&outcome, cfg.max_pairs);
     let result = outcome.result;
     let failed = cfg.fail_on.fails(result.verdict);
     let cross_check = if cfg.cross_check {
         progress(Phase::CrossCheck);
         let p = meshclash::check::cross_check::parry_f64(&a.mesh, &b.mesh, true)
-            .map_err(|e| Error::Usage(format!("--cross-check parry: {e}")))?;
+            .map_err(|e| Error::bad_flag("cross-check", UsageProblem::CrossCheck(e.to_string())))?;
         Some(report::cross_check_report(&result, &p, cfg.max_pairs, cfg.deterministic))
     } else {
         None

@@ -11,7 +11,7 @@ use glam::DMat4;
 use meshclash::bvh::{BuildOptions, Strategy};
 use meshclash::check::query::{self, InputSpec};
 use meshclash::check::self_clash::{check_parts, PartChoice, PartResult};
-use meshclash::error::{Error, Result};
+use meshclash::error::{Error, InputProblem, Quantity, Result, UsageProblem};
 use meshclash::report::self_report::SelfFailOn;
 use meshclash::report::self_report::{self as rep, SelfReport};
 use std::time::Instant;
@@ -34,7 +34,8 @@ pub struct SelfOutcome {
 /// Do the whole `self` job.
 pub fn run(args: &SelfArgs) -> Result<SelfOutcome> {
     if !(1..=64).contains(&args.leaf_size) {
-        return Err(Error::Usage(format!("--leaf-size must be 1..=64, got {}", args.leaf_size)));
+        let problem = UsageProblem::OutOfRange { value: args.leaf_size.into(), min: 1, max: 64 };
+        return Err(Error::bad_flag("leaf-size", problem));
     }
     let outputs: Vec<meshclash::output::write::Named> = [
         ("-o", &args.output),
@@ -58,10 +59,12 @@ fn run_in_pool(args: &SelfArgs, threads: usize) -> Result<SelfOutcome> {
     let load_ms = t0.elapsed().as_secs_f64() * 1e3;
     // Health numbers triangle corners in u32 (3 per triangle).
     if input.mesh.triangles.len() > (u32::MAX / 3) as usize {
-        return Err(Error::input(
-            &args.file,
-            format!("{} triangles: `self` handles at most {}", input.mesh.triangles.len(), u32::MAX / 3),
-        ));
+        let problem = InputProblem::TooLarge {
+            quantity: Quantity::SelfTriangles,
+            count: input.mesh.triangles.len() as u64,
+            limit: (u32::MAX / 3) as u64,
+        };
+        return Err(Error::in_file(&args.file, problem));
     }
     let keep = |name: &str| {
         (args.select.is_empty()

@@ -11,7 +11,7 @@ use super::config::Config;
 use super::run as cli;
 use clap::Parser;
 use meshclash::check::assembly::Hook;
-use meshclash::error::{Error, Result};
+use meshclash::error::{Error, InputProblem, Reading, Result, UsageProblem};
 use meshclash::output::write::{self, Staged};
 use meshclash::shard::plan::{self, Plan, PlanInput};
 use meshclash::shard::{sha256, Covered, MergeHook, PlanHook, ShardHook, ShardReport, SHARD_SCHEMA};
@@ -128,14 +128,34 @@ pub fn dispatch() -> Option<u8> {
     }))
 }
 
+/// A problem with the command or with how the plan, shards and reports fit together (exit 2),
+/// as a sentence.
 fn usage(msg: impl Into<String>) -> Error {
-    Error::Usage(msg.into())
+    Error::usage(UsageProblem::Other(msg.into()))
+}
+
+/// Flags that do not go together (`flag` is the one at fault).
+fn conflict(flag: &str, why: impl Into<String>) -> Error {
+    Error::bad_flag(flag, UsageProblem::Conflict(why.into()))
+}
+
+/// A file that cannot be read.
+fn unreadable(path: &Path, reading: Reading, e: &std::io::Error) -> Error {
+    Error::in_file(path, InputProblem::Unreadable { reading, kind: e.kind(), reason: e.to_string() })
+}
+
+/// A plan or shard report that breaks its format's rules.
+fn invalid(path: &Path, msg: impl Into<String>) -> Error {
+    Error::in_file(path, InputProblem::Invalid(msg.into()))
 }
 
 /// Parse check arguments as `meshclash ARGS` would.
 fn parse_check(args: &[String]) -> Result<Args> {
     let a = Args::try_parse_from(std::iter::once("meshclash".to_string()).chain(args.iter().cloned()))
-        .map_err(|e| usage(e.to_string().trim_start_matches("error: ").trim_end().to_string()))?;
+        .map_err(|e| {
+            let msg = e.to_string().trim_start_matches("error: ").trim_end().to_string();
+            Error::usage(UsageProblem::Invalid(msg))
+        })?;
     if a.command.as_ref().is_some_and(|c| !matches!(c, Command::Scene(_))) {
         return Err(usage("plan takes the arguments of a check (A B, or scene FILE), not a subcommand"));
     }
@@ -155,10 +175,16 @@ fn check_flags(a: &Args) -> &CheckArgs {
 fn config_of(args: &[String]) -> Result<Config> {
     let cfg = parse_check(args)?.into_config()?;
     if cfg.cross_check {
-        return Err(usage("--cross-check runs parry on the whole inputs: it cannot be sharded"));
+        return Err(conflict(
+            "cross-check",
+            "--cross-check runs parry on the whole inputs: it cannot be sharded",
+        ));
     }
     if cfg.settings.first_hit {
-        return Err(usage("--first-hit stops at a timing-dependent pair: it cannot be sharded"));
+        return Err(conflict(
+            "first-hit",
+            "--first-hit stops at a timing-dependent pair: it cannot be sharded",
+        ));
     }
     if cfg.output.is_some() {
         return Err(usage("give -o FILE (the plan) as its own two arguments"));
@@ -185,7 +211,7 @@ fn hash_inputs(cfg: &Config) -> Result<Vec<PlanInput>> {
     cli::input_paths(cfg)
         .into_iter()
         .map(|p| {
-            let err = |e: std::io::Error| Error::input(p, format!("cannot read: {e}"));
+            let err = |e: std::io::Error| unreadable(p, Reading::Input, &e);
             Ok(PlanInput {
                 path: p.to_string_lossy().into_owned(),
                 sha256: sha256::file_hex(p).map_err(err)?,
@@ -202,15 +228,11 @@ fn verify_inputs(plan: &Plan, cfg: &Config) -> Result<()> {
         return Err(usage("the plan's arguments and inputs disagree: plan again"));
     }
     for (p, i) in now.into_iter().zip(&plan.inputs) {
-        let h = sha256::file_hex(p).map_err(|e| Error::input(p, format!("cannot read: {e}")))?;
+        let h = sha256::file_hex(p).map_err(|e| unreadable(p, Reading::Input, &e))?;
         if h != i.sha256 {
-            return Err(Error::input(
+            return Err(Error::in_file(
                 p,
-                format!(
-                    "changed since the plan (sha256 {}…, the plan has {}…): plan again",
-                    &h[..12],
-                    &i.sha256[..12]
-                ),
+                InputProblem::ChangedSincePlan { sha256: h, planned: i.sha256.clone() },
             ));
         }
     }
@@ -290,14 +312,22 @@ fn env_number(name: &str) -> Result<Option<usize>> {
 pub fn shard_index(shard: Option<&str>, shards: Option<usize>) -> Result<(usize, usize)> {
     let (i, n) = match shard {
         Some(s) => {
-            let bad = || usage(format!("--shard takes I/N (1-based, e.g. 2/8), got '{s}'"));
+            let bad = || {
+                Error::bad_flag(
+                    "shard",
+                    UsageProblem::Other(format!("--shard takes I/N (1-based, e.g. 2/8), got '{s}'")),
+                )
+            };
             let (i, n) = s.split_once('/').ok_or_else(bad)?;
             let (i, n) = (
                 i.trim().parse::<usize>().map_err(|_| bad())?,
                 n.trim().parse::<usize>().map_err(|_| bad())?,
             );
             if shards.is_some_and(|m| m != n) {
-                return Err(usage(format!("--shard {s} and --shards {} disagree", shards.unwrap_or(0))));
+                return Err(conflict(
+                    "shards",
+                    format!("--shard {s} and --shards {} disagree", shards.unwrap_or(0)),
+                ));
             }
             (i, n)
         }
@@ -344,8 +374,8 @@ pub fn shard_index(shard: Option<&str>, shards: Option<usize>) -> Result<(usize,
 }
 
 fn read_plan(path: &Path) -> Result<(Plan, String)> {
-    let bytes = std::fs::read(path).map_err(|e| Error::input(path, format!("cannot read plan: {e}")))?;
-    let plan = Plan::parse(&bytes).map_err(|m| Error::input(path, m))?;
+    let bytes = std::fs::read(path).map_err(|e| unreadable(path, Reading::Plan, &e))?;
+    let plan = Plan::parse(&bytes).map_err(|m| invalid(path, m))?;
     Ok((plan, sha256::hex(&bytes)))
 }
 
@@ -434,17 +464,16 @@ fn run_shard(a: &RunArgs, plan: &Plan, plan_hash: &str, i: usize, n: usize) -> R
 }
 
 fn read_shard(path: &Path) -> Result<ShardReport> {
-    let bytes =
-        std::fs::read(path).map_err(|e| Error::input(path, format!("cannot read shard report: {e}")))?;
+    let bytes = std::fs::read(path).map_err(|e| unreadable(path, Reading::ShardReport, &e))?;
     let v: serde_json::Value = serde_json::from_slice(&bytes)
-        .map_err(|e| Error::input(path, format!("shard report is not JSON: {e}")))?;
+        .map_err(|e| invalid(path, format!("shard report is not JSON: {e}")))?;
     if v.get("schema").and_then(|s| s.as_str()) != Some(SHARD_SCHEMA) {
-        return Err(Error::input(
+        return Err(invalid(
             path,
             format!("not a {SHARD_SCHEMA} report (merge takes the files `meshclash run` writes)"),
         ));
     }
-    serde_json::from_value(v).map_err(|e| Error::input(path, format!("bad shard report: {e}")))
+    serde_json::from_value(v).map_err(|e| invalid(path, format!("bad shard report: {e}")))
 }
 
 /// Check that the shard reports make one whole plan; returns them sorted by index and whether
@@ -469,7 +498,7 @@ pub fn validate(
     for (k, r) in reports.into_iter().enumerate() {
         let f = &files[k];
         if r.plan_hash != hash {
-            return Err(Error::input(
+            return Err(invalid(
                 f,
                 format!(
                     "foreign shard: it belongs to another plan (plan sha256 {}…, {} has {}…)",
@@ -480,7 +509,7 @@ pub fn validate(
             ));
         }
         if r.shards != n {
-            return Err(Error::input(
+            return Err(invalid(
                 f,
                 format!(
                     "shard {}/{} of a {n}-shard run ({} is one of {n})",
@@ -491,13 +520,13 @@ pub fn validate(
             ));
         }
         if let Some(e) = &r.error {
-            return Err(Error::input(f, format!("shard {}/{n} failed: {e}", r.shard)));
+            return Err(invalid(f, format!("shard {}/{n} failed: {e}", r.shard)));
         }
         if r.shard == 0 || r.shard > n {
-            return Err(Error::input(f, format!("shard {}/{n} does not exist", r.shard)));
+            return Err(invalid(f, format!("shard {}/{n} does not exist", r.shard)));
         }
         if let Some((other, _)) = by_index.get(&r.shard) {
-            return Err(Error::input(
+            return Err(invalid(
                 f,
                 format!("duplicate shard {}/{n}: {} is the same shard", r.shard, files[*other].display()),
             ));
@@ -562,7 +591,7 @@ fn merge_cmd(a: MergeArgs) -> Result<u8> {
 /// `--allow-partial` with shards missing: the JSON report with `"complete": false` first.
 fn merge_partial(cfg: &Config, quiet: bool) -> Result<u8> {
     if cfg.outputs.format.is_some_and(|f| f != meshclash::output::Format::Json) {
-        return Err(usage("--allow-partial writes the JSON report only (no --format)"));
+        return Err(conflict("allow-partial", "--allow-partial writes the JSON report only (no --format)"));
     }
     cli::check_outputs(cfg)?;
     let mut staged = Staged::new();

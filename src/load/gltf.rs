@@ -72,7 +72,9 @@ use super::gltf_data::{
     load_buffers, parse_document, parse_extensions, split_glb, Extensions, GpuInstancing, NodeTransform,
     Reader,
 };
-use crate::error::{Error, Result};
+use crate::error::{
+    AccessorUser, Error, GltfProblem, InputProblem, InstancingProblem, Location, Quantity, Result,
+};
 use crate::scene::mesh::{Loaded, Mesh, Object};
 
 /// The deepest node hierarchy accepted.
@@ -124,16 +126,14 @@ pub(crate) fn load(path: &Path, bytes: &[u8]) -> Result<Loaded> {
             total_parts = total_parts.saturating_add(copies);
         }
     }
-    for (total, limit, what) in [
-        (total_v, MAX_SCENE_VERTICES, "vertices"),
-        (total_t, MAX_SCENE_TRIANGLES, "triangles"),
-        (total_parts, MAX_SCENE_PARTS, "parts"),
+    for (total, limit, quantity) in [
+        (total_v, MAX_SCENE_VERTICES, Quantity::SceneVertices),
+        (total_t, MAX_SCENE_TRIANGLES, Quantity::SceneTriangles),
+        (total_parts, MAX_SCENE_PARTS, Quantity::SceneParts),
     ] {
         if total > limit {
-            return Err(Error::input(
-                path,
-                format!("glTF scene has {total} {what} after instancing, more than the {limit} supported"),
-            ));
+            let problem = InputProblem::TooLarge { quantity, count: total as u64, limit: limit as u64 };
+            return Err(Error::in_file(path, problem));
         }
     }
     // Instancing multiplies what a small file asks for: refuse up front, before anything is
@@ -141,18 +141,14 @@ pub(crate) fn load(path: &Path, bytes: &[u8]) -> Result<Loaded> {
     let need = (total_v as u64)
         .saturating_mul(24)
         .saturating_add((total_t as u64).saturating_mul(super::CHECK_BYTES_PER_TRIANGLE));
-    if let Some(avail) = super::available_memory().filter(|&a| need > a) {
-        const GIB: f64 = (1u64 << 30) as f64;
-        return Err(Error::input(
-            path,
-            format!(
-                "glTF scene has {total_t} triangles after instancing; checking them needs about {:.1} GiB \
-                 (~{} bytes per triangle), more than the {:.1} GiB this process may use",
-                need as f64 / GIB,
-                super::CHECK_BYTES_PER_TRIANGLE,
-                avail as f64 / GIB
-            ),
-        ));
+    if let Some(available) = super::available_memory().filter(|&a| need > a) {
+        let problem = InputProblem::NeedsMemory {
+            triangles: total_t as u64,
+            need,
+            available,
+            per_triangle: super::CHECK_BYTES_PER_TRIANGLE,
+        };
+        return Err(Error::in_file(path, problem));
     }
 
     let mut mesh = Mesh {
@@ -169,29 +165,25 @@ pub(crate) fn load(path: &Path, bytes: &[u8]) -> Result<Loaded> {
         }
         let name = node_path(&inst.path, &names);
         let Some(gpu) = &inst.gpu else {
-            add_instance(&mut mesh, path, inst, prims, name, inst.world, "")?;
+            add_instance(&mut mesh, path, inst, prims, name, inst.world, None)?;
             continue;
         };
         let trs = InstanceTransforms::read(&reader, &accessors, inst.node, gpu)?;
         for k in 0..gpu.count {
             let world = inst.world * trs.matrix(k)?;
             if !world.is_finite() {
-                return Err(Error::input(
-                    path,
-                    format!(
-                        "glTF node {}: world transform of GPU instance {k} is not finite (overflow)",
-                        inst.node
-                    ),
-                ));
+                let at = Location::Instance { node: inst.node, instance: k };
+                return Err(Error::at(path, at, GltfProblem::WorldOverflow));
             }
             let part = format!("{name}#{k}");
-            add_instance(&mut mesh, path, inst, prims, part, world, &format!(" instance {k}"))?;
+            add_instance(&mut mesh, path, inst, prims, part, world, Some(k))?;
         }
     }
     Ok(Loaded { mesh, warnings })
 }
 
-/// Appends one part: `prims` transformed by `world`, as object `name`.
+/// Appends one part: `prims` transformed by `world`, as object `name` (GPU instance `instance`
+/// of the node, when it has them).
 fn add_instance(
     mesh: &mut Mesh,
     path: &Path,
@@ -199,7 +191,7 @@ fn add_instance(
     prims: &[Prim],
     name: String,
     world: DMat4,
-    which: &str,
+    instance: Option<usize>,
 ) -> Result<()> {
     let object = mesh.objects.len() as u32;
     mesh.objects.push(Object { name, gltf_mesh: Some(inst.mesh as u32), world: Some(world) });
@@ -219,13 +211,12 @@ fn add_instance(
         bases[k] = Some(base);
         for (i, &v) in prims[owner].positions.iter().enumerate() {
             let w = world.transform_point3(v);
-            if let Some(bad) = super::non_finite(w.to_array()) {
-                return Err(Error::input(
+            if let Some(value) = super::non_finite(w.to_array()) {
+                let at = Location::Placed { mesh: inst.mesh, position: i, node: inst.node, instance };
+                return Err(Error::at(
                     path,
-                    format!(
-                        "position {i} of mesh {} is not finite ({bad}) after the transform of node {}{which}",
-                        inst.mesh, inst.node
-                    ),
+                    at,
+                    InputProblem::NonFiniteAfterTransform { value: Some(value) },
                 ));
             }
             mesh.positions.push(w);
@@ -254,14 +245,14 @@ struct InstanceTransforms<'a> {
 
 impl<'a> InstanceTransforms<'a> {
     fn read(r: &Reader<'a, '_>, accessors: &[Accessor], node: usize, gpu: &Gpu) -> Result<Self> {
-        let what = format!("node {node} EXT_mesh_gpu_instancing");
+        let user = AccessorUser::Instancing { node };
         let get = |a: Option<usize>| a.and_then(|a| accessors.get(a));
         Ok(InstanceTransforms {
             path: r.path,
             node,
-            t: get(gpu.attrs.translation).map(|a| r.vectors(a, &what)).transpose()?,
-            r: get(gpu.attrs.rotation).map(|a| r.vectors(a, &what)).transpose()?,
-            s: get(gpu.attrs.scale).map(|a| r.vectors(a, &what)).transpose()?,
+            t: get(gpu.attrs.translation).map(|a| r.vectors(a, user)).transpose()?,
+            r: get(gpu.attrs.rotation).map(|a| r.vectors(a, user)).transpose()?,
+            s: get(gpu.attrs.scale).map(|a| r.vectors(a, user)).transpose()?,
         })
     }
 
@@ -273,20 +264,20 @@ impl<'a> InstanceTransforms<'a> {
         let q = self.r.as_ref().and_then(|v| v.get(k)).copied().unwrap_or([0.0, 0.0, 0.0, 1.0]);
         let s = self.s.as_ref().and_then(|v| v.get(k)).copied().unwrap_or([1.0; 3]);
         let bad =
-            |m: String| Error::input(self.path, format!("glTF node {} GPU instance {k}: {m}", self.node));
-        for (name, bad_value) in [
+            |p: GltfProblem| Error::at(self.path, Location::Instance { node: self.node, instance: k }, p);
+        for (attribute, bad_value) in [
             ("TRANSLATION", super::non_finite(t)),
             ("ROTATION", super::non_finite(q)),
             ("SCALE", super::non_finite(s)),
         ] {
-            if let Some(word) = bad_value {
-                return Err(bad(format!("{name} is not finite ({word})")));
+            if let Some(value) = bad_value {
+                return Err(bad(GltfProblem::InstanceNotFinite { attribute, value }));
             }
         }
         let q = DQuat::from_array(q);
         let len = q.length();
         if len == 0.0 || !len.is_finite() {
-            return Err(bad("ROTATION is a zero quaternion".into()));
+            return Err(bad(GltfProblem::ZeroQuaternion));
         }
         Ok(DMat4::from_scale_rotation_translation(DVec3::from_array(s), q / len, DVec3::from_array(t)))
     }
@@ -340,18 +331,23 @@ fn check_gpu(r: &Reader, accessors: &[Accessor], node: usize, attrs: &GpuInstanc
     let mut count: Option<(usize, &str)> = None;
     for (name, a) in &attrs.all {
         let Some(acc) = accessors.get(*a) else {
-            return Err(Error::input(
+            return Err(Error::at(
                 r.path,
-                format!("glTF node {node}: EXT_mesh_gpu_instancing accessor {a} does not exist"),
+                Location::Node(node),
+                InstancingProblem::NoSuchAccessor { accessor: *a },
             ));
         };
         r.check_instance_attribute(acc, name, node)?;
         match count {
             None => count = Some((acc.count(), name)),
-            Some((c, first)) if c != acc.count() => {
-                let (name, n) = (super::clip(name, 40), acc.count());
-                let msg = format!("attributes have different counts ({first}: {c}, {name}: {n})");
-                return Err(Error::input(r.path, format!("glTF node {node}: EXT_mesh_gpu_instancing {msg}")));
+            Some((first_count, first)) if first_count != acc.count() => {
+                let problem = InstancingProblem::CountMismatch {
+                    first: first.to_string(),
+                    first_count,
+                    attribute: super::clip(name, 40),
+                    count: acc.count(),
+                };
+                return Err(Error::at(r.path, Location::Node(node), problem));
             }
             Some(_) => {}
         }
@@ -369,7 +365,7 @@ fn traverse(
     accessors: &[Accessor],
     warnings: &mut Vec<String>,
 ) -> Result<Vec<Instance>> {
-    let err = |m: String| Error::input(path, m);
+    let err = |node: usize, p: GltfProblem| Error::at(path, Location::Node(node), p);
     let n = doc.nodes().len();
     let mut parent: Vec<Option<usize>> = vec![None; n];
     for node in doc.nodes() {
@@ -377,15 +373,15 @@ fn traverse(
             let c = child.index();
             if let Some(p) = parent[c] {
                 if p == node.index() {
-                    return Err(err(format!("glTF node {p} lists child {c} twice")));
+                    return Err(err(p, GltfProblem::ChildTwice { child: c }));
                 }
-                return Err(err(format!("glTF node {c} has two parents (nodes {p} and {})", node.index())));
+                return Err(err(c, GltfProblem::TwoParents { first: p, second: node.index() }));
             }
             parent[c] = Some(node.index());
         }
     }
     if let Some(c) = find_cycle(&parent) {
-        return Err(err(format!("glTF node graph has a cycle at node {c}")));
+        return Err(err(c, GltfProblem::Cycle));
     }
 
     let scene = doc.default_scene().or_else(|| doc.scenes().next());
@@ -396,10 +392,10 @@ fn traverse(
     let mut listed = vec![false; n];
     for &r in &roots {
         if let Some(p) = parent[r] {
-            return Err(err(format!("glTF node {r} is a scene root but also a child of node {p}")));
+            return Err(err(r, GltfProblem::RootIsChild { parent: p }));
         }
         if std::mem::replace(&mut listed[r], true) {
-            return Err(err(format!("glTF scene lists node {r} twice")));
+            return Err(err(r, GltfProblem::RootListedTwice));
         }
     }
 
@@ -413,10 +409,10 @@ fn traverse(
     let mut chain: Vec<usize> = Vec::new();
     while let Some((i, parent_world, depth)) = stack.pop() {
         if depth > MAX_DEPTH {
-            return Err(err(format!("glTF node hierarchy deeper than {MAX_DEPTH} levels (at node {i})")));
+            return Err(err(i, GltfProblem::TooDeep { limit: MAX_DEPTH }));
         }
         if std::mem::replace(&mut visited[i], true) {
-            return Err(err(format!("glTF node graph has a cycle at node {i}")));
+            return Err(err(i, GltfProblem::Cycle));
         }
         chain.truncate(depth - 1);
         chain.push(i);
@@ -424,7 +420,7 @@ fn traverse(
         let exact = ext.transforms.get(i).and_then(Option::as_ref);
         let world = parent_world * local_matrix(path, node, exact)?;
         if !world.is_finite() {
-            return Err(err(format!("glTF node {i}: world transform is not finite (overflow)")));
+            return Err(err(i, GltfProblem::WorldOverflow));
         }
         let gpu = ext.instancing.get(i).and_then(Option::as_ref);
         if let Some(mesh) = node.mesh() {
@@ -474,7 +470,7 @@ fn find_cycle(parent: &[Option<usize>]) -> Option<usize> {
 /// The node's local matrix in f64, from the numbers of the JSON read as f64 (`exact`, from
 /// [`Extensions::transforms`]); the `gltf` crate's f32 copy only when that is missing.
 fn local_matrix(path: &Path, node: &::gltf::Node, exact: Option<&NodeTransform>) -> Result<DMat4> {
-    let bad = |what: &str| Error::input(path, format!("glTF node {} has {what}", node.index()));
+    let bad = |p: GltfProblem| Error::at(path, Location::Node(node.index()), p);
     let widened;
     let transform = match exact {
         Some(t) => t,
@@ -494,18 +490,18 @@ fn local_matrix(path: &Path, node: &::gltf::Node, exact: Option<&NodeTransform>)
     match transform {
         NodeTransform::Matrix(m) => {
             if m.iter().any(|x| !x.is_finite()) {
-                return Err(bad("a non-finite matrix"));
+                return Err(bad(GltfProblem::NonFiniteTransform { matrix: true }));
             }
             Ok(DMat4::from_cols_array(m))
         }
         NodeTransform::Trs { t, r, s } => {
             if t.iter().chain(r).chain(s).any(|x| !x.is_finite()) {
-                return Err(bad("a non-finite translation, rotation or scale"));
+                return Err(bad(GltfProblem::NonFiniteTransform { matrix: false }));
             }
             let q = DQuat::from_array(*r);
             let len = q.length();
             if len == 0.0 || !len.is_finite() {
-                return Err(bad("a zero rotation quaternion"));
+                return Err(bad(GltfProblem::ZeroQuaternion));
             }
             Ok(DMat4::from_scale_rotation_translation(DVec3::from_array(*s), q / len, DVec3::from_array(*t)))
         }
@@ -533,17 +529,15 @@ fn decode_mesh(r: &Reader, doc: &Document, m: usize, warnings: &mut Vec<String>)
         if prim.morph_targets().len() > 0 {
             warnings.push(format!("{what}: morph targets ignored (base positions used)"));
         }
-        let positions = r.positions(&acc, &what)?;
+        let positions = r.positions(&acc, m, prim.index())?;
         let nv = positions.len();
         let indices: Cow<[u32]> = match prim.indices() {
-            Some(ia) => Cow::Owned(r.indices(&ia, &what)?),
+            Some(ia) => Cow::Owned(r.indices(&ia, m, prim.index())?),
             None => Cow::Owned((0..nv as u32).collect()),
         };
         if let Some((k, &v)) = indices.iter().enumerate().find(|(_, &v)| v as usize >= nv) {
-            return Err(Error::input(
-                r.path,
-                format!("{what}: index {k} refers to vertex {v} but there are {nv} vertices"),
-            ));
+            let at = Location::Index { mesh: m, primitive: prim.index(), index: k };
+            return Err(Error::at(r.path, at, InputProblem::IndexOutOfRange { index: v.into(), len: nv }));
         }
         let triangles = triangulate(mode, &indices);
         let leftover = match mode {

@@ -17,8 +17,11 @@ use ::gltf::accessor::{DataType, Dimensions};
 use ::gltf::{Accessor, Document};
 use base64::Engine as _;
 
-use super::io_message;
-use crate::error::{Error, Result};
+use super::unreadable;
+use crate::error::{
+    AccessorPart, AccessorRole, AccessorUser, Error, GltfProblem, InputProblem, InstancingProblem, Location,
+    Part, Reading, Result,
+};
 
 /// Required extensions a file may list and still load: those decoded here
 /// (`KHR_mesh_quantization`, `EXT_mesh_gpu_instancing`) and those that only add appearance
@@ -43,23 +46,26 @@ const SUPPORTED_REQUIRED: &[&str] = &[
 /// Splits a GLB file into its JSON chunk and optional BIN chunk, checking every declared
 /// length against the file first. Unknown chunks after those are ignored (as the spec says).
 pub(crate) fn split_glb<'a>(path: &Path, bytes: &'a [u8]) -> Result<(&'a [u8], Option<&'a [u8]>)> {
-    let err = |m: String| Error::input(path, m);
+    let err = |p: InputProblem| Error::in_file(path, p);
+    let truncated = |part: Part, declared: usize, have: usize| InputProblem::Truncated {
+        part,
+        declared: declared as u64,
+        have: have as u64,
+    };
     let have = bytes.len();
     if have < 12 {
-        return Err(err(format!("truncated GLB: {have} bytes, the header alone needs 12")));
+        return Err(err(truncated(Part::GlbHeader, 12, have)));
     }
     if &bytes[..4] != b"glTF" {
-        return Err(err("not a GLB file: missing 'glTF' magic".into()));
+        return Err(err(GltfProblem::NotGlb.into()));
     }
     let version = le_u32(bytes, 4).unwrap_or(0);
     if version != 2 {
-        return Err(err(format!("GLB version {version} is not supported (expected 2)")));
+        return Err(err(GltfProblem::GlbVersion(version as u32).into()));
     }
     let declared = le_u32(bytes, 8).unwrap_or(0);
     if declared > have {
-        return Err(err(format!(
-            "truncated GLB: header declares {declared} bytes but the file has {have} bytes"
-        )));
+        return Err(err(truncated(Part::Glb, declared, have)));
     }
     let data = &bytes[..declared];
     let mut pos = 12;
@@ -67,28 +73,28 @@ pub(crate) fn split_glb<'a>(path: &Path, bytes: &'a [u8]) -> Result<(&'a [u8], O
     let mut bin = None;
     let mut index = 0;
     while pos < data.len() {
+        let at = Location::Byte(pos as u64);
         let (Some(len), Some(kind)) = (le_u32(data, pos), data.get(pos + 4..pos + 8)) else {
-            return Err(err(format!("truncated GLB: chunk {index} header at byte {pos} is cut off")));
+            let problem = truncated(Part::GlbChunkHeader { chunk: index }, 8, data.len() - pos);
+            return Err(Error::at(path, at, problem));
         };
         let start = pos + 8;
         if len > data.len() - start {
-            let what = super::clip(String::from_utf8_lossy(kind).trim_end_matches('\0'), 4);
-            return Err(err(format!(
-                "truncated GLB: chunk {index} ('{what}') declares {len} bytes but only {} remain",
-                data.len() - start
-            )));
+            let kind = super::clip(String::from_utf8_lossy(kind).trim_end_matches('\0'), 4);
+            let problem = truncated(Part::GlbChunk { chunk: index, kind }, len, data.len() - start);
+            return Err(Error::at(path, at, problem));
         }
         let chunk = &data[start..start + len];
         match (index, kind) {
             (0, b"JSON") => json = Some(chunk),
-            (0, _) => return Err(err("GLB first chunk is not JSON".into())),
+            (0, _) => return Err(err(GltfProblem::FirstChunkNotJson.into())),
             (1, b"BIN\0") => bin = Some(chunk),
             _ => {}
         }
         index += 1;
         pos = start + len;
     }
-    let json = json.ok_or_else(|| err("GLB has no JSON chunk".into()))?;
+    let json = json.ok_or_else(|| err(GltfProblem::NoJsonChunk.into()))?;
     Ok((json, bin))
 }
 
@@ -104,20 +110,10 @@ fn le_u32(b: &[u8], o: usize) -> Option<usize> {
 pub(crate) fn parse_document(path: &Path, json: &[u8]) -> Result<Document> {
     let json = strip_bom(json);
     let mut root = ::gltf::json::Root::from_slice(json)
-        .map_err(|e| Error::input(path, format!("invalid glTF JSON: {e}")))?;
+        .map_err(|e| Error::in_file(path, GltfProblem::Json(e.to_string())))?;
     for ext in &root.extensions_required {
         if !ext.starts_with("KHR_materials_") && !SUPPORTED_REQUIRED.contains(&ext.as_str()) {
-            let hint = match ext.as_str() {
-                "KHR_draco_mesh_compression" => " (Draco-compressed geometry cannot be decoded)",
-                "EXT_meshopt_compression" | "KHR_meshopt_compression" => {
-                    " (meshopt-compressed buffers cannot be decoded)"
-                }
-                _ => "",
-            };
-            return Err(Error::input(
-                path,
-                format!("glTF requires extension '{ext}', which is not supported{hint}"),
-            ));
+            return Err(Error::in_file(path, InputProblem::UnsupportedExtension(ext.clone())));
         }
     }
     // Checked above; the gltf crate would reject any it does not itself implement.
@@ -130,20 +126,14 @@ pub(crate) fn parse_document(path: &Path, json: &[u8]) -> Result<Document> {
     // An accessor with neither bufferView nor sparse values has its data supplied by an
     // extension (core spec, § 3.6.2.4): a compressed file whose extension we cannot decode.
     if let Some(a) = root.accessors.iter().position(|a| a.buffer_view.is_none() && a.sparse.is_none()) {
-        let by: Vec<&str> = root
+        let extensions_used: Vec<String> = root
             .extensions_used
             .iter()
-            .map(String::as_str)
-            .filter(|e| !e.starts_with("KHR_materials_") && !SUPPORTED_REQUIRED.contains(e))
+            .filter(|e| !e.starts_with("KHR_materials_") && !SUPPORTED_REQUIRED.contains(&e.as_str()))
+            .cloned()
             .collect();
-        let by = if by.is_empty() { "none".to_string() } else { by.join(", ") };
-        return Err(Error::input(
-            path,
-            format!(
-                "glTF accessor {a} has no data (neither bufferView nor sparse values): it would \
-                 come from an extension that is not supported (extensions used: {by})"
-            ),
-        ));
+        let at = Location::Accessor { accessor: a, user: None };
+        return Err(Error::at(path, at, GltfProblem::NoAccessorData { extensions_used }));
     }
     // gltf-json's validation indexes `accessors` with the POSITION index unchecked (a panic on a
     // dangling index), so check those references before validating.
@@ -152,15 +142,11 @@ pub(crate) fn parse_document(path: &Path, json: &[u8]) -> Result<Document> {
         for (p, prim) in mesh.primitives.iter().enumerate() {
             if let Some(a) = prim.attributes.get(&positions) {
                 if a.value() >= root.accessors.len() {
-                    return Err(Error::input(
-                        path,
-                        format!(
-                            "invalid glTF: mesh {m} primitive {p} uses POSITION accessor {} but \
-                             there are {} accessors",
-                            a.value(),
-                            root.accessors.len()
-                        ),
-                    ));
+                    let problem = GltfProblem::NoPositionAccessor {
+                        accessor: a.value(),
+                        accessors: root.accessors.len(),
+                    };
+                    return Err(Error::at(path, Location::Primitive { mesh: m, primitive: p }, problem));
                 }
             }
         }
@@ -188,13 +174,13 @@ pub(crate) fn parse_document(path: &Path, json: &[u8]) -> Result<Document> {
                     n => format!(" (and {} more problems)", n - 1),
                 };
                 match list.first() {
-                    Some((p, v)) => format!("invalid glTF: {p}: {v}{more}"),
-                    None => "invalid glTF".to_string(),
+                    Some((p, v)) => format!("{p}: {v}{more}"),
+                    None => String::new(),
                 }
             }
-            other => format!("invalid glTF: {other}"),
+            other => other.to_string(),
         };
-        Error::input(path, msg)
+        Error::in_file(path, GltfProblem::Invalid(msg))
     })
 }
 
@@ -299,7 +285,7 @@ struct ExtNodeExtensions {
 /// lists it in `extensionsUsed` (instances left out would be clashes missed).
 pub(crate) fn parse_extensions(path: &Path, json: &[u8], accessors: usize) -> Result<Extensions> {
     let root: ExtRoot = serde_json::from_slice(strip_bom(json))
-        .map_err(|e| Error::input(path, format!("invalid glTF JSON: {e}")))?;
+        .map_err(|e| Error::in_file(path, GltfProblem::Json(e.to_string())))?;
     let mut out = Extensions::default();
     for (i, node) in root.nodes.into_iter().enumerate() {
         out.transforms.push(node.transform());
@@ -318,23 +304,21 @@ fn gpu_instancing(
     v: &serde_json::Value,
     accessors: usize,
 ) -> Result<GpuInstancing> {
-    let err = |m: String| Error::input(path, format!("glTF node {node}: EXT_mesh_gpu_instancing {m}"));
+    let err = |p: InstancingProblem| Error::at(path, Location::Node(node), p);
     let Some(attrs) = v.get("attributes").and_then(|a| a.as_object()) else {
-        return Err(err("has no 'attributes' object".into()));
+        return Err(err(InstancingProblem::NoAttributesObject));
     };
     if attrs.is_empty() {
-        return Err(err("has no attributes, so no instance count".into()));
+        return Err(err(InstancingProblem::NoAttributes));
     }
     let mut out = GpuInstancing::default();
     for (name, index) in attrs {
-        let shown = super::clip(name, 40);
+        let attribute = super::clip(name, 40);
         let Some(a) = index.as_u64() else {
-            return Err(err(format!("attribute {shown} is not an accessor index")));
+            return Err(err(InstancingProblem::NotAnIndex { attribute }));
         };
         if a >= accessors as u64 {
-            return Err(err(format!(
-                "attribute {shown} uses accessor {a} but there are {accessors} accessors"
-            )));
+            return Err(err(InstancingProblem::AccessorOutOfRange { attribute, accessor: a, accessors }));
         }
         let a = a as usize;
         match name.as_str() {
@@ -359,30 +343,29 @@ pub(crate) fn load_buffers<'a>(
     for buffer in doc.buffers() {
         let i = buffer.index();
         let declared = buffer.length();
-        let short = |what: &str, have: usize| {
-            Error::input(
+        let at = Location::Buffer(i);
+        let short = |part: Part, have: usize| {
+            Error::at(
                 path,
-                format!("glTF buffer {i} declares {declared} bytes but {what} has {have} bytes"),
+                at.clone(),
+                InputProblem::Truncated { part, declared: declared as u64, have: have as u64 },
             )
         };
         let data: Cow<'a, [u8]> = match buffer.source() {
             ::gltf::buffer::Source::Bin => {
                 let Some(b) = bin else {
-                    return Err(Error::input(
-                        path,
-                        format!("glTF buffer {i} refers to the GLB binary chunk but there is none"),
-                    ));
+                    return Err(Error::at(path, at, GltfProblem::NoBinChunk));
                 };
                 if b.len() < declared {
-                    return Err(short("the GLB binary chunk", b.len()));
+                    return Err(short(Part::BinChunk, b.len()));
                 }
                 Cow::Borrowed(b)
             }
             ::gltf::buffer::Source::Uri(uri) if uri.starts_with("data:") => {
                 let data = decode_data_uri(uri)
-                    .map_err(|m| Error::input(path, format!("glTF buffer {i} data URI is invalid: {m}")))?;
+                    .map_err(|m| Error::at(path, at.clone(), GltfProblem::BadDataUri(m)))?;
                 if data.len() < declared {
-                    return Err(short("its data URI", data.len()));
+                    return Err(short(Part::DataUri, data.len()));
                 }
                 Cow::Owned(data)
             }
@@ -437,27 +420,21 @@ fn unsafe_relative_path(name: &str) -> Option<&'static str> {
 /// file inside it that is a symbolic link is followed.
 fn read_external(path: &Path, i: usize, uri: &str, declared: usize) -> Result<Vec<u8>> {
     let shown = super::clip(uri, 80);
-    let refuse = |why: &str| {
-        Error::input(
-            path,
-            format!(
-                "glTF buffer {i} URI '{shown}' is refused: {why} (only data: URIs and relative \
-                 paths inside the glTF's directory are read)"
-            ),
-        )
+    let at = Location::Buffer(i);
+    let refuse = |reason: &'static str| {
+        Error::at(path, at.clone(), GltfProblem::UriRefused { uri: shown.clone(), reason })
     };
     if let Some(why) = unsafe_relative_path(uri) {
         return Err(refuse(why));
     }
-    let name = percent_decode(uri).map_err(|()| {
-        Error::input(path, format!("glTF buffer {i} URI '{shown}' is not valid UTF-8 when percent-decoded"))
-    })?;
+    let name = percent_decode(uri)
+        .map_err(|()| Error::at(path, at.clone(), GltfProblem::UriNotUtf8 { uri: shown.clone() }))?;
     if let Some(why) = unsafe_relative_path(&name) {
         return Err(refuse(why));
     }
     let file = path.parent().unwrap_or(Path::new("")).join(&name);
     let cannot = |e: std::io::Error| {
-        Error::input(path, format!("glTF external buffer '{shown}' cannot be read: {}", io_message(&e)))
+        Error::at(path, at.clone(), unreadable(Reading::ExternalBuffer(shown.clone()), &e))
     };
     // The text checks above cannot see symlinks: resolve both ends and compare (issue 11 item 6).
     let real = file.canonicalize().map_err(cannot)?;
@@ -471,25 +448,16 @@ fn read_external(path: &Path, i: usize, uri: &str, declared: usize) -> Result<Ve
     }
     let f = std::fs::File::open(&real).map_err(cannot)?;
     let have = f.metadata().map_err(cannot)?.len();
+    let short = |part: Part, have: u64| {
+        Error::at(path, at.clone(), InputProblem::Truncated { part, declared: declared as u64, have })
+    };
     if have < declared as u64 {
-        return Err(Error::input(
-            path,
-            format!(
-                "glTF external buffer '{shown}' has {have} bytes but buffer {i} declares \
-                 {declared}"
-            ),
-        ));
+        return Err(short(Part::ExternalFile(shown.clone()), have));
     }
     let mut data = Vec::with_capacity(declared);
     f.take(declared as u64).read_to_end(&mut data).map_err(cannot)?;
     if data.len() < declared {
-        return Err(Error::input(
-            path,
-            format!(
-                "glTF external buffer '{shown}' shrank while reading: {} of {declared} bytes",
-                data.len()
-            ),
-        ));
+        return Err(short(Part::ExternalFileRead(shown.clone()), data.len() as u64));
     }
     Ok(data)
 }
@@ -548,33 +516,33 @@ pub(crate) struct Reader<'a, 'b> {
 }
 
 impl Reader<'_, '_> {
-    fn err(&self, msg: String) -> Error {
-        Error::input(self.path, msg)
+    /// `problem` with accessor `acc` read for `user`.
+    fn err(&self, acc: &Accessor, user: AccessorUser, problem: GltfProblem) -> Error {
+        Error::at(self.path, Location::Accessor { accessor: acc.index(), user: Some(user) }, problem)
     }
 
-    /// A POSITION accessor as f64 triples (`what` names the mesh/primitive for messages).
+    /// A POSITION accessor of primitive `user` as f64 triples.
     ///
     /// `FLOAT` components are widened exactly. The integer component types of
     /// `KHR_mesh_quantization` are decoded as [`component`] says (exact for unnormalized
     /// integers; one correctly rounded f64 division for normalized ones). Sparse substitution
     /// works for every type, the sparse values having the accessor's component type.
-    pub(crate) fn positions(&self, acc: &Accessor, what: &str) -> Result<Vec<[f64; 3]>> {
+    pub(crate) fn positions(&self, acc: &Accessor, mesh: usize, primitive: usize) -> Result<Vec<[f64; 3]>> {
+        let user = AccessorUser::Primitive { mesh, primitive };
+        let role = AccessorRole::Positions;
         if acc.dimensions() != Dimensions::Vec3 {
-            return Err(self.err(format!(
-                "positions accessor of {what} has type {} (expected VEC3)",
-                dims_name(acc.dimensions())
-            )));
+            let found = dims_name(acc.dimensions());
+            return Err(self.err(acc, user, GltfProblem::AccessorType { role, found }));
         }
         if acc.data_type() == DataType::U32 {
-            return Err(self.err(format!(
-                "positions accessor of {what} uses component type UNSIGNED_INT (expected FLOAT, or \
-                 BYTE, UNSIGNED_BYTE, SHORT or UNSIGNED_SHORT with KHR_mesh_quantization)"
-            )));
+            let found = type_name(acc.data_type());
+            return Err(self.err(acc, user, GltfProblem::ComponentType { role, found }));
         }
-        let out = self.vectors::<3>(acc, what)?;
-        for (i, p) in out.iter().enumerate() {
-            if let Some(bad) = super::non_finite(*p) {
-                return Err(self.err(format!("position {i} of {what} has a non-finite coordinate ({bad})")));
+        let out = self.vectors::<3>(acc, user)?;
+        for (position, p) in out.iter().enumerate() {
+            if let Some(value) = super::non_finite(*p) {
+                let at = Location::Position { mesh, primitive, position };
+                return Err(Error::at(self.path, at, InputProblem::NonFinite { value }));
             }
         }
         Ok(out)
@@ -582,11 +550,15 @@ impl Reader<'_, '_> {
 
     /// Reads `acc` (any component type except `UNSIGNED_INT`) as `N`-vectors of f64, decoded
     /// by [`component`]. The caller checks the accessor type and component type it allows.
-    pub(crate) fn vectors<const N: usize>(&self, acc: &Accessor, what: &str) -> Result<Vec<[f64; N]>> {
+    pub(crate) fn vectors<const N: usize>(
+        &self,
+        acc: &Accessor,
+        user: AccessorUser,
+    ) -> Result<Vec<[f64; N]>> {
         let t = acc.data_type();
         let size = t.size();
         let norm = acc.normalized();
-        self.read(acc, what, N * size, |b| std::array::from_fn(|k| component(t, norm, &b[k * size..])))
+        self.read(acc, user, N * size, |b| std::array::from_fn(|k| component(t, norm, &b[k * size..])))
     }
 
     /// An `EXT_mesh_gpu_instancing` attribute of `node`: `TRANSLATION` and `SCALE` are FLOAT
@@ -603,39 +575,31 @@ impl Reader<'_, '_> {
             _ => return Ok(()),
         };
         if acc.dimensions() != dims || !ok {
-            let expected = match name {
-                "ROTATION" => "VEC4 of FLOAT, or of normalized BYTE or SHORT",
-                _ => "VEC3 of FLOAT",
+            let problem = InstancingProblem::AttributeType {
+                attribute: name.to_string(),
+                accessor: acc.index(),
+                dims: dims_name(acc.dimensions()),
+                normalized: acc.normalized(),
+                component: type_name(acc.data_type()),
             };
-            return Err(self.err(format!(
-                "glTF node {node}: EXT_mesh_gpu_instancing {name} accessor {} is {} of {}{} \
-                 (expected {expected})",
-                acc.index(),
-                dims_name(acc.dimensions()),
-                if acc.normalized() { "normalized " } else { "" },
-                type_name(acc.data_type()),
-            )));
+            return Err(Error::at(self.path, Location::Node(node), problem));
         }
         Ok(())
     }
 
-    /// An index accessor (u8, u16 or u32 scalars) as u32.
-    pub(crate) fn indices(&self, acc: &Accessor, what: &str) -> Result<Vec<u32>> {
+    /// An index accessor (u8, u16 or u32 scalars) of primitive `user` as u32.
+    pub(crate) fn indices(&self, acc: &Accessor, mesh: usize, primitive: usize) -> Result<Vec<u32>> {
+        let user = AccessorUser::Primitive { mesh, primitive };
+        let role = AccessorRole::Indices;
         if acc.dimensions() != Dimensions::Scalar {
-            return Err(self.err(format!(
-                "indices accessor of {what} has type {} (expected SCALAR)",
-                dims_name(acc.dimensions())
-            )));
+            let found = dims_name(acc.dimensions());
+            return Err(self.err(acc, user, GltfProblem::AccessorType { role, found }));
         }
         match acc.data_type() {
-            DataType::U8 => self.read(acc, what, 1, |b| b[0] as u32),
-            DataType::U16 => self.read(acc, what, 2, |b| u16::from_le_bytes([b[0], b[1]]) as u32),
-            DataType::U32 => self.read(acc, what, 4, |b| u32::from_le_bytes([b[0], b[1], b[2], b[3]])),
-            t => Err(self.err(format!(
-                "indices accessor of {what} uses component type {} (expected UNSIGNED_BYTE, \
-                 UNSIGNED_SHORT or UNSIGNED_INT)",
-                type_name(t)
-            ))),
+            DataType::U8 => self.read(acc, user, 1, |b| b[0] as u32),
+            DataType::U16 => self.read(acc, user, 2, |b| u16::from_le_bytes([b[0], b[1]]) as u32),
+            DataType::U32 => self.read(acc, user, 4, |b| u32::from_le_bytes([b[0], b[1], b[2], b[3]])),
+            t => Err(self.err(acc, user, GltfProblem::ComponentType { role, found: type_name(t) })),
         }
     }
 
@@ -647,24 +611,28 @@ impl Reader<'_, '_> {
         let start = view.offset();
         match start.checked_add(view.length()) {
             Some(end) if end <= limit => Ok(&data[start..end]),
-            _ => Err(self.err(format!(
-                "glTF bufferView {} (offset {start}, length {}) does not fit in buffer {b} \
-                 ({limit} bytes)",
-                view.index(),
-                view.length()
-            ))),
+            _ => {
+                let problem = GltfProblem::ViewOutOfBuffer {
+                    offset: start,
+                    length: view.length(),
+                    buffer: b,
+                    buffer_len: limit,
+                };
+                Err(Error::at(self.path, Location::BufferView(view.index()), problem))
+            }
         }
     }
 
-    /// Checks that `count` elements of `elem` bytes at `offset` with `stride` fit in `len`.
+    /// Checks that `count` elements of `elem` bytes at `offset` with `stride` fit in `len`
+    /// (`part` of accessor `acc` read for `user`).
     fn fits(
         &self,
+        (acc, user, part): (&Accessor, AccessorUser, AccessorPart),
         count: usize,
         elem: usize,
         stride: usize,
         offset: usize,
         len: usize,
-        what: String,
     ) -> Result<()> {
         if count == 0 {
             return Ok(());
@@ -675,10 +643,11 @@ impl Reader<'_, '_> {
             .and_then(|x| x.checked_add(offset));
         match end {
             Some(end) if end <= len => Ok(()),
-            _ => Err(self.err(format!(
-                "{what}: {count} elements of {elem} bytes (stride {stride}) from offset {offset} \
-                 do not fit in its bufferView of {len} bytes"
-            ))),
+            _ => {
+                let problem =
+                    GltfProblem::ElementsOutOfView { part, count, elem, stride, offset, view_len: len };
+                Err(self.err(acc, user, problem))
+            }
         }
     }
 
@@ -687,23 +656,26 @@ impl Reader<'_, '_> {
     fn read<T: Copy>(
         &self,
         acc: &Accessor,
-        what: &str,
+        user: AccessorUser,
         elem: usize,
         decode: impl Fn(&[u8]) -> T,
     ) -> Result<Vec<T>> {
         let count = acc.count();
-        let label = || format!("accessor {} of {what}", acc.index());
         let mut out = match acc.view() {
             Some(view) => {
                 let data = self.view_bytes(&view)?;
                 let stride = view.stride().unwrap_or(elem);
                 if stride < elem {
-                    return Err(self.err(format!(
-                        "{}: byteStride {stride} is smaller than its {elem}-byte elements",
-                        label()
-                    )));
+                    return Err(self.err(acc, user, GltfProblem::StrideTooSmall { stride, elem }));
                 }
-                self.fits(count, elem, stride, acc.offset(), data.len(), label())?;
+                self.fits(
+                    (acc, user, AccessorPart::Elements),
+                    count,
+                    elem,
+                    stride,
+                    acc.offset(),
+                    data.len(),
+                )?;
                 let data = &data[acc.offset().min(data.len())..];
                 let mut out = Vec::with_capacity(count);
                 for i in 0..count {
@@ -714,12 +686,8 @@ impl Reader<'_, '_> {
             }
             None => {
                 if count > self.input_bytes {
-                    return Err(self.err(format!(
-                        "{} declares {count} elements without a bufferView, more than the {} \
-                         bytes of input",
-                        label(),
-                        self.input_bytes
-                    )));
+                    let problem = GltfProblem::TooManyElements { count, input_bytes: self.input_bytes };
+                    return Err(self.err(acc, user, problem));
                 }
                 vec![decode(&vec![0u8; elem]); count]
             }
@@ -727,18 +695,17 @@ impl Reader<'_, '_> {
         if let Some(sparse) = acc.sparse() {
             let n = sparse.count();
             if n > count {
-                return Err(
-                    self.err(format!("{}: sparse count {n} exceeds the accessor count {count}", label()))
-                );
+                return Err(self.err(acc, user, GltfProblem::SparseCount { sparse: n, count }));
             }
             let ind = sparse.indices();
             let isize = ind.index_type().size();
             let ibytes = self.view_bytes(&ind.view())?;
-            self.fits(n, isize, isize, ind.offset(), ibytes.len(), format!("{} sparse indices", label()))?;
+            let part = (acc, user, AccessorPart::SparseIndices);
+            self.fits(part, n, isize, isize, ind.offset(), ibytes.len())?;
             let ibytes = &ibytes[ind.offset().min(ibytes.len())..];
             let vals = sparse.values();
             let vbytes = self.view_bytes(&vals.view())?;
-            self.fits(n, elem, elem, vals.offset(), vbytes.len(), format!("{} sparse values", label()))?;
+            self.fits((acc, user, AccessorPart::SparseValues), n, elem, elem, vals.offset(), vbytes.len())?;
             let vbytes = &vbytes[vals.offset().min(vbytes.len())..];
             for k in 0..n {
                 let b = &ibytes[k * isize..(k + 1) * isize];
@@ -748,8 +715,7 @@ impl Reader<'_, '_> {
                     _ => u32::from_le_bytes([b[0], b[1], b[2], b[3]]) as usize,
                 };
                 let Some(slot) = out.get_mut(idx) else {
-                    return Err(self
-                        .err(format!("{}: sparse index {idx} is out of range ({count} elements)", label())));
+                    return Err(self.err(acc, user, GltfProblem::SparseIndex { index: idx, count }));
                 };
                 *slot = decode(&vbytes[k * elem..(k + 1) * elem]);
             }

@@ -18,7 +18,7 @@
 
 use std::path::Path;
 
-use crate::error::{Error, Result};
+use crate::error::{Error, FileKind, InputProblem, Location, NonFinite, Reading, Result};
 use crate::scene::mesh::Loaded;
 
 /// The most triangles one input may make (2^28, 4 GiB of triangles and part ids): a glTF scene
@@ -105,37 +105,33 @@ impl Format {
 /// it is opened, so a FIFO cannot block the run and a device cannot stream without end
 /// (issue 11, item 5). Symlinks are followed: the link's target must be a regular file.
 pub fn load_path(path: &Path) -> Result<(Loaded, Format)> {
-    let meta = std::fs::metadata(path)
-        .map_err(|e| Error::input(path, format!("cannot read file: {}", io_message(&e))))?;
+    let cannot = |e: std::io::Error| Error::in_file(path, unreadable(Reading::File, &e));
+    let meta = std::fs::metadata(path).map_err(cannot)?;
     if !meta.is_file() {
-        return Err(Error::input(
-            path,
-            format!("not a regular file ({}); meshclash reads only regular files", file_kind(&meta)),
-        ));
+        return Err(Error::in_file(path, InputProblem::NotARegularFile { kind: file_kind(&meta) }));
     }
-    let bytes = std::fs::read(path)
-        .map_err(|e| Error::input(path, format!("cannot read file: {}", io_message(&e))))?;
+    let bytes = std::fs::read(path).map_err(cannot)?;
     let format = detect_format(path, &bytes)?;
     let loaded = load_bytes(path, &bytes, format)?;
     Ok((loaded, format))
 }
 
-/// A short name for the kind of a non-regular file, for error messages.
-fn file_kind(meta: &std::fs::Metadata) -> &'static str {
+/// The kind of a non-regular file.
+fn file_kind(meta: &std::fs::Metadata) -> FileKind {
     use std::os::unix::fs::FileTypeExt;
     let t = meta.file_type();
     if t.is_dir() {
-        "a directory"
+        FileKind::Directory
     } else if t.is_fifo() {
-        "a FIFO"
+        FileKind::Fifo
     } else if t.is_char_device() {
-        "a character device"
+        FileKind::CharDevice
     } else if t.is_block_device() {
-        "a block device"
+        FileKind::BlockDevice
     } else if t.is_socket() {
-        "a socket"
+        FileKind::Socket
     } else {
-        "not a regular file"
+        FileKind::Other
     }
 }
 
@@ -145,7 +141,7 @@ fn file_kind(meta: &std::fs::Metadata) -> &'static str {
 /// the file's directory.
 pub fn load_bytes(path: &Path, bytes: &[u8], format: Format) -> Result<Loaded> {
     if bytes.is_empty() {
-        return Err(Error::input(path, "file is empty"));
+        return Err(Error::in_file(path, InputProblem::Empty));
     }
     let loaded = match format {
         Format::Obj => obj::load(path, bytes)?,
@@ -165,31 +161,23 @@ pub fn load_bytes(path: &Path, bytes: &[u8], format: Format) -> Result<Loaded> {
 pub fn detect_format(path: &Path, bytes: &[u8]) -> Result<Format> {
     let ext = match path.extension() {
         Some(e) => e.to_string_lossy().to_ascii_lowercase(),
-        None => return Err(Error::input(path, "no file extension (expected .obj, .stl, .gltf or .glb)")),
+        None => return Err(Error::in_file(path, InputProblem::NoExtension)),
     };
     let format = match ext.as_str() {
         "obj" => Format::Obj,
         "stl" => Format::Stl,
         "gltf" => Format::Gltf,
         "glb" => Format::Glb,
-        _ => {
-            return Err(Error::input(
-                path,
-                format!("unknown extension '.{ext}' (expected .obj, .stl, .gltf or .glb)"),
-            ))
-        }
+        _ => return Err(Error::in_file(path, InputProblem::UnknownExtension(ext))),
     };
     if bytes.is_empty() {
-        return Err(Error::input(path, "file is empty"));
+        return Err(Error::in_file(path, InputProblem::Empty));
     }
     match format {
         Format::Obj => {
             let head = &bytes[..bytes.len().min(4096)];
             if let Some(pos) = head.iter().position(|&b| b == 0) {
-                return Err(Error::input(
-                    path,
-                    format!("not an OBJ text file: NUL byte at byte {pos} (binary data)"),
-                ));
+                return Err(Error::at(path, Location::Byte(pos as u64), InputProblem::NotText));
             }
             Ok(Format::Obj)
         }
@@ -205,14 +193,8 @@ pub fn detect_format(path: &Path, bytes: &[u8]) -> Result<Format> {
             {
                 Ok(Format::Gltf)
             } else {
-                Err(Error::input(
-                    path,
-                    format!(
-                        "not a glTF file: expected JSON starting with '{{' or the GLB magic \
-                         'glTF', found {}",
-                        describe_start(bytes)
-                    ),
-                ))
+                let start = bytes[..bytes.len().min(8)].to_vec();
+                Err(Error::in_file(path, InputProblem::NotGltf { start }))
             }
         }
     }
@@ -222,63 +204,47 @@ pub fn detect_format(path: &Path, bytes: &[u8]) -> Result<Format> {
 fn validate(path: &Path, loaded: &Loaded) -> Result<()> {
     let mesh = &loaded.mesh;
     if mesh.triangles.is_empty() {
-        return Err(Error::input(path, "no triangles"));
+        return Err(Error::in_file(path, InputProblem::NoTriangles));
     }
     if mesh.tri_object.len() != mesh.triangles.len() {
-        return Err(Error::input(
-            path,
-            format!(
-                "internal loader error: {} triangles but {} object entries",
-                mesh.triangles.len(),
-                mesh.tri_object.len()
-            ),
-        ));
+        let msg = format!("{} triangles but {} object entries", mesh.triangles.len(), mesh.tri_object.len());
+        return Err(Error::in_file(path, InputProblem::Internal(msg)));
     }
     let n = mesh.positions.len();
     for (t, tri) in mesh.triangles.iter().enumerate() {
         for &v in tri {
             if v as usize >= n {
-                return Err(Error::input(
-                    path,
-                    format!("triangle {t} refers to vertex {v} but there are {n} vertices"),
-                ));
+                let problem = InputProblem::IndexOutOfRange { index: v.into(), len: n };
+                return Err(Error::at(path, Location::Triangle(t), problem));
             }
         }
     }
     for (i, p) in mesh.positions.iter().enumerate() {
-        if let Some(bad) = non_finite([p.x, p.y, p.z]) {
-            return Err(Error::input(path, format!("vertex {i} has a non-finite coordinate ({bad})")));
+        if let Some(value) = non_finite([p.x, p.y, p.z]) {
+            return Err(Error::at(path, Location::Vertex(i), InputProblem::NonFinite { value }));
         }
     }
     for (t, &o) in mesh.tri_object.iter().enumerate() {
         if o as usize >= mesh.objects.len() {
-            return Err(Error::input(
-                path,
-                format!(
-                    "internal loader error: triangle {t} belongs to object {o} but there are {} \
-                     objects",
-                    mesh.objects.len()
-                ),
-            ));
+            let msg =
+                format!("triangle {t} belongs to object {o} but there are {} objects", mesh.objects.len());
+            return Err(Error::in_file(path, InputProblem::Internal(msg)));
         }
     }
     if let Some(i) = mesh.objects.iter().position(|o| o.name.is_empty()) {
-        return Err(Error::input(path, format!("internal loader error: object {i} has no name")));
+        return Err(Error::in_file(path, InputProblem::Internal(format!("object {i} has no name"))));
     }
     Ok(())
 }
 
-/// `Some("NaN")`, `Some("inf")` or `Some("-inf")` for the first non-finite value, else `None`.
-pub(crate) fn non_finite<const N: usize>(v: [f64; N]) -> Option<&'static str> {
-    v.iter().find(|x| !x.is_finite()).map(|x| {
-        if x.is_nan() {
-            "NaN"
-        } else if *x > 0.0 {
-            "inf"
-        } else {
-            "-inf"
-        }
-    })
+/// The first non-finite value (NaN, inf or -inf; displayed so), else `None`.
+pub(crate) fn non_finite<const N: usize>(v: [f64; N]) -> Option<NonFinite> {
+    NonFinite::first(v)
+}
+
+/// An unreadable file: the error's kind and its text without the trailing ` (os error N)`.
+pub(crate) fn unreadable(reading: Reading, e: &std::io::Error) -> InputProblem {
+    InputProblem::Unreadable { reading, kind: e.kind(), reason: io_message(e) }
 }
 
 /// An I/O error as text without the trailing ` (os error N)`.
@@ -287,17 +253,6 @@ pub(crate) fn io_message(e: &std::io::Error) -> String {
     match s.find(" (os error ") {
         Some(i) if s.ends_with(')') => s[..i].to_string(),
         _ => s,
-    }
-}
-
-/// A short printable rendering of a file's first bytes, for error messages.
-fn describe_start(bytes: &[u8]) -> String {
-    let head = &bytes[..bytes.len().min(8)];
-    if head.iter().all(|b| b.is_ascii_graphic() || *b == b' ') {
-        format!("'{}'", String::from_utf8_lossy(head))
-    } else {
-        let hex: Vec<String> = head.iter().map(|b| format!("{b:02x}")).collect();
-        format!("bytes {}", hex.join(" "))
     }
 }
 

@@ -20,7 +20,7 @@ use std::path::Path;
 use glam::DVec3;
 
 use super::{clip, drop_empty_objects, non_finite};
-use crate::error::{Error, Result};
+use crate::error::{Error, InputProblem, Location, Misplaced, Part, Quantity, Result};
 use crate::scene::mesh::{Loaded, Mesh, Object};
 
 const HEADER: usize = 84;
@@ -88,31 +88,23 @@ fn looks_like(bytes: &[u8]) -> Option<&'static str> {
 /// Errors unless `bytes` is an exactly-sized binary STL or looks like ASCII STL.
 pub(crate) fn check_viable(path: &Path, bytes: &[u8]) -> Result<()> {
     if bytes.is_empty() {
-        return Err(Error::input(path, "file is empty"));
+        return Err(Error::in_file(path, InputProblem::Empty));
     }
     if is_binary(bytes) || looks_ascii(bytes) {
         return Ok(());
     }
-    if let Some(kind) = looks_like(bytes) {
-        return Err(Error::input(path, format!("not an STL file (looks like {kind})")));
+    if let Some(looks_like) = looks_like(bytes) {
+        return Err(Error::in_file(path, InputProblem::NotStl { looks_like }));
     }
-    let have = bytes.len();
-    Err(Error::input(
+    let have = bytes.len() as u64;
+    Err(Error::in_file(
         path,
         match binary_expected_len(bytes) {
-            None => format!(
-                "not an STL file: {have} bytes is too short for binary STL (needs at least 84) \
-                 and it is not ASCII STL"
-            ),
-            Some((n, need)) if need > have as u64 => format!(
-                "truncated binary STL: header declares {n} triangles (needs {need} bytes) but \
-                 the file has {have} bytes"
-            ),
-            Some((n, need)) => format!(
-                "binary STL size mismatch: header declares {n} triangles (needs {need} bytes) \
-                 but the file has {have} bytes ({} extra)",
-                have as u64 - need
-            ),
+            None => InputProblem::TooShortForStl { have },
+            Some((triangles, need)) if need > have => {
+                InputProblem::Truncated { part: Part::StlFacets { triangles }, declared: need, have }
+            }
+            Some((triangles, need)) => InputProblem::SizeMismatch { triangles, need, have },
         },
     ))
 }
@@ -130,7 +122,12 @@ pub(crate) fn load(path: &Path, bytes: &[u8]) -> Result<Loaded> {
 fn load_binary(path: &Path, bytes: &[u8]) -> Result<Loaded> {
     let n = binary_expected_len(bytes).map_or(0, |(n, _)| n as usize);
     if n > u32::MAX as usize / 3 {
-        return Err(Error::input(path, format!("binary STL has {n} triangles, more than supported")));
+        let problem = InputProblem::TooLarge {
+            quantity: Quantity::StlTriangles,
+            count: n as u64,
+            limit: (u32::MAX / 3) as u64,
+        };
+        return Err(Error::in_file(path, problem));
     }
     // Size was checked against the file: `bytes` holds all n facets.
     let mut positions = Vec::with_capacity(3 * n);
@@ -142,11 +139,9 @@ fn load_binary(path: &Path, bytes: &[u8]) -> Result<Loaded> {
         };
         for k in 0..3 {
             let c = [f(3 * k), f(3 * k + 1), f(3 * k + 2)];
-            if let Some(bad) = non_finite(c) {
-                return Err(Error::input(
-                    path,
-                    format!("triangle {t} vertex {k} has a non-finite coordinate ({bad})"),
-                ));
+            if let Some(value) = non_finite(c) {
+                let at = Location::Corner { triangle: t, corner: k };
+                return Err(Error::at(path, at, InputProblem::NonFinite { value }));
             }
             positions.push(DVec3::from_array(c));
         }
@@ -189,7 +184,10 @@ enum State {
 }
 
 fn load_ascii(path: &Path, bytes: &[u8]) -> Result<Loaded> {
-    let err = |line: usize, msg: String| Error::input(path, format!("line {line}: {msg}"));
+    let err = |line: usize, problem: InputProblem| Error::at(path, Location::Line(line as u64), problem);
+    let misplaced = |line: usize, keyword: &str, how: Misplaced| {
+        err(line, InputProblem::Misplaced { keyword: keyword.to_string(), how })
+    };
     let mut mesh = Mesh::default();
     let mut warnings = Vec::new();
     let mut state = State::Outside;
@@ -212,7 +210,7 @@ fn load_ascii(path: &Path, bytes: &[u8]) -> Result<Loaded> {
         let is = |k: &[u8]| kw.eq_ignore_ascii_case(k);
         if is(b"solid") {
             if state == State::InFacet {
-                return Err(err(line_no, "'solid' inside a facet (missing endfacet)".into()));
+                return Err(misplaced(line_no, "solid", Misplaced::InsideFacet));
             }
             if state == State::InSolid {
                 warnings.push(format!("line {line_no}: new solid before 'endsolid'"));
@@ -226,10 +224,8 @@ fn load_ascii(path: &Path, bytes: &[u8]) -> Result<Loaded> {
         } else if is(b"facet") {
             match state {
                 State::InSolid => {}
-                State::Outside => return Err(err(line_no, "'facet' outside a solid".into())),
-                State::InFacet => {
-                    return Err(err(line_no, "'facet' inside a facet (missing endfacet)".into()))
-                }
+                State::Outside => return Err(misplaced(line_no, "facet", Misplaced::OutsideSolid)),
+                State::InFacet => return Err(misplaced(line_no, "facet", Misplaced::InsideFacet)),
             }
             verts.clear();
             facet_line = line_no;
@@ -237,39 +233,43 @@ fn load_ascii(path: &Path, bytes: &[u8]) -> Result<Loaded> {
         } else if is(b"outer") || is(b"endloop") {
             if state != State::InFacet {
                 let kw = String::from_utf8_lossy(kw);
-                return Err(err(line_no, format!("'{kw}' outside a facet")));
+                return Err(misplaced(line_no, &kw, Misplaced::OutsideFacet));
             }
         } else if is(b"vertex") {
             if state != State::InFacet {
-                return Err(err(line_no, "'vertex' outside a facet".into()));
+                return Err(misplaced(line_no, "vertex", Misplaced::OutsideFacet));
             }
             let mut c = [0.0f64; 3];
             for (k, slot) in c.iter_mut().enumerate() {
                 let Some((off, tok)) = tokens.next() else {
-                    return Err(err(line_no, format!("vertex has {k} coordinates (needs 3)")));
+                    return Err(err(line_no, InputProblem::TooFewCoordinates { found: k }));
                 };
                 let s = std::str::from_utf8(tok).map_err(|e| {
-                    err(line_no, format!("not UTF-8 at byte {}", line_start + off + e.valid_up_to()))
+                    let byte = (line_start + off + e.valid_up_to()) as u64;
+                    err(line_no, InputProblem::NotUtf8 { byte: Some(byte) })
                 })?;
-                *slot = s.parse().map_err(|_| {
-                    err(line_no, format!("cannot parse '{}' as a vertex coordinate", clip(s, 40)))
-                })?;
+                *slot = s.parse().map_err(|_| err(line_no, InputProblem::BadNumber(clip(s, 40))))?;
             }
-            if let Some(bad) = non_finite(c) {
-                return Err(err(line_no, format!("vertex has a non-finite coordinate ({bad})")));
+            if let Some(value) = non_finite(c) {
+                return Err(err(line_no, InputProblem::NonFinite { value }));
             }
             verts.push(DVec3::from_array(c));
         } else if is(b"endfacet") {
             if state != State::InFacet {
-                return Err(err(line_no, "'endfacet' outside a facet".into()));
+                return Err(misplaced(line_no, "endfacet", Misplaced::OutsideFacet));
             }
             if verts.len() < 3 {
-                let msg = format!("facet starting at line {facet_line} has {} vertices", verts.len());
-                return Err(err(line_no, format!("{msg} (needs 3)")));
+                let problem =
+                    InputProblem::ShortFacet { start_line: facet_line as u64, vertices: verts.len() };
+                return Err(err(line_no, problem));
             }
             let base = mesh.positions.len();
             if base + verts.len() > u32::MAX as usize {
-                return Err(err(line_no, "more than 4294967295 vertices".into()));
+                let (count, limit) = ((base + verts.len()) as u64, u32::MAX as u64);
+                return Err(err(
+                    line_no,
+                    InputProblem::TooLarge { quantity: Quantity::Vertices, count, limit },
+                ));
             }
             let b = base as u32;
             mesh.positions.extend_from_slice(&verts);
@@ -281,22 +281,17 @@ fn load_ascii(path: &Path, bytes: &[u8]) -> Result<Loaded> {
         } else if is(b"endsolid") {
             match state {
                 State::InSolid => state = State::Outside,
-                State::Outside => return Err(err(line_no, "'endsolid' without 'solid'".into())),
-                State::InFacet => {
-                    return Err(err(line_no, "'endsolid' inside a facet (missing endfacet)".into()))
-                }
+                State::Outside => return Err(misplaced(line_no, "endsolid", Misplaced::WithoutSolid)),
+                State::InFacet => return Err(misplaced(line_no, "endsolid", Misplaced::InsideFacet)),
             }
         } else {
             let shown = String::from_utf8_lossy(kw);
-            return Err(err(line_no, format!("unexpected '{}' in ASCII STL", clip(&shown, 40))));
+            return Err(err(line_no, InputProblem::UnknownKeyword(clip(&shown, 40))));
         }
     }
     match state {
         State::InFacet => {
-            return Err(Error::input(
-                path,
-                format!("unexpected end of file inside the facet starting at line {facet_line}"),
-            ))
+            return Err(Error::in_file(path, InputProblem::UnfinishedFacet { start_line: facet_line as u64 }))
         }
         State::InSolid => warnings.push("last solid has no 'endsolid'".to_string()),
         State::Outside => {}

@@ -19,7 +19,7 @@
 //! Content is streamed into the temporary through a buffer ([`Staged::stage_with`]): a report
 //! is never held whole in memory as text.
 
-use crate::error::{Error, Result};
+use crate::error::{Error, OutputProblem, Result};
 use std::io::{BufWriter, Write};
 use std::os::unix::fs::MetadataExt;
 use std::path::{Path, PathBuf};
@@ -33,8 +33,13 @@ pub fn write_file(path: &Path, bytes: &[u8]) -> Result<()> {
     s.commit()
 }
 
+/// An I/O error as an output problem.
+fn io_problem(e: &std::io::Error) -> OutputProblem {
+    OutputProblem::Io { kind: e.kind(), reason: e.to_string() }
+}
+
 fn out_err(path: &Path) -> impl Fn(std::io::Error) -> Error + '_ {
-    move |e| Error::Output { path: path.to_path_buf(), msg: e.to_string() }
+    move |e| Error::output(path, io_problem(&e))
 }
 
 /// Outputs written to temporaries, renamed over their targets by [`Staged::commit`]. Dropping
@@ -64,9 +69,7 @@ impl Staged {
     ) -> Result<()> {
         let err = out_err(path);
         let target = match target(path).map_err(&err)? {
-            Target::Directory => {
-                return Err(Error::Output { path: path.to_path_buf(), msg: "is a directory".into() })
-            }
+            Target::Directory => return Err(Error::output(path, OutputProblem::IsADirectory)),
             Target::Direct => {
                 let f = std::fs::OpenOptions::new().write(true).truncate(true).open(path).map_err(&err)?;
                 let mut w = BufWriter::new(f);
@@ -138,22 +141,23 @@ pub fn check_outputs(outputs: &[Named], inputs: &[&Path]) -> Result<()> {
         inputs.iter().filter_map(|p| std::fs::metadata(p).ok().map(|m| (id(&m), *p))).collect();
     let mut seen: Vec<((u64, u64), &str)> = Vec::new();
     for &(flag, path) in outputs {
-        let fail = |msg: String| Error::Output { path: path.to_path_buf(), msg };
-        let target = match target(path).map_err(|e| fail(e.to_string()))? {
-            Target::Directory => return Err(fail(format!("{flag} names a directory"))),
+        let fail = |problem: OutputProblem| Error::output(path, problem);
+        let flag_ = || flag.to_string();
+        let target = match target(path).map_err(|e| fail(io_problem(&e)))? {
+            Target::Directory => return Err(fail(OutputProblem::FlagNamesDirectory { flag: flag_() })),
             Target::Direct => path.to_path_buf(),
             Target::Replace(t) => t,
         };
         match std::fs::metadata(&target) {
             Ok(m) => {
                 if let Some((_, input)) = inputs.iter().find(|(i, _)| *i == id(&m)) {
-                    return Err(fail(format!(
-                        "{flag} names the input {} (the same file); refusing to overwrite an input",
-                        input.display()
-                    )));
+                    return Err(fail(OutputProblem::NamesAnInput {
+                        flag: flag_(),
+                        input: input.to_path_buf(),
+                    }));
                 }
                 if let Some((_, other)) = seen.iter().find(|(i, _)| *i == id(&m)) {
-                    return Err(fail(format!("{flag} names the same file as {other}")));
+                    return Err(fail(OutputProblem::SameFile { flag: flag_(), other: other.to_string() }));
                 }
                 if !m.is_file() {
                     continue; // a device, FIFO or socket: written directly (and may repeat)
@@ -164,17 +168,25 @@ pub fn check_outputs(outputs: &[Named], inputs: &[&Path]) -> Result<()> {
                 }
             }
             Err(e) if e.kind() == std::io::ErrorKind::NotFound => {}
-            Err(e) => return Err(fail(e.to_string())),
+            Err(e) => return Err(fail(io_problem(&e))),
         }
         let dir = dir_of(&target);
         match std::fs::metadata(dir) {
             Ok(m) if m.is_dir() => {}
-            Ok(_) => return Err(fail(format!("{} is not a directory", dir.display()))),
-            Err(e) => return Err(fail(format!("directory {}: {e}", dir.display()))),
+            Ok(_) => return Err(fail(OutputProblem::ParentNotADirectory { dir: dir.to_path_buf() })),
+            Err(e) => {
+                let problem = OutputProblem::Directory {
+                    dir: dir.to_path_buf(),
+                    kind: e.kind(),
+                    reason: e.to_string(),
+                };
+                return Err(fail(problem));
+            }
         }
         // Writable: the only honest test is to create (and at once delete) a temporary there.
-        tempfile::NamedTempFile::new_in(dir)
-            .map_err(|e| fail(format!("directory {} is not writable: {e}", dir.display())))?;
+        tempfile::NamedTempFile::new_in(dir).map_err(|e| {
+            fail(OutputProblem::NotWritable { dir: dir.to_path_buf(), kind: e.kind(), reason: e.to_string() })
+        })?;
     }
     Ok(())
 }

@@ -20,7 +20,7 @@
 //! New touching or clearance pairs are listed but do not fail it.
 
 use crate::check::query::{PairFinding, PairKind};
-use crate::error::{Error, Result};
+use crate::error::{Error, InputProblem, Reading, Result};
 use crate::report::{Report, ReportContainment, ReportPairKind};
 use crate::scene::mesh::Mesh;
 use serde::{Deserialize, Serialize};
@@ -90,8 +90,13 @@ pub fn assign_ids(rep: &mut Report, findings: &[Finding]) {
 /// Read a baseline report (any `meshclash.report/*` written with finding ids; unknown fields
 /// are ignored so that reports of later versions can serve as baselines).
 pub fn read(path: &Path) -> Result<Baseline> {
-    let bytes = std::fs::read(path).map_err(|e| Error::input(path, format!("cannot read baseline: {e}")))?;
-    parse(&path.display().to_string(), &bytes).map_err(|msg| Error::input(path, msg))
+    let bytes = std::fs::read(path).map_err(|e| {
+        Error::in_file(
+            path,
+            InputProblem::Unreadable { reading: Reading::Baseline, kind: e.kind(), reason: e.to_string() },
+        )
+    })?;
+    parse(&path.display().to_string(), &bytes).map_err(|msg| Error::in_file(path, InputProblem::Invalid(msg)))
 }
 
 /// Parse a baseline report's JSON; the error is a one-line message.
