@@ -477,10 +477,13 @@ mod chunked {
             };
             match keyword {
                 b"v" => {
+                    // One UTF-8 check per line; tokens end at ASCII whitespace, so they are
+                    // char boundaries of it.
+                    let line = std::str::from_utf8(text).ok()?;
                     let mut p = [0.0f64; 3];
                     for slot in &mut p {
-                        let (_, tok) = tokens.next()?;
-                        *slot = std::str::from_utf8(tok).ok()?.parse::<f64>().ok()?;
+                        let (off, tok) = tokens.next()?;
+                        *slot = line[off..off + tok.len()].parse::<f64>().ok()?;
                         if !slot.is_finite() {
                             return None;
                         }
