@@ -468,8 +468,67 @@ pub enum InputProblem {
     InCheck(Box<Error>),
     /// A loader broke its own guarantees (a bug).
     Internal(String),
-    /// A problem described only by text (code not yet converted to typed problems).
-    Other(String),
+    /// A coordinate beyond ±2^250 (located by [`Location::Vertex`]), where the exact predicates
+    /// stop being exact.
+    CoordinateBeyondExactRange {
+        /// The coordinate.
+        coordinate: f64,
+    },
+    /// An OBJ vertex that is not finite (located by [`Location::Line`]); `vertex` is its 1-based
+    /// number in the file.
+    ObjNonFiniteVertex {
+        /// The vertex's 1-based number.
+        vertex: usize,
+        /// The first bad value.
+        value: NonFinite,
+    },
+    /// An OBJ face (`f`) that cannot be read (located by [`Location::Line`]).
+    ObjFace(ObjFaceProblem),
+}
+
+/// What is wrong with an OBJ face.
+#[derive(Debug, Clone, PartialEq)]
+pub enum ObjFaceProblem {
+    /// More vertices than one polygon may have.
+    TooManyVertices {
+        /// The most read in one polygon.
+        limit: usize,
+    },
+    /// A vertex reference that is not an integer (shortened to 40 characters).
+    BadIndex(String),
+    /// A reference to vertex 0 (OBJ indices start at 1).
+    ZeroIndex,
+    /// A negative (relative) reference before the first vertex.
+    BeforeFirstVertex {
+        /// The index as written.
+        index: i64,
+        /// The vertices defined before the face.
+        defined: i64,
+    },
+    /// An index beyond what any file can hold (more than 2^32 vertices).
+    BeyondAnyFile {
+        /// The index as written.
+        index: i64,
+    },
+    /// Fewer than 3 vertices.
+    TooFewVertices {
+        /// How many it has.
+        found: usize,
+    },
+    /// The faces so far make more triangles than supported.
+    TooManyTriangles {
+        /// Triangles up to and including this face.
+        total: usize,
+        /// The most supported.
+        limit: usize,
+    },
+    /// A positive (forward) reference beyond the vertices of the whole file.
+    BeyondLastVertex {
+        /// The index as written (1-based).
+        index: i64,
+        /// The file's vertices.
+        vertices: i64,
+    },
 }
 
 /// What a glTF accessor is read as.
@@ -832,12 +891,6 @@ pub enum UsageProblem {
 }
 
 impl Error {
-    /// A problem with input file `path` described only by text. Prefer [`Error::in_file`] or
-    /// [`Error::at`] with a typed [`InputProblem`]; this stays for code not yet converted.
-    pub fn input(path: &Path, msg: impl Into<String>) -> Self {
-        Error::in_file(path, InputProblem::Other(msg.into()))
-    }
-
     /// `problem` with input file `path`, at no particular place.
     pub fn in_file(path: &Path, problem: impl Into<InputProblem>) -> Self {
         Error::located(path, None, problem)
@@ -945,6 +998,12 @@ impl Error {
     }
 }
 
+impl From<ObjFaceProblem> for InputProblem {
+    fn from(f: ObjFaceProblem) -> Self {
+        InputProblem::ObjFace(f)
+    }
+}
+
 impl From<GltfProblem> for InputProblem {
     fn from(p: GltfProblem) -> Self {
         InputProblem::Gltf(p)
@@ -1032,6 +1091,29 @@ impl fmt::Display for AccessorUser {
 /// `"{at}: "`, or nothing without a place.
 fn prefix(at: Option<&Location>) -> String {
     at.map_or(String::new(), |a| format!("{a}: "))
+}
+
+/// The text of an OBJ face problem (after its `line N: `).
+fn obj_face_text(f: &ObjFaceProblem) -> String {
+    use ObjFaceProblem as F;
+    match f {
+        F::TooManyVertices { limit } => {
+            format!("face has more than {limit} vertices, the most meshclash reads in one polygon")
+        }
+        F::BadIndex(t) => format!("cannot parse '{t}' as a face vertex index"),
+        F::ZeroIndex => "face refers to vertex 0 (OBJ indices start at 1)".into(),
+        F::BeforeFirstVertex { index, defined } => {
+            format!("face refers to vertex {index} but only {defined} vertices are defined before it")
+        }
+        F::BeyondAnyFile { index } => format!("face refers to vertex {index}, beyond any file"),
+        F::TooFewVertices { found } => format!("face has {found} vertices (needs at least 3)"),
+        F::TooManyTriangles { total, limit } => {
+            format!("the faces so far make {total} triangles, more than the {limit} supported")
+        }
+        F::BeyondLastVertex { index, vertices } => {
+            format!("face refers to vertex {index} but there are {vertices} vertices")
+        }
+    }
 }
 
 /// The message of an input error after `path: ` (before [`one_line`]).
@@ -1164,7 +1246,15 @@ fn input_text(at: Option<&Location>, p: &InputProblem) -> String {
             head(sha256, 12),
             head(planned, 12)
         ),
-        P::Selection(m) | P::Syntax(m) | P::Invalid(m) | P::Other(m) => format!("{pre}{m}"),
+        P::CoordinateBeyondExactRange { coordinate } => format!(
+            "{} has coordinate {coordinate:e}, beyond ±2^250 (about 1.8e75), where verdicts stop being exact",
+            at.map_or("a vertex".to_string(), |a| a.to_string())
+        ),
+        P::ObjNonFiniteVertex { vertex, value } => {
+            format!("{pre}vertex {vertex} has a non-finite coordinate ({value})")
+        }
+        P::ObjFace(f) => format!("{pre}{}", obj_face_text(f)),
+        P::Selection(m) | P::Syntax(m) | P::Invalid(m) => format!("{pre}{m}"),
         P::InCheck(e) => format!("{pre}{}", e.bare()),
         P::Internal(m) => format!("{pre}internal loader error: {m}"),
     }
@@ -1694,7 +1784,8 @@ mod tests {
         // Third-party text may span lines; the message may not.
         let e = Error::in_file(Path::new("g.gltf"), GltfProblem::Json("expected value\n  at line 1".into()));
         assert_eq!(e.to_string(), "g.gltf: invalid glTF JSON: expected value at line 1");
-        assert_eq!(Error::input(Path::new("p"), "old  style\ttext").to_string(), "p: old style text");
+        let e = Error::in_file(Path::new("p"), InputProblem::Syntax("third  party\ttext".into()));
+        assert_eq!(e.to_string(), "p: third party text");
         let e = Error::output(
             Path::new("o"),
             OutputProblem::Io { kind: io::ErrorKind::Other, reason: "a\nb".into() },

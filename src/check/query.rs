@@ -9,7 +9,7 @@ use crate::bvh::slab::{self, Oriented};
 use crate::bvh::traverse::{self, Candidate, Tree};
 use crate::bvh::{self, BuildOptions};
 use crate::check::containment::{self, Containment};
-use crate::error::{Error, Result};
+use crate::error::{Error, InputProblem, Location, Result};
 use crate::geom::predicates::{self, Tolerances};
 use crate::geom::{Aabb, DVec3};
 use crate::load::{self, Format};
@@ -155,9 +155,10 @@ pub fn check_range(mesh: &Mesh, path: &Path) -> Result<Vec<String>> {
         for c in p.to_array() {
             let m = c.abs();
             if m > predicates::MAX_EXACT_MAGNITUDE {
-                return Err(Error::input(
+                return Err(Error::at(
                     path,
-                    format!("vertex {i} has coordinate {c:e}, beyond ±2^250 (about 1.8e75), where verdicts stop being exact"),
+                    Location::Vertex(i),
+                    InputProblem::CoordinateBeyondExactRange { coordinate: c },
                 ));
             }
             if m != 0.0 && m < predicates::MIN_EXACT_MAGNITUDE {
@@ -182,7 +183,11 @@ pub fn place(mesh: &mut Mesh, m: &DMat4, path: &Path) -> Result<()> {
     for (i, p) in mesh.positions.iter_mut().enumerate() {
         *p = m.transform_point3(*p);
         if !p.is_finite() {
-            return Err(Error::input(path, format!("vertex {i} is not finite after the transform")));
+            return Err(Error::at(
+                path,
+                Location::Vertex(i),
+                InputProblem::NonFiniteAfterTransform { value: None },
+            ));
         }
     }
     Ok(())

@@ -24,8 +24,8 @@ use std::path::Path;
 
 use glam::DVec3;
 
-use super::{clip, drop_empty_objects, non_finite};
-use crate::error::{Error, Result};
+use super::{clip, drop_empty_objects};
+use crate::error::{Error, InputProblem, Location, NonFinite, ObjFaceProblem as Face, Result};
 use crate::scene::mesh::{Loaded, Mesh, Object};
 
 /// The most vertices one face (polygon) may have: a larger one is refused with its line number
@@ -119,8 +119,8 @@ impl<'p> Parser<'p> {
         }
     }
 
-    fn err(&self, line: usize, msg: impl std::fmt::Display) -> Error {
-        Error::input(self.path, format!("line {line}: {msg}"))
+    fn err(&self, line: usize, problem: impl Into<InputProblem>) -> Error {
+        Error::at(self.path, Location::Line(line as u64), problem)
     }
 
     fn run(mut self, bytes: &[u8]) -> Result<Loaded> {
@@ -130,7 +130,7 @@ impl<'p> Parser<'p> {
         }
         let n = self.mesh.positions.len() as i64;
         if let Some(&(line, idx)) = self.forward_refs.iter().find(|(_, i)| *i > n) {
-            return Err(self.err(line, format!("face refers to vertex {idx} but there are {n} vertices")));
+            return Err(self.err(line, Face::BeyondLastVertex { index: idx, vertices: n }));
         }
         if self.unrecognised > MAX_LINE_WARNINGS {
             self.warnings
@@ -190,23 +190,24 @@ impl<'p> Parser<'p> {
         let mut c = [0.0f64; 3];
         for (k, slot) in c.iter_mut().enumerate() {
             let Some((off, tok)) = tokens.next() else {
-                return Err(self.err(line, format!("vertex has {k} coordinates (needs 3)")));
+                return Err(self.err(line, InputProblem::TooFewCoordinates { found: k }));
             };
             // Tokens end at ASCII whitespace, so they are char boundaries of a valid line.
             let s = match valid {
                 Some(text) => &text[off..off + tok.len()],
                 None => self.utf8(line, start + off, tok)?,
             };
-            *slot = s.parse::<f64>().map_err(|_| {
-                self.err(line, format!("cannot parse '{}' as a vertex coordinate", clip(s, 40)))
-            })?;
+            *slot = s.parse::<f64>().map_err(|_| self.err(line, InputProblem::BadNumber(clip(s, 40))))?;
         }
         let index = self.mesh.positions.len();
-        if let Some(bad) = non_finite(c) {
-            return Err(self.err(line, format!("vertex {} has a non-finite coordinate ({bad})", index + 1)));
+        if let Some(value) = NonFinite::first(c) {
+            return Err(self.err(line, InputProblem::ObjNonFiniteVertex { vertex: index + 1, value }));
         }
         if index > u32::MAX as usize {
-            return Err(self.err(line, "more than 4294967296 vertices"));
+            let quantity = crate::error::Quantity::Vertices;
+            return Err(
+                self.err(line, InputProblem::TooLarge { quantity, count: index as u64 + 1, limit: 1 << 32 })
+            );
         }
         self.mesh.positions.push(DVec3::from_array(c));
         Ok(())
@@ -218,33 +219,22 @@ impl<'p> Parser<'p> {
         let defined = self.mesh.positions.len() as i64;
         while let Some((off, tok)) = tokens.next() {
             if face.len() == MAX_FACE_VERTICES {
-                return Err(self.err(
-                    line,
-                    format!("face has more than {MAX_FACE_VERTICES} vertices, the most meshclash reads in one polygon"),
-                ));
+                return Err(self.err(line, Face::TooManyVertices { limit: MAX_FACE_VERTICES }));
             }
             let v = tok.split(|&b| b == b'/').next().unwrap_or(tok);
             let idx = match plain_index(v) {
                 Some(i) => i,
                 None => {
                     let s = self.utf8(line, start + off, v)?;
-                    s.parse().map_err(|_| {
-                        self.err(line, format!("cannot parse '{}' as a face vertex index", clip(s, 40)))
-                    })?
+                    s.parse().map_err(|_| self.err(line, Face::BadIndex(clip(s, 40))))?
                 }
             };
             let zero_based = match idx {
-                0 => return Err(self.err(line, "face refers to vertex 0 (OBJ indices start at 1)")),
+                0 => return Err(self.err(line, Face::ZeroIndex)),
                 i if i < 0 => {
                     let r = defined + i;
                     if r < 0 {
-                        return Err(self.err(
-                            line,
-                            format!(
-                                "face refers to vertex {i} but only {defined} vertices are \
-                                 defined before it"
-                            ),
-                        ));
+                        return Err(self.err(line, Face::BeforeFirstVertex { index: i, defined }));
                     }
                     r
                 }
@@ -256,22 +246,16 @@ impl<'p> Parser<'p> {
                 }
             };
             let Ok(z) = u32::try_from(zero_based) else {
-                return Err(self.err(line, format!("face refers to vertex {idx}, beyond any file")));
+                return Err(self.err(line, Face::BeyondAnyFile { index: idx }));
             };
             face.push(z);
         }
         if face.len() < 3 {
-            return Err(self.err(line, format!("face has {} vertices (needs at least 3)", face.len())));
+            return Err(self.err(line, Face::TooFewVertices { found: face.len() }));
         }
         let total = self.mesh.triangles.len() + face.len() - 2;
         if total > self.max_triangles {
-            return Err(self.err(
-                line,
-                format!(
-                    "the faces so far make {total} triangles, more than the {} supported",
-                    self.max_triangles
-                ),
-            ));
+            return Err(self.err(line, Face::TooManyTriangles { total, limit: self.max_triangles }));
         }
         self.mesh.triangles.reserve(face.len() - 2);
         for i in 1..face.len() - 1 {
@@ -283,8 +267,9 @@ impl<'p> Parser<'p> {
     }
 
     fn utf8<'a>(&self, line: usize, offset: usize, tok: &'a [u8]) -> Result<&'a str> {
-        std::str::from_utf8(tok)
-            .map_err(|e| self.err(line, format!("not UTF-8 at byte {}", offset + e.valid_up_to())))
+        std::str::from_utf8(tok).map_err(|e| {
+            self.err(line, InputProblem::NotUtf8 { byte: Some((offset + e.valid_up_to()) as u64) })
+        })
     }
 }
 
@@ -767,6 +752,29 @@ mod tests {
         assert!(e.contains("line 2: cannot parse"), "{e}");
         let e = err(b"v 0 0 0\nf 1 1 9999999999999\n");
         assert!(e.contains("line 2: face refers to vertex 9999999999999"), "{e}");
+    }
+
+    #[test]
+    fn errors_carry_their_line_and_problem_as_data() {
+        use crate::error::{InputProblem as P, Location, NonFinite, ObjFaceProblem as F};
+        let typed = |src: &[u8]| load_bytes(&path(), src, Format::Obj).unwrap_err();
+        let cases: [(&[u8], u64, P); 5] = [
+            (b"v 0 0 0\nv 1 0 0\nv 0 1 0\nf 0 1 2\n", 4, P::ObjFace(F::ZeroIndex)),
+            (
+                b"v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 4\n",
+                4,
+                P::ObjFace(F::BeyondLastVertex { index: 4, vertices: 3 }),
+            ),
+            (b"v 0 0 0\nv 1 0 0\nf 1 2 -3\n", 3, P::ObjFace(F::BeforeFirstVertex { index: -3, defined: 2 })),
+            (b"v 0 0\n", 1, P::TooFewCoordinates { found: 2 }),
+            (b"v 0 0 0\nv 0 inf 0\n", 2, P::ObjNonFiniteVertex { vertex: 2, value: NonFinite::Inf }),
+        ];
+        for (src, line, problem) in cases {
+            let e = typed(src);
+            assert_eq!(e.path(), Some(path().as_path()));
+            assert_eq!(e.location(), Some(&Location::Line(line)), "{e}");
+            assert_eq!(format!("{:?}", e.input_problem()), format!("{:?}", Some(&problem)), "{e}");
+        }
     }
 
     #[test]
