@@ -28,7 +28,7 @@
 //!
 //! Each finding has a count and the first triangle ids involved (ascending, at most `first_n`).
 
-use crate::narrow::tri_tri::Shape;
+use crate::check::fans::Fans;
 use crate::scene::bodies::{find, union};
 use crate::scene::mesh::Mesh;
 use rayon::prelude::*;
@@ -74,157 +74,207 @@ pub struct Health {
     pub volume: Option<f64>,
 }
 
-/// An edge of a proper triangle: (key `lo << 32 | hi`, local triangle, edge number `c` (from
-/// corner `c` to corner `c + 1`), whether corner `c` is the low end); zero-area triangles leave
-/// sentinel entries with key `u64::MAX`.
-type Edge = (u64, u32, u8, bool);
-
-/// `items` without those `bucket` maps to None (sentinels), sorted (total order of `T`), where
-/// `bucket` is the item's leading sort key (`x < y` implies `bucket(x) <= bucket(y)`): a vertex
-/// id. When the buckets are dense (at most 4 ids per item, as in any part that is most of its
-/// mesh), a counting sort on the bucket (one pass to count, one to scatter) and a sort of each
-/// bucket's few entries; otherwise a comparison sort. Both give the same order.
-fn bucket_sort<T: Ord + Copy + Send + Sync>(
-    mut items: Vec<T>,
-    bucket: impl Fn(&T) -> Option<usize> + Sync,
-) -> Vec<T> {
-    let real = items.par_iter().filter(|e| bucket(e).is_some()).count();
-    let max = items.par_iter().filter_map(&bucket).max().unwrap_or(0);
-    if real == 0 || max / 4 > real {
-        items.par_sort_unstable();
-        items.truncate(real);
-        return items;
-    }
-    let mut next = vec![0u32; max + 2];
-    for b in items.iter().filter_map(&bucket) {
-        next[b + 1] += 1;
-    }
-    for i in 1..next.len() {
-        next[i] += next[i - 1];
-    }
-    let Some(&fill) = items.iter().find(|e| bucket(e).is_some()) else { return Vec::new() };
-    let mut out: Vec<T> = vec![fill; real];
-    for e in items {
-        if let Some(b) = bucket(&e) {
-            out[next[b] as usize] = e;
-            next[b] += 1;
-        }
-    }
-    drop(next);
-    // Each bucket's run (a handful of entries) in full order.
-    out.par_chunk_by_mut(|x, y| bucket(x) == bucket(y)).for_each(|run| run.sort_unstable());
-    out
-}
+/// How many vertex groups one parallel task tallies.
+const GROUPS_PER_TASK: usize = 1024;
 
 /// How many triangles go into one chunk of the volume sum (fixed, for determinism).
 const VOLUME_CHUNK: usize = 4096;
 
+/// What the vertex groups find, summed over groups (counts), with the triangles involved (mesh
+/// ids, in no particular order) and scratch space reused from one group to the next.
+#[derive(Default)]
+struct Tally {
+    n_boundary: u64,
+    n_nm: u64,
+    n_wind: u64,
+    n_nmv: u64,
+    boundary: Vec<u32>,
+    nm: Vec<u32>,
+    wind: Vec<u32>,
+    nmv: Vec<u32>,
+    dup: Vec<u32>,
+    /// The two ends of each boundary edge.
+    ends: Vec<(u32, u32)>,
+    /// Scratch: `other end << 32 | local triangle << 1 | 1 if the triangle runs the edge low to
+    /// high` of the edges to higher vertices.
+    edges: Vec<u64>,
+    /// Scratch: (`other two ids` as `low << 32 | high`, local triangle) of the faces whose
+    /// lowest id is here.
+    faces: Vec<(u64, u32)>,
+    /// Scratch: `other end << 32 | position in the fan` of the proper triangles' edges here
+    /// (large fans only).
+    joins: Vec<u64>,
+    /// Scratch: union–find over the proper triangles of the fan.
+    parent: Vec<u32>,
+    /// Scratch: the proper triangles of the fan, with their other two vertices.
+    fan: Vec<(u32, u32, u32)>,
+}
+
+impl Tally {
+    fn merge(mut self, mut o: Tally) -> Tally {
+        self.n_boundary += o.n_boundary;
+        self.n_nm += o.n_nm;
+        self.n_wind += o.n_wind;
+        self.n_nmv += o.n_nmv;
+        self.boundary.append(&mut o.boundary);
+        self.nm.append(&mut o.nm);
+        self.wind.append(&mut o.wind);
+        self.nmv.append(&mut o.nmv);
+        self.dup.append(&mut o.dup);
+        self.ends.append(&mut o.ends);
+        self
+    }
+
+    /// Everything about the vertex of one group: the edges to higher vertices (each edge is
+    /// met once, at its lower end), the faces whose lowest vertex it is (duplicates), and the
+    /// fans of the proper triangles around it (joined through the edges at the vertex).
+    fn vertex(&mut self, v: u32, fans: &Fans, tris: &[u32]) {
+        let (group, ids) = (fans.group(v as usize), &fans.ids);
+        self.edges.clear();
+        self.faces.clear();
+        self.fan.clear();
+        for &e in group {
+            let (k, c) = (e / 3, e as usize % 3);
+            let t = ids[k as usize];
+            let (w1, w2) = (t[(c + 1) % 3], t[(c + 2) % 3]);
+            if w1 == v || w2 == v || w1 == w2 {
+                continue; // fewer than three distinct vertices: not a face, and no edges
+            }
+            if v < w1 && v < w2 {
+                self.faces.push(((w1.min(w2) as u64) << 32 | w1.max(w2) as u64, k));
+            }
+            if fans.proper(k as usize) {
+                // Edge c runs v → w1 (low to high iff w1 > v), edge c + 2 runs w2 → v.
+                let key = |w: u32, up: bool| (w as u64) << 32 | (k as u64) << 1 | up as u64;
+                if w1 > v {
+                    self.edges.push(key(w1, true));
+                }
+                if w2 > v {
+                    self.edges.push(key(w2, false));
+                }
+                self.fan.push((k, w1, w2));
+            }
+        }
+        // Duplicates: every later copy of a vertex set (entries come in triangle order).
+        if self.faces.len() > 1 {
+            self.faces.sort_unstable();
+            for run in self.faces.chunk_by(|x, y| x.0 == y.0) {
+                self.dup.extend(run[1..].iter().map(|x| tris[x.1 as usize]));
+            }
+        }
+        // Edges to higher vertices, by how many triangles use them.
+        small_sort(&mut self.edges);
+        let tri = |e: u64| tris[(e as u32 >> 1) as usize];
+        for run in self.edges.chunk_by(|x, y| x >> 32 == y >> 32) {
+            match run.len() {
+                1 => {
+                    self.n_boundary += 1;
+                    self.boundary.push(tri(run[0]));
+                    self.ends.push((v, (run[0] >> 32) as u32));
+                }
+                2 if run[0] & 1 == run[1] & 1 => {
+                    self.n_wind += 1;
+                    self.wind.extend(run.iter().map(|&e| tri(e)));
+                }
+                2 => {}
+                _ => {
+                    self.n_nm += 1;
+                    self.nm.extend(run.iter().map(|&e| tri(e)));
+                }
+            }
+        }
+        // Fans: proper triangles sharing an edge at v are in one fan; more than one fan is a
+        // bow-tie.
+        let m = self.fan.len();
+        if m > 1 {
+            self.parent.clear();
+            self.parent.extend(0..m as u32);
+            if m <= SMALL_FAN {
+                for i in 0..m {
+                    let (_, a1, a2) = self.fan[i];
+                    for j in i + 1..m {
+                        let (_, b1, b2) = self.fan[j];
+                        if a1 == b1 || a1 == b2 || a2 == b1 || a2 == b2 {
+                            union(&mut self.parent, i as u32, j as u32);
+                        }
+                    }
+                }
+            } else {
+                self.joins.clear();
+                for (i, &(_, w1, w2)) in self.fan.iter().enumerate() {
+                    self.joins.extend([(w1 as u64) << 32 | i as u64, (w2 as u64) << 32 | i as u64]);
+                }
+                self.joins.sort_unstable();
+                for w in self.joins.windows(2) {
+                    if w[0] >> 32 == w[1] >> 32 {
+                        union(&mut self.parent, w[0] as u32, w[1] as u32);
+                    }
+                }
+            }
+            let roots = (0..m as u32).filter(|&i| self.parent[i as usize] == i).count();
+            if roots > 1 {
+                self.n_nmv += 1;
+                self.nmv.extend(self.fan.iter().map(|x| tris[x.0 as usize]));
+            }
+        }
+    }
+}
+
+/// Fans up to this many proper triangles are joined by comparing every pair; larger ones by a
+/// sort of their edges.
+const SMALL_FAN: usize = 16;
+
+/// Sort a short slice by insertion (the edges at one vertex: a handful), a long one by
+/// `sort_unstable`.
+fn small_sort(v: &mut [u64]) {
+    if v.len() > 16 {
+        v.sort_unstable();
+        return;
+    }
+    for i in 1..v.len() {
+        let x = v[i];
+        let mut j = i;
+        while j > 0 && v[j - 1] > x {
+            v[j] = v[j - 1];
+            j -= 1;
+        }
+        v[j] = x;
+    }
+}
+
 /// The health of the part made of triangles `tris` of `mesh`; `merged` gives each vertex its
 /// exact-position id ([`crate::scene::bodies::merge_vertices`]). Triangle ids in the result are
 /// indices into `mesh`.
+///
+/// The corners are grouped by vertex ([`Fans`]: a counting sort, 4 bytes per corner); then
+/// each vertex, in parallel, settles its own edges to higher vertices, the faces it is the
+/// lowest vertex of, and its fans. Nothing is sorted globally but the few triangles a finding
+/// lists.
 pub fn health(mesh: &Mesh, merged: &[u32], tris: &[u32], first_n: usize) -> Health {
-    let ids = |k: usize| mesh.triangles[tris[k] as usize].map(|v| merged[v as usize]);
+    health_with(mesh, &Fans::new(mesh, merged, tris), tris, first_n)
+}
+
+/// [`health`], given the part's fans ([`Fans::new`] over the same triangles).
+pub fn health_with(mesh: &Mesh, fans: &Fans, tris: &[u32], first_n: usize) -> Health {
     let pos = |k: usize| crate::bvh::triangle(mesh, tris[k]);
-    let proper: Vec<bool> =
-        (0..tris.len()).into_par_iter().map(|k| !Shape::of(&pos(k)).is_degenerate()).collect();
-    let zero: Vec<u32> = (0..tris.len()).filter(|&k| !proper[k]).map(|k| tris[k]).collect();
+    let proper = |k: usize| fans.proper(k);
+    let zero: Vec<u32> = (0..tris.len()).filter(|&k| !proper(k)).map(|k| tris[k]).collect();
     let zero_area_triangles = Finding::of(zero.len() as u64, zero, first_n);
-
-    // Duplicates: sorted vertex sets of the triangles with three distinct vertices.
-    let faces: Vec<([u32; 3], u32)> = (0..tris.len())
+    let chunks = fans.vertices().div_ceil(GROUPS_PER_TASK);
+    let mut tally = (0..chunks)
         .into_par_iter()
-        .filter_map(|k| {
-            let mut v = ids(k);
-            v.sort_unstable();
-            (v[0] != v[1] && v[1] != v[2]).then_some((v, tris[k]))
+        .map(|c| {
+            let mut t = Tally::default();
+            for v in c * GROUPS_PER_TASK..((c + 1) * GROUPS_PER_TASK).min(fans.vertices()) {
+                t.vertex(v as u32, fans, tris);
+            }
+            t
         })
-        .collect();
-    let faces = bucket_sort(faces, |f| Some(f.0[0] as usize));
-    let mut dup = Vec::new();
-    for run in faces.chunk_by(|x, y| x.0 == y.0) {
-        dup.extend(run[1..].iter().map(|x| x.1));
-    }
-    drop(faces);
-    let duplicate_faces = Finding::of(dup.len() as u64, dup, first_n);
-
-    // Edges of the proper triangles: (key (lo, hi), local triangle, edge number c (from corner
-    // c to corner c + 1), whether corner c is the low end), 16 bytes. Zero-area triangles get
-    // sentinel keys (above every real key: lo < hi <= u32::MAX), cut off after the sort;
-    // filling a preallocated array keeps the collection indexed and parallel.
-    let mut edges: Vec<Edge> = vec![(u64::MAX, 0, 0, false); 3 * tris.len()];
-    edges.par_chunks_mut(3).enumerate().filter(|(k, _)| proper[*k]).for_each(|(k, out)| {
-        let v = ids(k);
-        for (c, e) in out.iter_mut().enumerate() {
-            let (a, b) = (v[c], v[(c + 1) % 3]);
-            *e = ((a.min(b) as u64) << 32 | a.max(b) as u64, k as u32, c as u8, a < b);
-        }
-    });
-    let edges = bucket_sort(edges, |e| (e.0 != u64::MAX).then_some((e.0 >> 32) as usize));
-    let forward = |e: &Edge| e.3;
-    let tri_of = |e: &Edge| tris[e.1 as usize];
-    // Corner slots (local triangle × 3 + corner) joined through the edges at their vertex.
-    let mut corner: Vec<u32> = (0..tris.len() as u32 * 3).collect();
-    let corner_at = |e: &Edge, lo_end: bool| {
-        let (k, c) = (e.1, e.2 as u32);
-        let at_c = forward(e) == lo_end;
-        k * 3 + if at_c { c } else { (c + 1) % 3 }
-    };
-    let (mut boundary, mut nm, mut wind) = (Vec::new(), Vec::new(), Vec::new());
-    let (mut n_boundary, mut n_nm, mut n_wind) = (0u64, 0u64, 0u64);
-    let mut boundary_ends: Vec<(u32, u32)> = Vec::new();
-    for run in edges.chunk_by(|x, y| x.0 == y.0) {
-        match run.len() {
-            1 => {
-                n_boundary += 1;
-                boundary.push(tri_of(&run[0]));
-                boundary_ends.push(((run[0].0 >> 32) as u32, run[0].0 as u32));
-            }
-            2 if forward(&run[0]) == forward(&run[1]) => {
-                n_wind += 1;
-                wind.extend(run.iter().map(tri_of));
-            }
-            2 => {}
-            _ => {
-                n_nm += 1;
-                nm.extend(run.iter().map(tri_of));
-            }
-        }
-        for lo_end in [true, false] {
-            for w in run.windows(2) {
-                union(&mut corner, corner_at(&w[0], lo_end), corner_at(&w[1], lo_end));
-            }
-        }
-    }
-    let closed = !edges.is_empty() && n_boundary == 0 && n_nm == 0;
-    drop(edges);
-    // Non-manifold vertices: more than one corner set (fan) at one vertex. Corners are only
-    // ever joined with corners at the same vertex, so each fan has one root corner: a vertex
-    // with two roots is non-manifold.
-    let mut roots: Vec<u32> = Vec::with_capacity(tris.len() / 2 + 1);
-    for k in (0..tris.len()).filter(|&k| proper[k]) {
-        let v = ids(k);
-        for (c, &vc) in v.iter().enumerate() {
-            let slot = (k * 3 + c) as u32;
-            if find(&mut corner, slot) == slot {
-                roots.push(vc);
-            }
-        }
-    }
-    drop(corner);
-    roots.par_sort_unstable();
-    let nmv_vertices: Vec<u32> =
-        roots.chunk_by(|x, y| x == y).filter(|run| run.len() > 1).map(|run| run[0]).collect();
-    let n_nmv = nmv_vertices.len() as u64;
-    drop(roots);
-    let nmv_tris: Vec<u32> = if nmv_vertices.is_empty() {
-        Vec::new()
-    } else {
-        (0..tris.len())
-            .filter(|&k| proper[k] && ids(k).iter().any(|v| nmv_vertices.binary_search(v).is_ok()))
-            .map(|k| tris[k])
-            .collect()
-    };
+        .reduce(Tally::default, Tally::merge);
+    let any_proper = (0..tris.len()).any(proper);
+    let closed = any_proper && tally.n_boundary == 0 && tally.n_nm == 0;
     // Boundary loops: components of the boundary-edge graph.
+    let boundary_ends = std::mem::take(&mut tally.ends);
     let mut ends: Vec<u32> = boundary_ends.iter().flat_map(|&(a, b)| [a, b]).collect();
     ends.sort_unstable();
     ends.dedup();
@@ -244,7 +294,7 @@ pub fn health(mesh: &Mesh, merged: &[u32], tris: &[u32], first_n: usize) -> Heal
                 let mut s = 0.0;
                 for (x, _) in chunk.iter().enumerate() {
                     let k = c * VOLUME_CHUNK + x;
-                    if proper[k] {
+                    if proper(k) {
                         let [a, b, cc] = pos(k);
                         s += (a - o).dot((b - o).cross(cc - o));
                     }
@@ -254,15 +304,16 @@ pub fn health(mesh: &Mesh, merged: &[u32], tris: &[u32], first_n: usize) -> Heal
             .collect();
         chunks.iter().sum::<f64>() / 6.0
     });
+    let dup = std::mem::take(&mut tally.dup);
     Health {
         closed,
-        duplicate_faces,
+        duplicate_faces: Finding::of(dup.len() as u64, dup, first_n),
         zero_area_triangles,
-        non_manifold_edges: Finding::of(n_nm, nm, first_n),
-        non_manifold_vertices: Finding::of(n_nmv, nmv_tris, first_n),
-        boundary_edges: Finding::of(n_boundary, boundary, first_n),
+        non_manifold_edges: Finding::of(tally.n_nm, std::mem::take(&mut tally.nm), first_n),
+        non_manifold_vertices: Finding::of(tally.n_nmv, std::mem::take(&mut tally.nmv), first_n),
+        boundary_edges: Finding::of(tally.n_boundary, std::mem::take(&mut tally.boundary), first_n),
         boundary_loops,
-        inconsistent_winding_edges: Finding::of(n_wind, wind, first_n),
+        inconsistent_winding_edges: Finding::of(tally.n_wind, std::mem::take(&mut tally.wind), first_n),
         volume,
     }
 }

@@ -7,6 +7,7 @@
 pub mod assembly;
 pub mod containment;
 pub mod cross_check;
+pub mod fans;
 pub mod finding_id;
 pub mod health;
 pub mod query;

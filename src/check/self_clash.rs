@@ -37,20 +37,34 @@
 //!
 //! # The walk
 //!
-//! One BVH per part (binned SAH, [`crate::bvh`]) is walked against itself: a node is paired with
-//! itself once (its two children each with themselves, and the two children with each other),
-//! and two different nodes as in a dual-tree walk, so each unordered leaf pair is visited once
-//! and each unordered triangle pair is tested once. As in [`crate::bvh::traverse`], the root is
-//! expanded breadth-first into a fixed number of independent sub-walks, and the result is
-//! sorted, so the answer does not depend on the thread count.
+//! One tree per part is walked against itself: a node is paired with itself once (its two
+//! children each with themselves, and the two children with each other), and two different
+//! nodes as in a dual-tree walk, so each unordered leaf pair is visited once and each unordered
+//! triangle pair is tested once. As in [`crate::bvh::traverse`], the root is expanded
+//! breadth-first into a fixed number of independent sub-walks, and the result is sorted, so
+//! the answer does not depend on the thread count.
+//!
+//! The tree ([`tree`]) orders the triangles along a Morton curve and splits at the highest
+//! differing bit of their codes: a few linear passes instead of a binned-SAH build, which buys
+//! little on a surface walked against itself. Its boxes are f32, rounded outward (they contain
+//! the exact boxes), and a leaf's triangles are one run of a 40-byte-per-triangle array (box,
+//! vertex numbers, position); corners are read from the mesh only for pairs that get a test.
+//!
+//! On a surface, almost every pair whose boxes overlap is a pair of neighbours around a vertex.
+//! Those are settled a whole vertex fan at a time where one exact argument covers the fan
+//! ([`certified_fans`]: projected along an axis, the fan's triangles tile the turn around the
+//! vertex once); the walk skips every pair sharing a certified vertex. The other pairs get the
+//! pair test ([`classify_adjacent`] behind float filters that only skip work).
 
-use crate::bvh::{BuildOptions, Bvh};
+use crate::bvh::BuildOptions;
+use crate::check::fans::Fans;
 use crate::geom::predicates::{self as pr, PlaneFilter};
 use crate::geom::{Aabb, DVec3};
 use crate::narrow::tri_tri::{self, Hit};
 use crate::scene::mesh::Mesh;
 use rayon::prelude::*;
 use std::ops::Range;
+use tree::{FBox, SNode};
 
 /// How many independent sub-walks the root is split into (fixed, for determinism).
 const SEED_TASKS: usize = 256;
@@ -223,48 +237,207 @@ fn classify_adjacent_with(
     }
 }
 
-/// One triangle as a pair test reads it (see [`self_pairs_timed`]).
+/// One triangle as the walk reads it, in curve order (see [`self_pairs_with`]): 40 bytes.
 #[derive(Debug, Clone, Copy)]
 struct Slot {
+    /// A box around it (f32, rounded outward).
+    b: FBox,
+    /// Its vertex numbers ([`Fans::ids`]: equal iff the merged ids are).
+    ids: [u32; 3],
+    /// Its position in the part.
+    k: u32,
+}
+
+impl tree::Item for Slot {
+    #[inline]
+    fn bounds(&self) -> FBox {
+        self.b
+    }
+    #[inline]
+    fn id(&self) -> u32 {
+        self.k
+    }
+}
+
+/// One triangle as a pair test reads it (gathered from the mesh for the pairs that need one).
+#[derive(Debug, Clone, Copy)]
+struct Tri {
     /// Its corners.
     p: [DVec3; 3],
-    /// Their merged (exact-position) ids.
+    /// Their vertex numbers.
     ids: [u32; 3],
     /// Its index in the mesh.
     t: u32,
 }
 
-/// Walk `tree` against itself: `leaf_self` gets each leaf once, `leaf_pair` each unordered pair
-/// of different leaves whose boxes overlap (closed boxes) once, each leaf as its range of
-/// positions in `tree.prims`. Results come back in an order that depends only on the tree.
-pub fn self_walk<T, S, P>(tree: &Bvh, leaf_self: S, leaf_pair: P) -> Vec<T>
+/// `Some(s)` when `s` is a proven non-zero sign.
+#[inline]
+fn strict(s: Option<pr::Sign>) -> Option<pr::Sign> {
+    s.filter(|&s| s != 0)
+}
+
+/// Exact, for a proper triangle `s = (v, a, b)` (in its own winding, rotated so that `v` comes
+/// first) and a triangle `t = (v, c, d)` whose `c` and `d` lie strictly on opposite sides of
+/// `s`'s plane, `c` on side `side_c` (`orient3d(v, a, b, c)`): do `s` and `t` meet anywhere
+/// but `v`?
+///
+/// `t` meets the plane of `s` in the segment `[v, p]`, `p` the point where `[c, d]` crosses it,
+/// so `s ∩ t = s ∩ [v, p]`: more than `v` iff `p - v` points into the angle of `s` at `v`, i.e.
+/// `p` lies on the inner side (or on) the lines `va` and `bv` and is not `v` itself. For a
+/// segment `cd` crossing the plane, `orient3d(c, d, x, y)` has the sign of `p`'s side of the
+/// line `xy` in that plane times `-side_c` (the three signs of the classic segment–triangle
+/// test); `p = v` (both zero) only when `t` is a segment through `v`, which meets `s` in `v`
+/// alone.
+fn meets_beyond_vertex_crossing(v: DVec3, a: DVec3, b: DVec3, c: DVec3, d: DVec3, side_c: pr::Sign) -> bool {
+    let inner = -side_c;
+    let (o1, o2) = (pr::orient3d(c, d, v, a), pr::orient3d(c, d, b, v));
+    o1 != -inner && o2 != -inner && (o1 != 0 || o2 != 0)
+}
+
+/// The self-clash test of one pair of slots whose boxes overlap, `fx` the plane filter of `x`
+/// (built once per `x` and reused against every `y` it meets) and `mx` the corners of `x` that
+/// are corners of `y` ([`shared_mask`]): the pair, lower triangle first, when it is one.
+///
+/// Fast paths for the pairs a surface is made of (every box overlaps its neighbours'), when
+/// both triangles have three distinct ids: sharing two (an edge), they are apart beyond it
+/// when the filter proves the unshared vertex of one off the other's plane; sharing one (a
+/// vertex `v`), when it proves the two unshared vertices of one strictly on one side of the
+/// other's plane, and when it proves them strictly on opposite sides, two exact orientations
+/// decide it ([`meets_beyond_vertex_crossing`]). Proven signs are exact, so these give the
+/// answer of [`classify_adjacent`]; everything else goes to it.
+#[inline(never)]
+fn test_pair(x: &Tri, fx: &PlaneFilter, y: &Tri, mx: usize) -> Option<SelfPair> {
+    let (xi, yi) = (x.ids, y.ids);
+    let distinct = |i: [u32; 3]| (i[0] != i[1]) & (i[1] != i[2]) & (i[0] != i[2]);
+    let my = shared_mask(yi, xi);
+    let beyond = if !(distinct(xi) & distinct(yi)) {
+        None
+    } else {
+        match mx {
+            // Nothing shared: any contact; none when `y` is strictly on one side of `x`'s plane.
+            0 => Some(!one_side(fx, &y.p)),
+            // The same face twice: a duplicate, not a pair.
+            7 => Some(false),
+            3 | 5 | 6 => {
+                // An edge: the unshared corner of each against the other's plane.
+                let (kx, ky) = (UNSHARED[mx], UNSHARED[my]);
+                let apart = strict(fx.side(y.p[ky])).is_some()
+                    || strict(PlaneFilter::new(&y.p).side(x.p[kx])).is_some();
+                apart.then_some(false)
+            }
+            // A vertex.
+            _ => {
+                let (kx, ky) = (SHARED[mx], SHARED[my]);
+                match vertex_sides(fx, x, kx, y, ky) {
+                    Some(r) => Some(r),
+                    None => vertex_sides(&PlaneFilter::new(&y.p), y, ky, x, kx),
+                }
+            }
+        }
+    };
+    let (lo, hi) = if x.t < y.t { (x, y) } else { (y, x) };
+    let hit = match beyond {
+        Some(false) => return None,
+        Some(true) => tri_tri::classify(&lo.p, &hi.p),
+        None => classify_adjacent_with(&lo.p, lo.ids, &hi.p, hi.ids, None),
+    };
+    hit.map(|hit| SelfPair { a: lo.t, b: hi.t, hit })
+}
+
+/// Bit `k` set when corner `k` of `i` is a corner of `o` (by vertex number).
+#[inline(always)]
+fn shared_mask(i: [u32; 3], o: [u32; 3]) -> usize {
+    let has = |v: u32| ((v == o[0]) | (v == o[1]) | (v == o[2])) as usize;
+    has(i[0]) | has(i[1]) << 1 | has(i[2]) << 2
+}
+
+/// For a mask with one bit set: that corner.
+const SHARED: [usize; 8] = [0, 0, 1, 0, 2, 0, 0, 0];
+/// For a mask with two bits set: the corner not set.
+const UNSHARED: [usize; 8] = [0, 0, 0, 2, 0, 1, 0, 0];
+/// The corner after (in the winding) each corner.
+const NEXT: [usize; 3] = [1, 2, 0];
+
+/// True if filter `f` proves the three points strictly on one side of its plane.
+#[inline]
+fn one_side(f: &PlaneFilter, p: &[DVec3; 3]) -> bool {
+    match (f.side(p[0]), f.side(p[1]), f.side(p[2])) {
+        (Some(a), Some(b), Some(c)) => a != 0 && a == b && a == c,
+        _ => false,
+    }
+}
+
+/// For `s` (filter `f`) and `t` sharing only their corners `ks` and `kt` (the vertex `v`), `s`
+/// and `t` read from `v` in their own winding as `(v, a, b)` and `(v, c, d)`: whether they
+/// meet beyond `v`, when the filter's signs for `c` and `d` settle it (both strictly on one
+/// side: no; strictly on opposite sides: [`meets_beyond_vertex_crossing`]).
+#[inline]
+fn vertex_sides(f: &PlaneFilter, s: &Tri, ks: usize, t: &Tri, kt: usize) -> Option<bool> {
+    let (c, d) = (t.p[NEXT[kt]], t.p[NEXT[NEXT[kt]]]);
+    let (sc, sd) = (strict(f.side(c))?, strict(f.side(d))?);
+    if sc == sd {
+        return Some(false);
+    }
+    let (v, a, b) = (s.p[ks], s.p[NEXT[ks]], s.p[NEXT[NEXT[ks]]]);
+    Some(meets_beyond_vertex_crossing(v, a, b, c, d, sc))
+}
+
+/// The box of a triangle by plain comparisons (coordinates are finite).
+#[inline(always)]
+fn tri_box(p: &[DVec3; 3]) -> Aabb {
+    let lo = |a: f64, b: f64| if b < a { b } else { a };
+    let hi = |a: f64, b: f64| if b > a { b } else { a };
+    let [a, b, c] = p;
+    Aabb {
+        min: DVec3::new(lo(lo(a.x, b.x), c.x), lo(lo(a.y, b.y), c.y), lo(lo(a.z, b.z), c.z)),
+        max: DVec3::new(hi(hi(a.x, b.x), c.x), hi(hi(a.y, b.y), c.y), hi(hi(a.z, b.z), c.z)),
+    }
+}
+
+/// Does the closed box of triangle `p` meet the closed box `b`? (It misses it iff all three
+/// corners are beyond one face of `b`.)
+#[inline(always)]
+fn tri_meets_box(p: &[DVec3; 3], b: &Aabb) -> bool {
+    let [u, v, w] = p;
+    let out = (u.x < b.min.x) & (v.x < b.min.x) & (w.x < b.min.x)
+        | (u.x > b.max.x) & (v.x > b.max.x) & (w.x > b.max.x)
+        | (u.y < b.min.y) & (v.y < b.min.y) & (w.y < b.min.y)
+        | (u.y > b.max.y) & (v.y > b.max.y) & (w.y > b.max.y)
+        | (u.z < b.min.z) & (v.z < b.min.z) & (w.z < b.min.z)
+        | (u.z > b.max.z) & (v.z > b.max.z) & (w.z > b.max.z);
+    !out
+}
+
+/// Walk a tree (`nodes` in [`crate::bvh::Bvh`]'s layout) against itself: `leaf_self` gets each
+/// leaf once, `leaf_pair` each unordered pair of different leaves whose boxes meet (closed
+/// boxes) once, each leaf as its range of positions (`a .. a + count`). Results come back in an order that depends only on the tree.
+fn self_walk<T, S, P>(nodes: &[SNode], leaf_self: S, leaf_pair: P) -> Vec<T>
 where
     T: Send,
     S: Fn(Range<usize>, &mut Vec<T>) + Sync,
     P: Fn(Range<usize>, Range<usize>, &mut Vec<T>) + Sync,
 {
-    let range = |n: &crate::bvh::Node| n.a as usize..(n.a + n.count) as usize;
+    let range = |n: &SNode| n.a as usize..(n.a + n.count) as usize;
     #[derive(Clone, Copy)]
     enum Job {
         Node(u32),
         Pair(u32, u32),
     }
-    let nodes = &tree.nodes;
     if nodes.is_empty() {
         return Vec::new();
     }
-    let meet = |i: u32, j: u32| nodes[i as usize].bounds.overlaps(&nodes[j as usize].bounds);
-    // Expand one job; leaf work goes to `out`, new jobs to `push`.
-    let step = |job: Job, out: &mut Vec<T>, push: &mut dyn FnMut(Job)| match job {
+    let meet = |i: u32, j: u32| nodes[i as usize].b.meets(&nodes[j as usize].b);
+    // Expand one job; leaf work goes to `out`, new jobs to `jobs`.
+    let step = |job: Job, out: &mut Vec<T>, jobs: &mut Vec<Job>| match job {
         Job::Node(i) => {
             let n = &nodes[i as usize];
             if n.is_leaf() {
                 leaf_self(range(n), out);
             } else {
-                push(Job::Node(i + 1));
-                push(Job::Node(n.a));
+                jobs.push(Job::Node(i + 1));
+                jobs.push(Job::Node(n.a));
                 if meet(i + 1, n.a) {
-                    push(Job::Pair(i + 1, n.a));
+                    jobs.push(Job::Pair(i + 1, n.a));
                 }
             }
         }
@@ -277,12 +450,12 @@ where
                 }
                 (true, false) => false,
                 (false, true) => true,
-                (false, false) => a.bounds.half_area() >= b.bounds.half_area(),
+                (false, false) => a.b.half_area() >= b.b.half_area(),
             };
             let kids = if open_a { [(i + 1, j), (a.a, j)] } else { [(i, j + 1), (i, b.a)] };
             for (x, y) in kids {
                 if meet(x, y) {
-                    push(Job::Pair(x, y));
+                    jobs.push(Job::Pair(x, y));
                 }
             }
         }
@@ -293,7 +466,7 @@ where
     while !level.is_empty() && level.len() < SEED_TASKS {
         let mut next = Vec::with_capacity(level.len() * 3);
         for &job in &level {
-            step(job, &mut early, &mut |j| next.push(j));
+            step(job, &mut early, &mut next);
         }
         level = next;
     }
@@ -303,7 +476,7 @@ where
             let mut out = Vec::new();
             let mut stack = vec![seed];
             while let Some(job) = stack.pop() {
-                step(job, &mut out, &mut |j| stack.push(j));
+                step(job, &mut out, &mut stack);
             }
             out
         })
@@ -321,7 +494,7 @@ pub fn self_pairs(mesh: &Mesh, merged: &[u32], tris: &[u32], opts: BuildOptions)
 /// Milliseconds spent by one [`self_pairs_timed`] call, by phase.
 #[derive(Debug, Clone, Copy, Default, PartialEq)]
 pub struct SelfTimes {
-    /// Triangle boxes and the tree.
+    /// The vertex fans and their certificates, the curve order and the tree.
     pub tree_ms: f64,
     /// The walk with every pair test, and the final sort.
     pub walk_ms: f64,
@@ -335,63 +508,163 @@ pub fn self_pairs_timed(
     opts: BuildOptions,
 ) -> (Vec<SelfPair>, SelfTimes) {
     let t0 = std::time::Instant::now();
-    let boxes: Vec<Aabb> =
-        tris.par_iter().map(|&t| Aabb::of_triangle(&crate::bvh::triangle(mesh, t))).collect();
-    let tree = Bvh::build_from_boxes(&boxes, opts);
-    drop(boxes);
-    // What a pair test reads, laid out in the tree's leaf order so that a leaf is one run of
-    // memory and no pair test reaches into the mesh: the corners, their merged ids and the
-    // triangle index in `mesh` (88 bytes per triangle). Boxes are recomputed from the corners
-    // (cheaper than reading them).
-    let slots: Vec<Slot> = tree
-        .prims
+    let fans = Fans::new(mesh, merged, tris);
+    let (pairs, mut times) = self_pairs_with(mesh, tris, &fans, opts);
+    times.tree_ms = t0.elapsed().as_secs_f64() * 1e3 - times.walk_ms;
+    (pairs, times)
+}
+
+/// [`self_pairs_timed`], given the part's fans ([`Fans::new`] over the same triangles).
+pub fn self_pairs_with(
+    mesh: &Mesh,
+    tris: &[u32],
+    fans: &Fans,
+    opts: BuildOptions,
+) -> (Vec<SelfPair>, SelfTimes) {
+    let t0 = std::time::Instant::now();
+    let certified = certified_fans(mesh, tris, fans);
+    let corners = |k: usize| crate::bvh::triangle(mesh, tris[k]);
+    let (keys, centres) = tree::curve_keys(tris.len(), |k| tri_box(&corners(k)).center());
+    let origin = if centres.center().is_finite() { centres.center() } else { DVec3::ZERO };
+    // What the walk reads, in curve order (which the tree keeps), so that a leaf is one run of
+    // memory: a box, the vertex numbers and the position in the part. Corners are read from
+    // the mesh only for the pairs that need a test.
+    let mut slots: Vec<Slot> = keys
         .par_iter()
-        .map(|&k| {
-            let t = tris[k as usize];
-            let v = mesh.triangles[t as usize];
-            Slot { p: v.map(|i| mesh.positions[i as usize]), ids: v.map(|i| merged[i as usize]), t }
+        .map(|&key| {
+            let k = key as u32;
+            let b = FBox::around(&tri_box(&corners(k as usize)), origin);
+            Slot { b, ids: fans.ids[k as usize], k }
         })
         .collect();
+    let nodes = tree::build(&mut slots, &keys, opts.leaf_size.clamp(1, 255) as usize);
+    drop(keys);
     let tree_ms = t0.elapsed().as_secs_f64() * 1e3;
     let t1 = std::time::Instant::now();
-    // `x`'s box and plane filter are computed once per `x` and reused for every `y` it meets.
-    let test = |x: &Slot, (bx, fx): &(Aabb, PlaneFilter), y: &Slot, out: &mut Vec<SelfPair>| {
-        if !bx.overlaps(&Aabb::of_triangle(&y.p)) {
-            return;
-        }
-        // Lower triangle first, so the listed segment does not depend on the tree.
-        let hit = if x.t < y.t {
-            classify_adjacent_with(&x.p, x.ids, &y.p, y.ids, Some((true, fx)))
-        } else {
-            classify_adjacent_with(&y.p, y.ids, &x.p, x.ids, Some((false, fx)))
-        };
-        if let Some(hit) = hit {
-            out.push(SelfPair { a: x.t.min(y.t), b: x.t.max(y.t), hit });
+    let is_certified = |v: u32| certified[v as usize / 64] >> (v % 64) & 1 != 0;
+    let tri = |s: &Slot| Tri { p: corners(s.k as usize), ids: s.ids, t: tris[s.k as usize] };
+    // `x` against each of `ys`: the box test; then a pair sharing a vertex whose fan is
+    // certified is settled; the rest get the exact box test and the pair test (`x`'s corners,
+    // box and plane filter read once, on first use).
+    let against = |x: &Slot, ys: &[Slot], out: &mut Vec<SelfPair>| {
+        let cx = x.ids.iter().enumerate().fold(0, |m, (k, &v)| m | (is_certified(v) as usize) << k);
+        let mut full = None;
+        for y in ys {
+            if x.b.meets(&y.b) {
+                let mx = shared_mask(x.ids, y.ids);
+                if mx & cx != 0 {
+                    continue;
+                }
+                let (tx, bx, fx) = full.get_or_insert_with(|| {
+                    let t = tri(x);
+                    (t, tri_box(&t.p), PlaneFilter::new(&t.p))
+                });
+                let ty = tri(y);
+                if !tri_meets_box(&ty.p, bx) {
+                    continue;
+                }
+                if let Some(p) = test_pair(tx, fx, &ty, mx) {
+                    out.push(p);
+                }
+            }
         }
     };
-    let prep = |x: &Slot| (Aabb::of_triangle(&x.p), PlaneFilter::new(&x.p));
     let mut pairs = self_walk(
-        &tree,
+        &nodes,
         |leaf, out| {
             let leaf = &slots[leaf];
             for (k, x) in leaf.iter().enumerate() {
-                let px = prep(x);
-                for y in &leaf[k + 1..] {
-                    test(x, &px, y, out);
-                }
+                against(x, &leaf[k + 1..], out);
             }
         },
         |la, lb, out| {
+            let lb = &slots[lb];
             for x in &slots[la] {
-                let px = prep(x);
-                for y in &slots[lb.clone()] {
-                    test(x, &px, y, out);
-                }
+                against(x, lb, out);
             }
         },
     );
     pairs.par_sort_unstable_by_key(|p| (p.a, p.b));
     (pairs, SelfTimes { tree_ms, walk_ms: t1.elapsed().as_secs_f64() * 1e3 })
+}
+
+/// Fans with more triangles than this are not certified (their pairs are tested one by one).
+const CERTIFIED_FAN_MAX: usize = 32;
+
+/// One bit per vertex: set when every pair of triangles around the vertex is proven to meet
+/// only in what it shares, by one exact argument for the whole fan.
+///
+/// The fan of `v` is certified when its triangles, read from `v` in their own winding as
+/// `(v, w1, w2)`, are all proper, no two have the same `w1` or the same `w2`, the `w1` are the
+/// `w2` (a closed ring, every edge at `v` used by two triangles in opposite directions), and
+/// there is an axis `a` along which the filter proves every normal's component `a` non-zero
+/// with one sign `s`, and, projected along `a`, the ring goes around `v` exactly once.
+///
+/// Then the projection along `a` is one-to-one on each triangle, and every projected triangle
+/// `(v, w1, w2)` turns the same way `s` around `v` by less than π; the ring's winding number
+/// around `v` is the sum of those turns over 2π, so winding ±1 means the projected triangles
+/// are sectors around `v` that tile the turn once without overlapping. Two sectors then meet
+/// only in `v` or in their common edge, and the triangles (one-to-one over them) only in what
+/// they share: no pair of the fan is a self-clash. The winding number is counted exactly
+/// (Sunday's crossing rule): every ring edge `w1 → w2` has `v` on the side `s` (that is the
+/// sign of its triangle), so only the edges crossing the line through `v` upward (`s > 0`) or
+/// downward (`s < 0`) count, and those are decided by comparing coordinates. Nothing is
+/// rounded, so a certified fan is a proof; a fan that is not certified only costs its pairs
+/// the pair test.
+fn certified_fans(mesh: &Mesh, tris: &[u32], fans: &Fans) -> Vec<u64> {
+    let n = fans.vertices();
+    let corner = |e: u32, step: usize| {
+        let (k, c) = (e as usize / 3, e as usize % 3);
+        mesh.positions[mesh.triangles[tris[k] as usize][(c + step) % 3] as usize]
+    };
+    let certify = |v: usize| -> bool {
+        let group = fans.group(v);
+        let m = group.len();
+        if !(3..=CERTIFIED_FAN_MAX).contains(&m) {
+            return false;
+        }
+        let k0 = group[0] as usize / 3;
+        // An axis along which every normal has one proven sign.
+        let Some((axis, s)) = (0..3).find_map(|a| {
+            let s = fans.normal_sign(k0, a)?;
+            group.iter().all(|&e| fans.normal_sign(e as usize / 3, a) == Some(s)).then_some((a, s))
+        }) else {
+            return false;
+        };
+        // The ring: each w1 once, each w2 once, and the same set.
+        let mut w1 = [0u32; CERTIFIED_FAN_MAX];
+        let mut w2 = [0u32; CERTIFIED_FAN_MAX];
+        for (i, &e) in group.iter().enumerate() {
+            let (k, c) = (e as usize / 3, e as usize % 3);
+            let t = fans.ids[k];
+            (w1[i], w2[i]) = (t[(c + 1) % 3], t[(c + 2) % 3]);
+        }
+        let (w1, w2) = (&mut w1[..m], &mut w2[..m]);
+        w1.sort_unstable();
+        w2.sort_unstable();
+        if w1 != w2 || w1.windows(2).any(|p| p[0] == p[1]) {
+            return false;
+        }
+        // Crossings of the line through v along the projection's second coordinate.
+        let y = (axis + 2) % 3;
+        let yv = corner(group[0], 0)[y];
+        let crossings = group
+            .iter()
+            .filter(|&&e| {
+                let (p, q) = (corner(e, 1)[y], corner(e, 2)[y]);
+                if s > 0 {
+                    p <= yv && yv < q
+                } else {
+                    q <= yv && yv < p
+                }
+            })
+            .count();
+        crossings == 1
+    };
+    (0..n.div_ceil(64))
+        .into_par_iter()
+        .map(|w| (w * 64..(w * 64 + 64).min(n)).filter(|&v| certify(v)).fold(0u64, |b, v| b | 1 << (v % 64)))
+        .collect()
 }
 
 /// The same answer as [`self_pairs`] by testing every pair (quadratic; for tests).
@@ -485,25 +758,33 @@ pub fn check_part_list(
     let same_as: Vec<Option<usize>> = if reuse { translates(mesh, &parts) } else { vec![None; parts.len()] };
     let merge_ms = t.elapsed().as_secs_f64() * 1e3;
     let leaders: Vec<usize> = (0..parts.len()).filter(|&i| same_as[i].is_none()).collect();
-    // Health and the self-clash walks run side by side: parts of the health pass are
-    // sequential (union-find), and the walk fills the other cores meanwhile.
     let ms = |t: std::time::Instant| t.elapsed().as_secs_f64() * 1e3;
+    // The fans of each part serve both passes; health and the self-clash walks then run side
+    // by side (the walks' tree builds have sequential stretches the health pass fills).
+    let t = std::time::Instant::now();
+    let fans: Vec<Fans> = leaders.par_iter().map(|&i| Fans::new(mesh, &merged, &parts[i].2)).collect();
+    let fans_ms = ms(t);
     let ((healths, health_ms), (found, query_ms)) = rayon::join(
         || {
             let t = std::time::Instant::now();
             let h: Vec<crate::check::health::Health> = leaders
                 .par_iter()
-                .map(|&i| crate::check::health::health(mesh, &merged, &parts[i].2, first_n))
+                .zip(&fans)
+                .map(|(&i, f)| crate::check::health::health_with(mesh, f, &parts[i].2, first_n))
                 .collect();
-            (h, ms(t))
+            (h, ms(t) + fans_ms)
         },
         || {
             let t = std::time::Instant::now();
-            let f: Vec<Vec<SelfPair>> =
-                leaders.par_iter().map(|&i| self_pairs(mesh, &merged, &parts[i].2, opts)).collect();
+            let f: Vec<Vec<SelfPair>> = leaders
+                .par_iter()
+                .zip(&fans)
+                .map(|(&i, f)| self_pairs_with(mesh, &parts[i].2, f, opts).0)
+                .collect();
             (f, ms(t))
         },
     );
+    drop(fans);
     let mut checked: Vec<Option<(crate::check::health::Health, Vec<SelfPair>)>> = vec![None; parts.len()];
     for (&i, r) in leaders.iter().zip(healths.into_iter().zip(found)) {
         checked[i] = Some(r);
@@ -635,6 +916,8 @@ fn derive(
     };
     Some((h, out))
 }
+
+mod tree;
 
 #[cfg(test)]
 mod tests;

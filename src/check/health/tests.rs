@@ -186,3 +186,260 @@ fn sparse_and_dense_edge_sorts_agree() {
     assert!(sparse.boundary_edges.count > 0 && sparse.non_manifold_edges.count > 0);
     assert_eq!(sparse.boundary_loops, dense.boundary_loops);
 }
+
+/// The health pass as it was before the vertex groups (a global sort of every edge, then
+/// union–find over all corners), kept as an oracle for the one in use.
+mod by_edge_sort {
+    use super::super::{Finding, Health, VOLUME_CHUNK};
+    use crate::narrow::tri_tri::Shape;
+    use crate::scene::bodies::{find, union};
+    use crate::scene::mesh::Mesh;
+    use rayon::prelude::*;
+
+    /// An edge of a proper triangle: (key `lo << 32 | hi`, local triangle, edge number `c` (from
+    /// corner `c` to corner `c + 1`), whether corner `c` is the low end); zero-area triangles leave
+    /// sentinel entries with key `u64::MAX`.
+    type Edge = (u64, u32, u8, bool);
+
+    /// `items` without those `bucket` maps to None (sentinels), sorted (total order of `T`), where
+    /// `bucket` is the item's leading sort key (`x < y` implies `bucket(x) <= bucket(y)`): a vertex
+    /// id. When the buckets are dense (at most 4 ids per item, as in any part that is most of its
+    /// mesh), a counting sort on the bucket (one pass to count, one to scatter) and a sort of each
+    /// bucket's few entries; otherwise a comparison sort. Both give the same order.
+    fn bucket_sort<T: Ord + Copy + Send + Sync>(
+        mut items: Vec<T>,
+        bucket: impl Fn(&T) -> Option<usize> + Sync,
+    ) -> Vec<T> {
+        let real = items.par_iter().filter(|e| bucket(e).is_some()).count();
+        let max = items.par_iter().filter_map(&bucket).max().unwrap_or(0);
+        if real == 0 || max / 4 > real {
+            items.par_sort_unstable();
+            items.truncate(real);
+            return items;
+        }
+        let mut next = vec![0u32; max + 2];
+        for b in items.iter().filter_map(&bucket) {
+            next[b + 1] += 1;
+        }
+        for i in 1..next.len() {
+            next[i] += next[i - 1];
+        }
+        let Some(&fill) = items.iter().find(|e| bucket(e).is_some()) else { return Vec::new() };
+        let mut out: Vec<T> = vec![fill; real];
+        for e in items {
+            if let Some(b) = bucket(&e) {
+                out[next[b] as usize] = e;
+                next[b] += 1;
+            }
+        }
+        drop(next);
+        // Each bucket's run (a handful of entries) in full order.
+        out.par_chunk_by_mut(|x, y| bucket(x) == bucket(y)).for_each(|run| run.sort_unstable());
+        out
+    }
+
+    /// The health of the part made of triangles `tris` of `mesh`; `merged` gives each vertex its
+    /// exact-position id ([`crate::scene::bodies::merge_vertices`]). Triangle ids in the result are
+    /// indices into `mesh`.
+    pub fn health_by_edge_sort(mesh: &Mesh, merged: &[u32], tris: &[u32], first_n: usize) -> Health {
+        let ids = |k: usize| mesh.triangles[tris[k] as usize].map(|v| merged[v as usize]);
+        let pos = |k: usize| crate::bvh::triangle(mesh, tris[k]);
+        let proper: Vec<bool> =
+            (0..tris.len()).into_par_iter().map(|k| !Shape::of(&pos(k)).is_degenerate()).collect();
+        let zero: Vec<u32> = (0..tris.len()).filter(|&k| !proper[k]).map(|k| tris[k]).collect();
+        let zero_area_triangles = Finding::of(zero.len() as u64, zero, first_n);
+
+        // Duplicates: sorted vertex sets of the triangles with three distinct vertices.
+        let faces: Vec<([u32; 3], u32)> = (0..tris.len())
+            .into_par_iter()
+            .filter_map(|k| {
+                let mut v = ids(k);
+                v.sort_unstable();
+                (v[0] != v[1] && v[1] != v[2]).then_some((v, tris[k]))
+            })
+            .collect();
+        let faces = bucket_sort(faces, |f| Some(f.0[0] as usize));
+        let mut dup = Vec::new();
+        for run in faces.chunk_by(|x, y| x.0 == y.0) {
+            dup.extend(run[1..].iter().map(|x| x.1));
+        }
+        drop(faces);
+        let duplicate_faces = Finding::of(dup.len() as u64, dup, first_n);
+
+        // Edges of the proper triangles: (key (lo, hi), local triangle, edge number c (from corner
+        // c to corner c + 1), whether corner c is the low end), 16 bytes. Zero-area triangles get
+        // sentinel keys (above every real key: lo < hi <= u32::MAX), cut off after the sort;
+        // filling a preallocated array keeps the collection indexed and parallel.
+        let mut edges: Vec<Edge> = vec![(u64::MAX, 0, 0, false); 3 * tris.len()];
+        edges.par_chunks_mut(3).enumerate().filter(|(k, _)| proper[*k]).for_each(|(k, out)| {
+            let v = ids(k);
+            for (c, e) in out.iter_mut().enumerate() {
+                let (a, b) = (v[c], v[(c + 1) % 3]);
+                *e = ((a.min(b) as u64) << 32 | a.max(b) as u64, k as u32, c as u8, a < b);
+            }
+        });
+        let edges = bucket_sort(edges, |e| (e.0 != u64::MAX).then_some((e.0 >> 32) as usize));
+        let forward = |e: &Edge| e.3;
+        let tri_of = |e: &Edge| tris[e.1 as usize];
+        // Corner slots (local triangle × 3 + corner) joined through the edges at their vertex.
+        let mut corner: Vec<u32> = (0..tris.len() as u32 * 3).collect();
+        let corner_at = |e: &Edge, lo_end: bool| {
+            let (k, c) = (e.1, e.2 as u32);
+            let at_c = forward(e) == lo_end;
+            k * 3 + if at_c { c } else { (c + 1) % 3 }
+        };
+        let (mut boundary, mut nm, mut wind) = (Vec::new(), Vec::new(), Vec::new());
+        let (mut n_boundary, mut n_nm, mut n_wind) = (0u64, 0u64, 0u64);
+        let mut boundary_ends: Vec<(u32, u32)> = Vec::new();
+        for run in edges.chunk_by(|x, y| x.0 == y.0) {
+            match run.len() {
+                1 => {
+                    n_boundary += 1;
+                    boundary.push(tri_of(&run[0]));
+                    boundary_ends.push(((run[0].0 >> 32) as u32, run[0].0 as u32));
+                }
+                2 if forward(&run[0]) == forward(&run[1]) => {
+                    n_wind += 1;
+                    wind.extend(run.iter().map(tri_of));
+                }
+                2 => {}
+                _ => {
+                    n_nm += 1;
+                    nm.extend(run.iter().map(tri_of));
+                }
+            }
+            for lo_end in [true, false] {
+                for w in run.windows(2) {
+                    union(&mut corner, corner_at(&w[0], lo_end), corner_at(&w[1], lo_end));
+                }
+            }
+        }
+        let closed = !edges.is_empty() && n_boundary == 0 && n_nm == 0;
+        drop(edges);
+        // Non-manifold vertices: more than one corner set (fan) at one vertex. Corners are only
+        // ever joined with corners at the same vertex, so each fan has one root corner: a vertex
+        // with two roots is non-manifold.
+        let mut roots: Vec<u32> = Vec::with_capacity(tris.len() / 2 + 1);
+        for k in (0..tris.len()).filter(|&k| proper[k]) {
+            let v = ids(k);
+            for (c, &vc) in v.iter().enumerate() {
+                let slot = (k * 3 + c) as u32;
+                if find(&mut corner, slot) == slot {
+                    roots.push(vc);
+                }
+            }
+        }
+        drop(corner);
+        roots.par_sort_unstable();
+        let nmv_vertices: Vec<u32> =
+            roots.chunk_by(|x, y| x == y).filter(|run| run.len() > 1).map(|run| run[0]).collect();
+        let n_nmv = nmv_vertices.len() as u64;
+        drop(roots);
+        let nmv_tris: Vec<u32> = if nmv_vertices.is_empty() {
+            Vec::new()
+        } else {
+            (0..tris.len())
+                .filter(|&k| proper[k] && ids(k).iter().any(|v| nmv_vertices.binary_search(v).is_ok()))
+                .map(|k| tris[k])
+                .collect()
+        };
+        // Boundary loops: components of the boundary-edge graph.
+        let mut ends: Vec<u32> = boundary_ends.iter().flat_map(|&(a, b)| [a, b]).collect();
+        ends.sort_unstable();
+        ends.dedup();
+        let mut parent: Vec<u32> = (0..ends.len() as u32).collect();
+        let at = |v: u32| ends.binary_search(&v).unwrap() as u32;
+        for &(a, b) in &boundary_ends {
+            union(&mut parent, at(a), at(b));
+        }
+        let boundary_loops = (0..parent.len() as u32).filter(|&i| find(&mut parent, i) == i).count() as u64;
+
+        let volume = closed.then(|| {
+            let o = mesh.positions[mesh.triangles[tris[0] as usize][0] as usize];
+            let chunks: Vec<f64> = tris
+                .par_chunks(VOLUME_CHUNK)
+                .enumerate()
+                .map(|(c, chunk)| {
+                    let mut s = 0.0;
+                    for (x, _) in chunk.iter().enumerate() {
+                        let k = c * VOLUME_CHUNK + x;
+                        if proper[k] {
+                            let [a, b, cc] = pos(k);
+                            s += (a - o).dot((b - o).cross(cc - o));
+                        }
+                    }
+                    s
+                })
+                .collect();
+            chunks.iter().sum::<f64>() / 6.0
+        });
+        Health {
+            closed,
+            duplicate_faces,
+            zero_area_triangles,
+            non_manifold_edges: Finding::of(n_nm, nm, first_n),
+            non_manifold_vertices: Finding::of(n_nmv, nmv_tris, first_n),
+            boundary_edges: Finding::of(n_boundary, boundary, first_n),
+            boundary_loops,
+            inconsistent_winding_edges: Finding::of(n_wind, wind, first_n),
+            volume,
+        }
+    }
+}
+
+/// Random small parts with every kind of finding: a grid of vertices (so that faces share
+/// vertices, edges and whole vertex sets), triangles over random vertex triples, some with a
+/// repeated vertex, some duplicated in either winding, some collinear.
+fn messy_mesh() -> impl proptest::strategy::Strategy<Value = Mesh> {
+    use proptest::prelude::*;
+    (prop::collection::vec((0u32..12, 0u32..12, 0u32..12), 1..60), prop::collection::vec(0u32..4, 0..8))
+        .prop_map(|(tris, flips)| {
+            let mut m = one(|_| {});
+            // 12 vertices: a 2 x 2 x 3 block, with three collinear along z.
+            for i in 0..12u32 {
+                m.positions.push(DVec3::new((i % 2) as f64, (i / 2 % 2) as f64, (i / 4) as f64));
+            }
+            for &(a, b, c) in &tris {
+                m.triangles.push([a, b, c]);
+            }
+            for &f in &flips {
+                if let Some(&t) = m.triangles.get(f as usize) {
+                    m.triangles.push([t[0], t[2], t[1]]);
+                }
+            }
+            m.tri_object = vec![0; m.triangles.len()];
+            m
+        })
+}
+
+proptest::proptest! {
+    #![proptest_config(proptest::prelude::ProptestConfig::with_cases(400))]
+    /// The vertex-group pass gives exactly what the global edge sort gave, on whole meshes and
+    /// on a sparse part of them.
+    #[test]
+    fn vertex_groups_match_the_edge_sort(m in messy_mesh(), first_n in 1usize..12) {
+        let (merged, _) = crate::scene::bodies::merge_vertices(&m.positions);
+        let all: Vec<u32> = (0..m.triangles.len() as u32).collect();
+        let odd: Vec<u32> = all.iter().copied().filter(|t| t % 3 != 1).collect();
+        for part in [&all, &odd] {
+            let want = by_edge_sort::health_by_edge_sort(&m, &merged, part, first_n);
+            proptest::prop_assert_eq!(health(&m, &merged, part, first_n), want);
+        }
+    }
+}
+
+#[test]
+fn the_shared_meshes_match_the_edge_sort() {
+    let dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../shared/meshes");
+    for f in ["stanford-bunny.obj", "fcl_rob.obj", "joined_tetrahedra.obj", "shared.STL", "featuretype.STL"] {
+        let (loaded, _) = crate::load::load_path(&dir.join(f)).expect("a shared mesh");
+        let m = &loaded.mesh;
+        let (merged, _) = crate::scene::bodies::merge_vertices(&m.positions);
+        let all: Vec<u32> = (0..m.triangles.len() as u32).collect();
+        assert_eq!(
+            health(m, &merged, &all, 10),
+            by_edge_sort::health_by_edge_sort(m, &merged, &all, 10),
+            "{f}"
+        );
+    }
+}
