@@ -39,7 +39,7 @@ const BLOCK_SHIFT: u32 = 6;
 /// `cell_of` entry of a top node that is not a cell.
 const NOT_A_CELL: u32 = u32::MAX;
 /// Bits per axis of the curve codes.
-const CODE_BITS: u32 = 10;
+pub(crate) const CODE_BITS: u32 = 10;
 
 struct Cell {
     /// First triangle slot in the top tree's `prims` (curve order).
@@ -261,8 +261,9 @@ fn curve_order<M: TriMesh + ?Sized>(mesh: &M) -> (Vec<u32>, Vec<u32>) {
     keys.into_iter().map(|k| (k as u32, (k >> 32) as u32)).unzip()
 }
 
-/// The 30-bit Morton code of three 10-bit coordinates (x in the lowest bit).
-fn interleave(q: [u32; 3]) -> u64 {
+/// The 30-bit Morton code of three 10-bit coordinates (x in the lowest bit); also the self
+/// tree's curve (`check::self_clash::tree`).
+pub(crate) fn interleave(q: [u32; 3]) -> u64 {
     fn spread(v: u32) -> u64 {
         let mut x = v as u64 & 0x3ff;
         x = (x | (x << 16)) & 0x30000ff;
@@ -275,7 +276,7 @@ fn interleave(q: [u32; 3]) -> u64 {
 }
 
 /// Stable LSD radix sort of `keys` by bits 32..62 (three passes of 10 bits).
-fn radix_sort_high(keys: &mut Vec<u64>) {
+pub(crate) fn radix_sort_high(keys: &mut Vec<u64>) {
     let mut tmp = vec![0u64; keys.len()];
     for pass in 0..3 {
         let shift = 32 + 10 * pass;

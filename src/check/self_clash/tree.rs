@@ -122,8 +122,8 @@ impl SNode {
     }
 }
 
-/// Bits per axis of the curve codes (30-bit codes).
-const CODE_BITS: u32 = 10;
+/// Bits per axis of the curve codes (30-bit codes, as the lazy trees': one encoder and sort).
+const CODE_BITS: u32 = crate::bvh::lazy::CODE_BITS;
 
 /// Ranges above this many items are split before their subtrees are built in parallel.
 const TASK_MIN: usize = 1 << 15;
@@ -160,10 +160,10 @@ pub fn curve_keys(n: usize, centre: impl Fn(usize) -> DVec3 + Sync) -> (Vec<u64>
         .map(|k| {
             // `as` saturates (NaN to 0); the top edge is clamped into the last cell.
             let q = ((centre(k) - bounds.min) * scale).to_array().map(|v| (v as u32).min(max_q));
-            (morton(q) << 32) | k as u64
+            (crate::bvh::lazy::interleave(q) << 32) | k as u64
         })
         .collect();
-    radix_sort_codes(&mut keys);
+    crate::bvh::lazy::radix_sort_high(&mut keys);
     (keys, bounds)
 }
 
@@ -323,41 +323,6 @@ fn split_point<T: Item>(keys: &[u64], items: &mut [T]) -> usize {
         x.bounds().centre(axis).total_cmp(&y.bounds().centre(axis)).then(x.id().cmp(&y.id()))
     });
     n / 2
-}
-
-/// The Morton code of three `CODE_BITS`-bit coordinates (x in the lowest bit).
-fn morton(q: [u32; 3]) -> u64 {
-    fn spread(v: u32) -> u64 {
-        let mut x = v as u64 & 0x3ff;
-        x = (x | (x << 16)) & 0x30000ff;
-        x = (x | (x << 8)) & 0x300f00f;
-        x = (x | (x << 4)) & 0x30c30c3;
-        x = (x | (x << 2)) & 0x9249249;
-        x
-    }
-    spread(q[0]) | (spread(q[1]) << 1) | (spread(q[2]) << 2)
-}
-
-/// Stable LSD radix sort of `keys` by their code bits (32..62), three passes of 10 bits; the
-/// bits below 32 are already ascending (indices), so the result is in full key order.
-fn radix_sort_codes(keys: &mut Vec<u64>) {
-    let mut tmp = vec![0u64; keys.len()];
-    for pass in 0..3 {
-        let shift = 32 + 10 * pass;
-        let mut count = [0usize; 1025];
-        for &k in keys.iter() {
-            count[((k >> shift) & 0x3ff) as usize + 1] += 1;
-        }
-        for i in 1..1025 {
-            count[i] += count[i - 1];
-        }
-        for &k in keys.iter() {
-            let b = ((k >> shift) & 0x3ff) as usize;
-            tmp[count[b]] = k;
-            count[b] += 1;
-        }
-        std::mem::swap(keys, &mut tmp);
-    }
 }
 
 #[cfg(test)]
