@@ -1,0 +1,435 @@
+//! Prepared meshes: a mesh whose tree is built once, then placed under any number of affine
+//! transforms for the yes/no and distance queries a collision manager makes.
+//!
+//! A placed mesh ([`Placed`]) reads its own world coordinates — every vertex transformed in f64,
+//! exactly as `--transform` does — and walks the prepared tree through a conservative box map
+//! ([`BoxMap`], the one instances of a glTF mesh share trees with), so every verdict and distance
+//! is exactly what a tree built on the world coordinates would give; only the tree statistics
+//! differ (they describe the prepared tree).
+
+use crate::bvh::traverse::{MappedTree, Tree};
+use crate::bvh::{BuildOptions, Bvh, Node};
+use crate::check::containment::{self, Containment, Topology};
+use crate::check::query::{self, Closest, DistanceError, PairFinding, PairKind, Settings};
+use crate::error::{Error, InputProblem, Location, Result};
+use crate::geom::predicates::{self, BoxMap, Tolerances};
+use crate::geom::{Aabb, DVec3};
+use crate::scene::mesh::{Mesh, TriMesh};
+use glam::DMat4;
+use std::path::{Path, PathBuf};
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::{Arc, OnceLock};
+
+/// A mesh with its tree built once, to be placed under many transforms ([`Prepared::place`]).
+#[derive(Debug)]
+pub struct Prepared {
+    /// The mesh in its own coordinates.
+    pub mesh: Mesh,
+    /// Its tree.
+    pub tree: Bvh,
+    /// Its name in error messages and reports.
+    pub label: PathBuf,
+}
+
+impl Prepared {
+    /// Build the tree of `mesh` (validated by [`mesh_from_arrays`] or a loader).
+    pub fn new(label: &Path, mesh: Mesh, opts: BuildOptions) -> Result<Prepared> {
+        query::check_range(&mesh, label)?;
+        let tree = Bvh::build(&mesh, opts);
+        Ok(Prepared { mesh, tree, label: label.to_path_buf() })
+    }
+
+    /// Place the mesh: every vertex transformed in f64 (as `--transform` does; identity keeps
+    /// the coordinates as they are), the tree mapped onto the result conservatively.
+    pub fn place(self: &Arc<Self>, m: DMat4) -> Result<Placed> {
+        let local = &self.mesh.positions;
+        if m == DMat4::IDENTITY {
+            let root = Aabb::of_points(local);
+            return Ok(Placed {
+                prepared: self.clone(),
+                transform: m,
+                world: None,
+                tree: Mapping::Own,
+                root,
+                topology: OnceLock::new(),
+            });
+        }
+        let mut world = Vec::with_capacity(local.len());
+        for (i, p) in local.iter().enumerate() {
+            let w = m.transform_point3(*p);
+            if !w.is_finite() {
+                let problem = InputProblem::NonFiniteAfterTransform { value: None };
+                return Err(Error::at(&self.label, Location::Vertex(i), problem));
+            }
+            if w.abs().max_element() > predicates::MAX_EXACT_MAGNITUDE {
+                return Err(Error::at(&self.label, Location::Vertex(i), InputProblem::BeyondExactRange));
+            }
+            world.push(w);
+        }
+        let rows = [0, 1, 2].map(|k| [m.x_axis[k], m.y_axis[k], m.z_axis[k], m.w_axis[k]]);
+        let tree =
+            match BoxMap::fit(rows, &self.tree.bounds(), local.iter().copied().zip(world.iter().copied())) {
+                Some(map) => Mapping::Mapped(map),
+                None => Mapping::Refit(refit(&self.tree, &world, &self.mesh.triangles)),
+            };
+        let root = Aabb::of_points(&world);
+        Ok(Placed {
+            prepared: self.clone(),
+            transform: m,
+            world: Some(world),
+            tree,
+            root,
+            topology: OnceLock::new(),
+        })
+    }
+}
+
+/// How a placed mesh sees the prepared tree.
+#[derive(Debug)]
+enum Mapping {
+    /// Identity placement: the tree as built.
+    Own,
+    /// Boxes mapped by the placement (conservatively widened).
+    Mapped(BoxMap),
+    /// The fallback when no box map fits: same topology, exact boxes.
+    Refit(Bvh),
+}
+
+fn refit(template: &Bvh, world: &[DVec3], tris: &[[u32; 3]]) -> Bvh {
+    let mut nodes: Vec<Node> = template.nodes.clone();
+    for i in (0..nodes.len()).rev() {
+        let n = nodes[i];
+        nodes[i].bounds = if n.is_leaf() {
+            template.leaf_prims(&n).iter().fold(Aabb::EMPTY, |b, &t| {
+                b.union(Aabb::of_triangle(&tris[t as usize].map(|v| world[v as usize])))
+            })
+        } else {
+            nodes[i + 1].bounds.union(nodes[n.a as usize].bounds)
+        };
+    }
+    Bvh { nodes, prims: template.prims.clone() }
+}
+
+/// A prepared mesh under one placement: its world coordinates and a view of the prepared tree.
+#[derive(Debug)]
+pub struct Placed {
+    /// The prepared mesh.
+    pub prepared: Arc<Prepared>,
+    /// The placement.
+    pub transform: DMat4,
+    world: Option<Vec<DVec3>>,
+    tree: Mapping,
+    root: Aabb,
+    topology: OnceLock<Topology>,
+}
+
+/// A placed mesh as the checks read it (world coordinates; nothing copied).
+#[derive(Debug, Clone, Copy)]
+pub struct PlacedMesh<'a> {
+    positions: &'a [DVec3],
+    triangles: &'a [[u32; 3]],
+}
+
+impl TriMesh for PlacedMesh<'_> {
+    #[inline]
+    fn vertex_count(&self) -> usize {
+        self.positions.len()
+    }
+    #[inline]
+    fn vertex(&self, v: u32) -> DVec3 {
+        self.positions[v as usize]
+    }
+    #[inline]
+    fn triangle_count(&self) -> usize {
+        self.triangles.len()
+    }
+    #[inline]
+    fn indices(&self, t: u32) -> [u32; 3] {
+        self.triangles[t as usize]
+    }
+    fn positions(&self) -> std::borrow::Cow<'_, [DVec3]> {
+        std::borrow::Cow::Borrowed(self.positions)
+    }
+}
+
+impl Placed {
+    /// The world coordinates.
+    pub fn positions(&self) -> &[DVec3] {
+        self.world.as_deref().unwrap_or(&self.prepared.mesh.positions)
+    }
+
+    /// The mesh view.
+    pub fn mesh(&self) -> PlacedMesh<'_> {
+        PlacedMesh { positions: self.positions(), triangles: &self.prepared.mesh.triangles }
+    }
+
+    /// The tree view.
+    pub fn tree(&self) -> MappedTree<'_> {
+        let (bvh, map) = match &self.tree {
+            Mapping::Own => (&self.prepared.tree, None),
+            Mapping::Mapped(m) => (&self.prepared.tree, Some(*m)),
+            Mapping::Refit(t) => (t, None),
+        };
+        MappedTree { bvh, map, root: self.root }
+    }
+
+    /// The exact world box.
+    pub fn bounds(&self) -> Aabb {
+        self.root
+    }
+
+    fn topology(&self) -> &Topology {
+        self.topology.get_or_init(|| containment::topology(&self.mesh()))
+    }
+}
+
+/// What [`collide`] finds between two placed meshes.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Collision {
+    /// Triangle pairs that meet (crossing or touching exactly), sorted; with `all` false, at
+    /// least one when they meet (the first crossing pair found stops the walk).
+    pub contacts: Vec<PairFinding>,
+    /// Containment, decided when no triangles meet.
+    pub containment: Containment,
+}
+
+impl Collision {
+    /// Do the two meshes collide: triangles meet (crossing or touching), or one lies inside the
+    /// other (containment, including the partial kinds and face-to-face volume overlap).
+    pub fn collides(&self) -> bool {
+        !self.contacts.is_empty() || self.containment.is_clash()
+    }
+}
+
+/// Every triangle pair of `a` and `b` that meets exactly (crossing or touching), sorted; with
+/// `first`, the walk stops at the first one found (which one depends on timing).
+pub fn meeting_pairs<A, TA, B, TB>(a: &A, ta: &TA, b: &B, tb: &TB, first: bool) -> Vec<PairFinding>
+where
+    A: TriMesh + ?Sized,
+    TA: Tree + ?Sized,
+    B: TriMesh + ?Sized,
+    TB: Tree + ?Sized,
+{
+    if !first {
+        return query::find_pairs(a, ta, b, tb, &Settings::default()).0;
+    }
+    if a.triangle_count() + b.triangle_count() <= SEQUENTIAL_FIRST_CONTACT {
+        return first_contact_sequential(a, ta, b, tb).into_iter().collect();
+    }
+    let tol = Tolerances::default();
+    let stop = AtomicBool::new(false);
+    let mut found = crate::bvh::traverse::collect_pairs(
+        ta,
+        tb,
+        |x, y| !stop.load(Ordering::Relaxed) && tol.boxes_may_meet(x, y),
+        |la, lb, out| {
+            for &i in la {
+                let ti = a.triangle(i);
+                let bi = Aabb::of_triangle(&ti);
+                for &j in lb {
+                    if stop.load(Ordering::Relaxed) {
+                        return;
+                    }
+                    let tj = b.triangle(j);
+                    if !tol.boxes_may_meet(&bi, &Aabb::of_triangle(&tj)) {
+                        continue;
+                    }
+                    if let Some(h) = crate::narrow::tri_tri::classify(&ti, &tj) {
+                        let kind = if h.crossing { PairKind::Crossing } else { PairKind::Touching };
+                        out.push(PairFinding {
+                            a: i,
+                            b: j,
+                            kind,
+                            contact: Some(h.contact),
+                            distance: 0.0,
+                            segment: h.segment,
+                        });
+                        stop.store(true, Ordering::Relaxed);
+                        return;
+                    }
+                }
+            }
+        },
+    );
+    found.sort_unstable_by_key(|p| (p.a, p.b));
+    found
+}
+
+/// Up to this many triangles in both meshes together, the first-contact search walks the two
+/// trees on one thread: a collision manager runs many small pairs at once, and splitting each
+/// into parallel sub-walks cost more than the walk itself (a speed threshold, no verdict
+/// depends on it).
+const SEQUENTIAL_FIRST_CONTACT: usize = 50_000;
+
+/// The first meeting triangle pair of a depth-first dual walk on this thread (descending the
+/// node with the larger box, as the parallel walks do).
+fn first_contact_sequential<A, TA, B, TB>(a: &A, ta: &TA, b: &B, tb: &TB) -> Option<PairFinding>
+where
+    A: TriMesh + ?Sized,
+    TA: Tree + ?Sized,
+    B: TriMesh + ?Sized,
+    TB: Tree + ?Sized,
+{
+    let tol = Tolerances::default();
+    if ta.is_empty() || tb.is_empty() {
+        return None;
+    }
+    let mut stack = vec![(0u32, 0u32, ta.node_box(0), tb.node_box(0))];
+    while let Some((i, j, bi, bj)) = stack.pop() {
+        if !tol.boxes_may_meet(&bi, &bj) {
+            continue;
+        }
+        let open_a = match (ta.is_leaf(i), tb.is_leaf(j)) {
+            (true, true) => {
+                for &s in ta.leaf_prims(i) {
+                    let ts = a.triangle(s);
+                    let bs = Aabb::of_triangle(&ts);
+                    for &t in tb.leaf_prims(j) {
+                        let tt = b.triangle(t);
+                        if !tol.boxes_may_meet(&bs, &Aabb::of_triangle(&tt)) {
+                            continue;
+                        }
+                        if let Some(h) = crate::narrow::tri_tri::classify(&ts, &tt) {
+                            let kind = if h.crossing { PairKind::Crossing } else { PairKind::Touching };
+                            return Some(PairFinding {
+                                a: s,
+                                b: t,
+                                kind,
+                                contact: Some(h.contact),
+                                distance: 0.0,
+                                segment: h.segment,
+                            });
+                        }
+                    }
+                }
+                continue;
+            }
+            (false, true) => true,
+            (true, false) => false,
+            (false, false) => bi.half_area() >= bj.half_area(),
+        };
+        if open_a {
+            for c in ta.children(i).into_iter().rev() {
+                stack.push((c, j, ta.node_box(c), bj));
+            }
+        } else {
+            for c in tb.children(j).into_iter().rev() {
+                stack.push((i, c, bi, tb.node_box(c)));
+            }
+        }
+    }
+    None
+}
+
+/// Exact collision test of two placed meshes: every meeting triangle pair (`all`), or stop at
+/// the first meeting pair; when none meet, containment decides (left at `None`, not decided,
+/// when no vertex of either mesh lies in the other's box: nothing can be contained then).
+pub fn collide(a: &Placed, b: &Placed, all: bool) -> Collision {
+    let none = Collision { contacts: Vec::new(), containment: Containment::None };
+    if !a.bounds().overlaps(&b.bounds()) {
+        return none;
+    }
+    let (ma, mb, ta, tb) = (a.mesh(), b.mesh(), a.tree(), b.tree());
+    let contacts = meeting_pairs(&ma, &ta, &mb, &tb, !all);
+    if !contacts.is_empty() {
+        return Collision { contacts, containment: Containment::None };
+    }
+    // Every vertex of a contained component lies in the other mesh's box: with no vertex of
+    // either mesh in the other's box, no containment is possible (exact test), and the
+    // topology and ray casts are skipped.
+    let any_inside = |p: &Placed, q: &Placed| {
+        let bq = q.bounds();
+        p.positions().iter().any(|v| bq.contains(&Aabb { min: *v, max: *v }))
+    };
+    if !any_inside(a, b) && !any_inside(b, a) {
+        return none;
+    }
+    let containment = containment::decide(&ma, &ta, a.topology(), &mb, &tb, b.topology());
+    Collision { contacts, containment }
+}
+
+/// The minimum distance between two placed meshes (their surfaces) with a closest pair of
+/// points: 0 at a shared point when triangles meet; `None` beyond `bound` (pass infinity for
+/// no bound).
+pub fn distance(a: &Placed, b: &Placed, bound: f64) -> Option<Closest> {
+    if a.bounds().distance_sq(&b.bounds()).sqrt() > bound {
+        return None;
+    }
+    let (ma, mb, ta, tb) = (a.mesh(), b.mesh(), a.tree(), b.tree());
+    if a.bounds().overlaps(&b.bounds()) {
+        // Stops at the first meeting pair: the distance is 0 either way, the witness is a
+        // shared point of some meeting pair.
+        if let Some(p) = meeting_pairs(&ma, &ta, &mb, &tb, true).first() {
+            return Some(query::pair_witness(&ma, &mb, p));
+        }
+    }
+    query::closest_pair(&ma, &ta, &mb, &tb, DistanceError::default()).filter(|c| c.distance <= bound)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn cube(at: DVec3) -> Mesh {
+        let v: Vec<DVec3> = (0..8)
+            .map(|i| at + DVec3::new((i & 1) as f64, ((i >> 1) & 1) as f64, ((i >> 2) & 1) as f64))
+            .collect();
+        let t = vec![
+            [0, 2, 1],
+            [1, 2, 3],
+            [4, 5, 6],
+            [5, 7, 6],
+            [0, 1, 4],
+            [1, 5, 4],
+            [2, 6, 3],
+            [3, 6, 7],
+            [0, 4, 2],
+            [2, 4, 6],
+            [1, 3, 5],
+            [3, 7, 5],
+        ];
+        Mesh {
+            positions: v,
+            tri_object: vec![0; t.len()],
+            triangles: t,
+            objects: vec![crate::scene::mesh::Object { name: "cube".into(), ..Default::default() }],
+        }
+    }
+
+    fn prepared(m: Mesh) -> Arc<Prepared> {
+        Arc::new(Prepared::new(Path::new("<cube>"), m, BuildOptions::default()).unwrap())
+    }
+
+    #[test]
+    fn placed_queries_match_a_fresh_check() {
+        let a = prepared(cube(DVec3::ZERO));
+        let pa = a.place(DMat4::IDENTITY).unwrap();
+        for (shift, meets) in [(0.5, true), (1.0, true), (1.25, false)] {
+            let rot = DMat4::from_translation(DVec3::new(shift, 0.2, 0.1)) * DMat4::from_rotation_z(0.0);
+            let pb = a.place(rot).unwrap();
+            let mut world = cube(DVec3::ZERO);
+            query::place(&mut world, &rot, Path::new("x")).unwrap();
+            let fresh = query::check(&cube(DVec3::ZERO), &world, &Settings::default());
+            let c = collide(&pa, &pb, true);
+            assert_eq!(c.collides(), meets, "shift {shift}");
+            assert_eq!(c.contacts, fresh.pairs);
+            // The first-contact searches (one thread for small pairs, parallel otherwise) find
+            // one of those pairs, or none.
+            let (ma, mb, ta, tb) = (pa.mesh(), pb.mesh(), pa.tree(), pb.tree());
+            let seq = first_contact_sequential(&ma, &ta, &mb, &tb);
+            assert_eq!(seq.is_some(), meets);
+            assert!(seq.is_none_or(|p| fresh.pairs.contains(&p)));
+            assert_eq!(collide(&pa, &pb, false).collides(), meets);
+            let d = distance(&pa, &pb, f64::INFINITY).unwrap();
+            assert_eq!(d.distance, fresh.closest.unwrap().distance);
+        }
+        // A small cube inside a big one: no triangles meet, yet they collide (containment).
+        let big = prepared(cube(DVec3::ZERO));
+        let pbig = big.place(DMat4::from_scale(DVec3::splat(4.0))).unwrap();
+        let small = a.place(DMat4::from_translation(DVec3::splat(1.0))).unwrap();
+        let c = collide(&pbig, &small, false);
+        assert!(c.contacts.is_empty());
+        assert_eq!(c.containment, Containment::BInA);
+        assert_eq!(distance(&pbig, &small, f64::INFINITY).unwrap().distance, 1.0);
+    }
+}
