@@ -4,9 +4,10 @@
 # check over processes with separate memory.
 #
 #   deploy/local.sh N DIR -- CHECK ARGUMENTS...
-#   e.g. deploy/local.sh 4 out -- scene site.glb --clearance 10 --no-timings --junit out/report.xml
+#   e.g. deploy/local.sh 4 out -- scene site.glb --clearance 10 --no-timings
 #
-# Writes DIR/plan.json, DIR/shard-I.json and DIR/report.json; exits with the merge's code
+# Writes DIR/plan.json, DIR/shard-I.json, DIR/report.json and DIR/report.xml (JUnit); exits with
+# the merge's code
 # (0 clear, 1 findings at or above --fail-on, 2 error). MESHCLASH overrides the binary.
 set -uo pipefail
 exe=${MESHCLASH:-meshclash}
@@ -29,4 +30,4 @@ done
 [ $failed = 0 ] || echo "local.sh: a shard failed; the merge names it" >&2
 shards=()
 for i in $(seq "$n"); do shards+=("$dir/shard-$i.json"); done
-"$exe" merge "${shards[@]}" -o "$dir/report.json"
+"$exe" merge "${shards[@]}" --junit "$dir/report.xml" -o "$dir/report.json"

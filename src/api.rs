@@ -1,69 +1,28 @@
 //! Entry points for embedding meshclash in another program (the Python package in `python/`
-//! uses nothing else): the JSON report for two inputs that are files or in-memory meshes, and
-//! the *prepared* meshes of [`crate::prepared`] (re-exported here) — a mesh whose tree is built
+//! uses nothing else): the report for two inputs that are files or in-memory meshes, and the
+//! *prepared* meshes of [`crate::prepared`] (re-exported here) — a mesh whose tree is built
 //! once, then placed under any number of affine transforms for the yes/no and distance queries a
 //! collision manager makes.
 //!
-//! [`report`] goes the same way as the command line (load, place, [`crate::check::assembly::run`],
-//! [`crate::report::build`], finding ids), so the same inputs and settings give the same document
-//! (the Python tests compare them, parsed, with the binary's `--no-timings` output).
+//! A report goes through the one pipeline ([`crate::pipeline::run`], then
+//! [`crate::pipeline::report::build`]), exactly as the command line does, so the same inputs and settings
+//! give the same document (the Python tests compare them with the binary's `--no-timings`
+//! output). This module only turns an embedder's options into a [`Request`].
 
 use crate::bvh::BuildOptions;
-use crate::check::assembly::{self, Selection};
-use crate::check::query::{self, Detail, DistanceError, Input, InputSpec, Mode, Settings};
+use crate::check::assembly::Selection;
+use crate::check::query::{Detail, DistanceError, Mode, Settings};
 use crate::error::{Error, InputProblem, Location, NonFinite, Result, UsageProblem};
-use crate::geom::predicates::Tolerances;
-use crate::geom::{Aabb, DVec3};
-use crate::load::Format;
-use crate::report::{self, Report, SettingsReport};
-use crate::scene::mesh::{Loaded, Mesh, Object};
+use crate::geom::DVec3;
+use crate::pipeline::{InputRequest, Request};
+use crate::report::Report;
+use crate::scene::mesh::{Mesh, Object};
 use glam::DMat4;
 use std::path::Path;
-use std::time::Instant;
 
+pub use crate::pipeline::Tolerance;
 pub use crate::prepared::{collide, distance, meeting_pairs, Collision, Placed, PlacedMesh, Prepared};
-
-/// The `format` an in-memory input has in the report.
-pub const ARRAY_FORMAT: &str = "array";
-
-/// A tolerance as given: absolute, or relative to the diagonal of the box around both inputs
-/// (the command line's `1e-6rel`).
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub enum Tolerance {
-    /// Model units.
-    Abs(f64),
-    /// Times the diagonal of the box around both inputs.
-    Rel(f64),
-}
-
-impl Tolerance {
-    /// Parse `0.5` or `1e-6rel` (finite, >= 0); the error names `flag` as the command line does.
-    pub fn parse(flag: &str, s: &str) -> Result<Tolerance> {
-        let t = s.trim();
-        let (num, rel) = match t.strip_suffix("rel") {
-            Some(n) => (n, true),
-            None => (t, false),
-        };
-        match num.trim().parse::<f64>() {
-            Ok(v) if v.is_finite() && v >= 0.0 => Ok(if rel { Tolerance::Rel(v) } else { Tolerance::Abs(v) }),
-            _ => Err(Error::bad_flag(flag, UsageProblem::BadTolerance { text: s.to_string() })),
-        }
-    }
-
-    fn resolve(self, size: f64) -> f64 {
-        match self {
-            Tolerance::Abs(v) => v,
-            Tolerance::Rel(r) => r * size,
-        }
-    }
-
-    fn spec(self) -> String {
-        match self {
-            Tolerance::Abs(v) => format!("{v}"),
-            Tolerance::Rel(r) => format!("{r}rel"),
-        }
-    }
-}
+pub use crate::report::ARRAY_FORMAT;
 
 /// What to check and how: the command line's flags that shape the report.
 #[derive(Debug, Clone, PartialEq)]
@@ -117,6 +76,31 @@ impl Default for Options {
 }
 
 impl Options {
+    /// The pipeline's request for these inputs (one input: scene mode).
+    pub fn request(&self, inputs: Vec<InputRequest>) -> Request {
+        let mut selection = self.selection.clone();
+        selection.scene = inputs.len() == 1;
+        Request {
+            inputs,
+            touch: self.touch,
+            clearance: self.clearance,
+            settings: Settings {
+                tolerances: Default::default(),
+                bvh: self.bvh,
+                mode: self.mode,
+                first_hit: self.first_hit,
+                distance_error: self.distance_error,
+                detail: self.detail,
+            },
+            max_pairs: self.max_pairs,
+            deterministic: self.deterministic,
+            penetration: self.penetration,
+            selection,
+            split_bodies: self.split_bodies,
+            ..Request::defaults()
+        }
+    }
+
     /// Reject what the command line rejects (leaf size, distance allowances).
     pub fn validate(&self) -> Result<()> {
         if !(1..=64).contains(&self.bvh.leaf_size) {
@@ -134,38 +118,22 @@ impl Options {
     }
 }
 
-/// One input of a report: a loaded file, or a mesh handed over in memory (reported with
-/// [`ARRAY_FORMAT`] and its label as the path).
+/// One input of a report: a file, or a mesh handed over in memory (reported with
+/// [`ARRAY_FORMAT`] and its label as the path), with its placement.
 #[derive(Debug, Clone)]
-pub struct Source {
-    /// The placed input.
-    pub input: Input,
-    /// The transform applied.
-    pub transform: DMat4,
-    /// True for an in-memory mesh.
-    pub array: bool,
+pub struct Source(pub InputRequest);
+
+/// A file placed by `transform`, as the command line takes `A`/`B` (read when the report is
+/// made). `split_bodies` is [`Options::split_bodies`]'s, kept for callers that set it here.
+pub fn file_source(path: &Path, transform: DMat4, _split_bodies: bool) -> Result<Source> {
+    Ok(Source(InputRequest { source: crate::pipeline::Source::File(path.to_path_buf()), transform }))
 }
 
-/// Load a file and place it, as the command line does for `A`/`B` (with `--split-bodies` when
-/// `split_bodies`).
-pub fn file_source(path: &Path, transform: DMat4, split_bodies: bool) -> Result<Source> {
-    let mut input = query::load_input(&InputSpec { path: path.to_path_buf(), transform })?;
-    if split_bodies {
-        crate::scene::bodies::split_bodies(&mut input.mesh);
-    }
-    Ok(Source { input, transform, array: false })
-}
-
-/// Place an in-memory mesh (from [`mesh_from_arrays`]); `label` stands for its path in the report
-/// and in error messages.
-pub fn array_source(label: &Path, mesh: Mesh, transform: DMat4, split_bodies: bool) -> Result<Source> {
-    let spec = InputSpec { path: label.to_path_buf(), transform };
-    let mut input =
-        query::prepare_input(&spec, Loaded { mesh, warnings: Vec::new() }, Format::Obj, 1.0, None)?;
-    if split_bodies {
-        crate::scene::bodies::split_bodies(&mut input.mesh);
-    }
-    Ok(Source { input, transform, array: true })
+/// An in-memory mesh (from [`mesh_from_arrays`]) placed by `transform`; `label` stands for its
+/// path in the report and in error messages.
+pub fn array_source(label: &Path, mesh: Mesh, transform: DMat4, _split_bodies: bool) -> Result<Source> {
+    let source = crate::pipeline::Source::Mesh { label: label.to_path_buf(), mesh };
+    Ok(Source(InputRequest { source, transform }))
 }
 
 /// Triangle indices from a flat list of any integer type (three per triangle), with the
@@ -239,129 +207,28 @@ pub fn in_pool<T: Send>(threads: usize, f: impl FnOnce(usize) -> Result<T> + Sen
     pool.install(|| f(pool.current_num_threads()))
 }
 
-/// The report for `a` against `b` (`b` = None: scene mode, `a`'s parts against each other; set
-/// `opts.selection.scene`), as the command line writes it for the same inputs and flags.
+/// The report for `a` against `b` (`b` = None: scene mode, `a`'s parts against each other), as
+/// the command line writes it for the same inputs and flags.
 pub fn report(a: &Source, b: Option<&Source>, opts: &Options) -> Result<Report> {
     opts.validate()?;
-    in_pool(opts.threads, |threads| {
-        let t0 = Instant::now();
-        let bs = b.unwrap_or(a);
-        let outcome_of = |settings: &Settings| {
-            assembly::run(&a.input.mesh, &bs.input.mesh, &opts.selection, settings)
-                .map_err(|e| Error::in_file(&bs.input.path, InputProblem::Selection(e)))
-        };
-        finish_report(a, bs, opts, threads, t0, outcome_of)
-    })
+    let inputs = std::iter::once(a).chain(b).map(|s| s.0.clone()).collect();
+    let req = opts.request(inputs);
+    in_pool(opts.threads, |_| Ok(crate::pipeline::report::build(&crate::pipeline::run(&req, &|_| {})?)))
 }
 
-/// The settings with the tolerances resolved for two inputs.
-fn resolved_settings(a: &Mesh, b: &Mesh, opts: &Options) -> Result<(Settings, f64)> {
-    let size = Aabb::of_points(&a.positions).union(Aabb::of_points(&b.positions)).extent().length();
-    let tolerances = Tolerances { touch: opts.touch.resolve(size), clearance: opts.clearance.resolve(size) };
-    if !tolerances.touch.is_finite() || !tolerances.clearance.is_finite() {
-        return Err(Error::usage(UsageProblem::ToleranceOverflow));
-    }
-    let settings = Settings {
-        tolerances,
-        bvh: opts.bvh,
-        mode: opts.mode,
-        first_hit: opts.first_hit,
-        distance_error: opts.distance_error,
-        detail: opts.detail,
-    };
-    Ok((settings, size))
-}
-
-fn finish_report(
-    a: &Source,
-    b: &Source,
-    opts: &Options,
-    threads: usize,
-    t0: Instant,
-    outcome_of: impl FnOnce(&Settings) -> Result<assembly::Outcome>,
-) -> Result<Report> {
-    let (settings, size) = resolved_settings(&a.input.mesh, &b.input.mesh, opts)?;
-    let load_ms = t0.elapsed().as_secs_f64() * 1e3;
-    let outcome = outcome_of(&settings)?;
-    let assembly_view = report::assembly_view(&outcome, opts.max_pairs);
-    let result = outcome.result;
-    let ctx = report::Context {
-        inputs: [&a.input, &b.input],
-        transforms: [a.transform, b.transform],
-        settings: SettingsReport {
-            touch_tolerance: settings.tolerances.touch,
-            clearance: settings.tolerances.clearance,
-            touch_tolerance_given: opts.touch.spec(),
-            clearance_given: opts.clearance.spec(),
-            model_size: size,
-            units: "model".into(),
-            fail_on: query::FailOn::Clash.name().into(),
-            bvh: opts.bvh.strategy.name().into(),
-            mode: opts.mode.name().into(),
-            first_hit: opts.first_hit,
-            penetration: opts.penetration,
-            distance_rel_err: opts.distance_error.rel,
-            distance_abs_err: opts.distance_error.abs,
-            leaf_size: opts.bvh.leaf_size,
-            max_pairs: opts.max_pairs,
-            threads: (!opts.deterministic).then_some(threads),
-            detail: (opts.detail != Detail::Pairs).then(|| opts.detail.name().into()),
-        },
-        failed: query::FailOn::Clash.fails(result.verdict),
-        times: (!opts.deterministic).then(|| (load_ms, t0.elapsed().as_secs_f64() * 1e3)),
-        cross_check: None,
-        assembly: assembly_view,
-    };
-    let mut rep = report::build(&ctx, &result);
-    let listed = &result.pairs[..rep.pairs.len()];
-    let findings = report::baseline::findings(listed, &a.input.mesh, &b.input.mesh);
-    report::baseline::assign_ids(&mut rep, &findings);
-    if a.array {
-        rep.inputs.a.format = ARRAY_FORMAT.into();
-    }
-    if b.array {
-        rep.inputs.b.format = ARRAY_FORMAT.into();
-    }
-    Ok(rep)
-}
-
-/// The report for two placed meshes, as [`report`] gives for the same world coordinates
-/// (files mode), except that `bvh` describes the prepared trees and `timings_ms.build` is 0.
+/// The report for two placed meshes: the report of their prepared meshes under their
+/// placements, as [`report`] gives for the same arrays and transforms.
 pub fn report_placed(a: &Placed, b: &Placed, opts: &Options) -> Result<Report> {
-    opts.validate()?;
     if opts.selection.by_parts() || opts.split_bodies {
         return Err(Error::usage(UsageProblem::Conflict(
             "prepared meshes are checked whole: selections, scene mode and --split-bodies need arrays or files".into(),
         )));
     }
-    in_pool(opts.threads, |threads| {
-        let t0 = Instant::now();
-        let (sa, sb) = (placed_source(a), placed_source(b));
-        let outcome_of = |settings: &Settings| {
-            let r = query::check_built(&a.mesh(), &a.tree(), &b.mesh(), &b.tree(), settings);
-            let mut parts = assembly::parts_of(&sa.input.mesh, 0);
-            parts.extend(assembly::parts_of(&sb.input.mesh, 1));
-            let part_pairs = assembly::group_by_part(&parts, &sa.input.mesh, &sb.input.mesh, &r);
-            let info = assembly::AssemblyInfo {
-                mode: "files",
-                selected: [1, 1],
-                candidate_part_pairs: part_pairs.len(),
-                built_parts: None,
-                sah_builds: None,
-                sharing: None,
-            };
-            Ok(assembly::Outcome { result: r, parts, part_pairs, info })
-        };
-        finish_report(&sa, &sb, opts, threads, t0, outcome_of)
-    })
-}
-
-/// A placed mesh copied as a report input, with its label as the path.
-fn placed_source(p: &Placed) -> Source {
-    let mut mesh = p.prepared.mesh.clone();
-    mesh.positions = p.positions().to_vec();
-    let input = Input { path: p.prepared.label.clone(), format: Format::Obj, mesh, warnings: Vec::new() };
-    Source { input, transform: p.transform, array: true }
+    let source = |p: &Placed| {
+        let mesh = p.prepared.mesh.clone();
+        array_source(&p.prepared.label, mesh, p.transform, false)
+    };
+    report(&source(a)?, Some(&source(b)?), opts)
 }
 
 #[cfg(test)]

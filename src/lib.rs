@@ -26,6 +26,7 @@ pub mod geom;
 pub mod load;
 pub mod narrow;
 pub mod output;
+pub mod pipeline;
 pub mod prepared;
 pub mod report;
 pub mod scene;

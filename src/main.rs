@@ -14,9 +14,6 @@ use std::io::IsTerminal;
 use std::process::ExitCode;
 
 fn main() -> ExitCode {
-    if let Some(code) = app::shard::dispatch() {
-        return ExitCode::from(code); // `plan`, `run`, `merge` (issue 14)
-    }
     // Help wraps to the terminal's width, or to 100 columns when stdout is not a terminal.
     let width = (!std::io::stdout().is_terminal()).then_some(100);
     let args = match cli::parse(width) {
@@ -39,11 +36,20 @@ fn main() -> ExitCode {
     if let Some(cli::Command::SelfCheck(s)) = args.command {
         return self_check(s);
     }
+    if let Some(cmd @ (cli::Command::Plan(_) | cli::Command::Run(_) | cli::Command::Merge(_))) = args.command
+    {
+        return ExitCode::from(app::shard::dispatch(cmd));
+    }
     if let Some(cmd) = args.command.as_ref().filter(|c| !matches!(c, cli::Command::Scene(_))) {
         // `schema`, `completions <shell>`, `man`: generated text on stdout; `bench`: forwarded.
         let text = match cmd {
             cli::Command::Output(c) => app::man::render(c),
-            cli::Command::ClashSet(_) | cli::Command::SelfCheck(_) | cli::Command::Scene(_) => {
+            cli::Command::ClashSet(_)
+            | cli::Command::SelfCheck(_)
+            | cli::Command::Scene(_)
+            | cli::Command::Plan(_)
+            | cli::Command::Run(_)
+            | cli::Command::Merge(_) => {
                 unreachable!("handled above")
             }
             cli::Command::Bench(b) => return bench_forward(&b.args),
@@ -54,9 +60,17 @@ fn main() -> ExitCode {
         Some(cli::Command::Scene(s)) => &s.check,
         _ => &args.check,
     };
-    let (quiet, format) = (flags.quiet, flags.outputs.format);
+    let (quiet, color) = (flags.quiet, flags.color);
     let (stdout_tty, stderr_tty) = (std::io::stdout().is_terminal(), std::io::stderr().is_terminal());
-    let color = std::env::var_os("NO_COLOR").is_none_or(|v| v.is_empty());
+    // A person at a terminal with no -o and no --format gets the text summary; a program (a
+    // pipe, a file) gets the JSON report.
+    let config = args.into_config().map(|mut cfg| {
+        if stdout_tty && cfg.outputs.format.is_none() && cfg.output.is_none() {
+            cfg.outputs.format = Some(meshclash::output::Format::Text);
+        }
+        cfg
+    });
+    let text_out = config.as_ref().is_ok_and(|c| c.outputs.format == Some(meshclash::output::Format::Text));
     // Progress and the human summary only for a person at a terminal, never in pipes or CI logs.
     let spinner = (stderr_tty && !quiet)
         .then(|| Spinner::start(indicatif::ProgressDrawTarget::stderr(), progress::DEFAULT_DELAY));
@@ -65,7 +79,7 @@ fn main() -> ExitCode {
             s.phase(p);
         }
     };
-    let outcome = args.into_config().and_then(|cfg| run::run_with_progress(&cfg, &on_phase));
+    let outcome = config.and_then(|cfg| run::run_with_progress(&cfg, &on_phase));
     if let Some(s) = spinner {
         s.finish();
     }
@@ -76,11 +90,11 @@ fn main() -> ExitCode {
                     eprintln!("meshclash: warning: {w}");
                 }
             }
-            let text_on_tty = format == Some(cli::FormatArg::Text) && stdout_tty;
+            let text_on_tty = text_out && stdout_tty;
             if stderr_tty && !quiet && !text_on_tty {
-                eprint!("{}", text::render(&out.report, color));
+                eprint!("{}", text::render(&out.report, color.enabled(true)));
             }
-            if text_on_tty && color {
+            if text_out && color.enabled(stdout_tty) {
                 out.stdout = Some(text::render(&out.report, true));
             }
             let written = match (&out.stdout, out.json_stdout) {
@@ -89,8 +103,13 @@ fn main() -> ExitCode {
                 (None, false) => Ok(true),
             };
             if let Err(e) = written {
+                // All or nothing: the staged files are dropped unwritten.
                 eprintln!("meshclash: error: cannot write to stdout: {e}");
                 return Code::Error.into();
+            }
+            if let Err(e) = out.staged.commit() {
+                eprintln!("meshclash: error: {e}");
+                return e.exit_code().into();
             }
             out.exit_code.into()
         }

@@ -22,7 +22,8 @@ fn stdout_of(args: &[&str]) -> String {
     String::from_utf8(out.stdout).unwrap()
 }
 
-const SUBCOMMANDS: [&str; 7] = ["scene", "clash-set", "self", "bench", "schema", "completions", "man"];
+const SUBCOMMANDS: [&str; 10] =
+    ["scene", "clash-set", "self", "plan", "run", "merge", "bench", "schema", "completions", "man"];
 
 #[test]
 fn every_subcommand_is_listed_in_help_and_man_page() {

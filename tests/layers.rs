@@ -1,4 +1,4 @@
-//! The module graph of `src/`, read from `crate::` paths (issue 13): the lower layers import
+//! The module graph of `src/`, read from `crate::` paths: the lower layers import
 //! nothing above them, and no two top-level modules import each other, directly or through
 //! others, except the cycles listed in [`KNOWN_CYCLES`] (which fail the test when they grow,
 //! when a new one appears, or when one is gone and still listed). Run with
@@ -137,8 +137,8 @@ fn lower_layers_import_nothing_above_them() {
 }
 
 /// Import cycles between top-level modules that exist today, each as its sorted member list
-/// (a strongly connected component of the graph). Issue 13 removes them; remove an entry here
-/// when its cycle is gone (the test says so).
+/// (a strongly connected component of the graph); remove an entry here when its cycle is gone
+/// (the test says so).
 const KNOWN_CYCLES: &[&[&str]] = &[];
 
 /// Strongly connected components that contain a cycle (the import cycles), each sorted, in
@@ -220,6 +220,37 @@ fn the_library_never_uses_the_binary() {
             assert!(!text.contains(dep), "{} uses {dep}: the app layer belongs in src/app/", f.display());
         }
     }
+}
+
+#[test]
+fn the_report_is_a_projection_and_outputs_read_it() {
+    // The wire format does not compute: it names neither the loaders, the trees nor the
+    // narrow phase (the pipeline computes; `pipeline::report::build` projects).
+    let g = graph();
+    let report = reachable(&g, "report");
+    for below in ["bvh", "load", "narrow", "pipeline", "output"] {
+        assert!(!g["report"].contains(below), "src/report names crate::{below}");
+    }
+    assert!(!report.contains("pipeline"), "src/report reaches crate::pipeline");
+    // Outputs are projections: nothing under src/output takes a report to change it.
+    let src = Path::new(env!("CARGO_MANIFEST_DIR")).join("src");
+    let mut files = Vec::new();
+    rust_files(&src.join("output"), &mut files);
+    rust_files(&src.join("report"), &mut files);
+    for f in files {
+        let text = std::fs::read_to_string(&f).unwrap();
+        let code: String = text.lines().map(|l| l.split("//").next().unwrap()).collect::<Vec<_>>().join("\n");
+        assert!(
+            !code.contains("&mut Report") && !code.contains("&mut crate::report::Report"),
+            "{} changes a report",
+            f.display()
+        );
+    }
+    // One pipeline: the binary and the embedding API reach the check through it.
+    assert!(g["api"].contains("pipeline"), "src/api.rs goes through crate::pipeline");
+    let app = std::fs::read_to_string(src.join("app/run.rs")).unwrap();
+    assert!(app.contains("meshclash::pipeline::run("), "the app layer runs the pipeline");
+    assert!(!app.contains("assembly::run("), "the app layer does not assemble a check itself");
 }
 
 #[test]

@@ -123,6 +123,7 @@ fn without_lists(mut r: Value) -> Value {
     r["pairs"] = Value::Array(vec![]);
     r["pairs_truncated"] = Value::Null;
     r["regions"] = Value::Array(vec![]);
+    r.as_object_mut().unwrap().remove("unlisted");
     r["settings"].as_object_mut().unwrap().remove("detail");
     for p in r["part_pairs"].as_array_mut().unwrap() {
         p["pairs"] = Value::Array(vec![]);

@@ -109,7 +109,7 @@ fn spawn_shard(dir: &Path, plan: &str, i: usize, n: usize, via: Via, threads: us
 fn sharded(dir: &Path, check: &[&str], n: usize, via: Via) -> (Vec<u8>, Vec<u8>, i32) {
     let mut args = vec!["plan"];
     args.extend(check);
-    args.extend(["--no-timings", "--junit", "merged.xml", "-o", "plan.json"]);
+    args.extend(["--no-timings", "-o", "plan.json"]);
     let o = run(dir, &args);
     assert_eq!(o.status.code(), Some(0), "plan: {}", stderr(&o));
     let children: Vec<Child> = (1..=n).map(|i| spawn_shard(dir, "plan.json", i, n, via, 1 + i % 2)).collect();
@@ -121,7 +121,7 @@ fn sharded(dir: &Path, check: &[&str], n: usize, via: Via) -> (Vec<u8>, Vec<u8>,
     let mut order: Vec<usize> = (1..=n).filter(|i| i % 3 == 0).collect();
     order.extend((1..=n).rev().filter(|i| i % 3 != 0));
     let names: Vec<String> = order.iter().map(|i| format!("shard-{i}.json")).collect();
-    let mut args = vec!["merge", "-o", "merged.json"];
+    let mut args = vec!["merge", "--junit", "merged.xml", "-o", "merged.json"];
     args.extend(names.iter().map(String::as_str));
     let o = run(dir, &args);
     assert!(matches!(o.status.code(), Some(0 | 1)), "merge: {}", stderr(&o));
@@ -466,17 +466,7 @@ fn deploy_local_sh_runs_plan_shards_and_merge() {
     let script = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("deploy/local.sh");
     let o = Command::new("bash")
         .arg(&script)
-        .args([
-            "3",
-            "out",
-            "--",
-            "scene",
-            "shared.STL",
-            "--split-bodies",
-            "--no-timings",
-            "--junit",
-            "out/r.xml",
-        ])
+        .args(["3", "out", "--", "scene", "shared.STL", "--split-bodies", "--no-timings"])
         .env("MESHCLASH", env!("CARGO_BIN_EXE_meshclash"))
         .current_dir(p)
         .output()
@@ -484,6 +474,6 @@ fn deploy_local_sh_runs_plan_shards_and_merge() {
     let (report, junit, code) = single(p, &["scene", "shared.STL", "--split-bodies"]);
     assert_eq!(o.status.code(), Some(code), "{}", stderr(&o));
     assert!(std::fs::read(p.join("out/report.json")).unwrap() == report);
-    assert!(std::fs::read(p.join("out/r.xml")).unwrap() == junit);
+    assert!(std::fs::read(p.join("out/report.xml")).unwrap() == junit);
     assert!((1..=3).all(|i| p.join(format!("out/shard-{i}.json")).is_file()));
 }

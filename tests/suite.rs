@@ -22,10 +22,14 @@ mod cli_errors;
 mod cli_messages;
 #[path = "cli_subcommands.rs"]
 mod cli_subcommands;
+#[path = "contract.rs"]
+mod contract;
 #[path = "extremes.rs"]
 mod extremes;
 #[path = "fcl_reference.rs"]
 mod fcl_reference;
+#[path = "gate.rs"]
+mod gate;
 #[path = "glb.rs"]
 mod glb;
 #[path = "gltf_ext.rs"]

@@ -13,7 +13,7 @@ prefix=$1 queue=$2 jobdef=$3 n=${4:-8}
 
 # 1. Plan (here, or as a job of its own): the inputs go up with the plan; the paths in the
 #    plan are relative, so every job works in a directory laid out the same way.
-meshclash plan scene site.glb --clearance 10 --no-timings --junit report.xml -o plan.json
+meshclash plan scene site.glb --clearance 10 --no-timings -o plan.json
 aws s3 cp site.glb "$prefix/site.glb"
 aws s3 cp plan.json "$prefix/plan.json"
 
@@ -24,7 +24,7 @@ array=$(aws batch submit-job --job-name meshclash-shards --job-queue "$queue" --
     --array-properties size="$n" --parameters script="$shard_script" --query jobId --output text)
 
 merge_script='set -e; cd /tmp; aws s3 cp '"$prefix"'/site.glb site.glb; aws s3 cp --recursive '"$prefix"'/shards shards;
-set +e; meshclash merge shards/shard-*.json -o report.json; code=$?; set -e;
+set +e; meshclash merge shards/shard-*.json --junit report.xml -o report.json; code=$?; set -e;
 aws s3 cp report.json '"$prefix"'/report.json; aws s3 cp report.xml '"$prefix"'/report.xml; exit $code'
 aws batch submit-job --job-name meshclash-merge --job-queue "$queue" --job-definition "$jobdef" \
     --depends-on jobId="$array" --parameters script="$merge_script" --query jobId --output text

@@ -9,7 +9,7 @@ set -euo pipefail
 bucket=$1 region=$2 image=$3 n=${4:-8}
 
 # Plan locally (or in a one-task job) and upload inputs + plan side by side.
-meshclash plan scene site.glb --clearance 10 --no-timings --junit report.xml -o plan.json
+meshclash plan scene site.glb --clearance 10 --no-timings -o plan.json
 gcloud storage cp site.glb plan.json "gs://$bucket/"
 
 gcloud run jobs deploy meshclash-shards --region "$region" --image "$image" \
@@ -22,7 +22,7 @@ gcloud run jobs execute meshclash-shards --region "$region" --wait
 gcloud run jobs deploy meshclash-merge --region "$region" --image "$image" --tasks 1 \
     --add-volume name=work,type=cloud-storage,bucket="$bucket" \
     --add-volume-mount volume=work,mount-path=/work \
-    --command sh --args=-c,'cd /work && meshclash merge shards/shard-*.json -o report.json'
+    --command sh --args=-c,'cd /work && meshclash merge shards/shard-*.json --junit report.xml -o report.json'
 # Exit 1 (findings at or above --fail-on) shows as a failed execution: read report.json.
 gcloud run jobs execute meshclash-merge --region "$region" --wait || true
 gcloud storage cp "gs://$bucket/report.json" "gs://$bucket/report.xml" .

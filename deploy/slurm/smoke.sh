@@ -80,12 +80,12 @@ sinfo
 cp "$scene" "$work/site.glb"
 cd "$work"
 t0=$(date +%s.%N)
-"$exe" plan scene site.glb --no-timings --junit report.xml -o plan.json
+"$exe" plan scene site.glb --no-timings -o plan.json
 t1=$(date +%s.%N)
 array=$(sbatch --parsable --array=1-"$n" --chdir="$work" --output="$work/out/shard-%a.log" \
     --export=ALL,MESHCLASH="$exe" "$here/meshclash-array.sbatch")
 merge=$(sbatch --parsable --dependency=afterok:"$array" --chdir="$work" --output="$work/out/merge.log" \
-    --wrap="\"$exe\" merge out/shard-*.json -o report.json; echo exit=\$? > out/merge.code")
+    --wrap="\"$exe\" merge out/shard-*.json --junit report.xml -o report.json; echo exit=\$? > out/merge.code")
 echo "submitted array $array (1-$n) and merge $merge"
 while squeue -h -j "$array,$merge" 2>/dev/null | grep -q .; do sleep 1; done
 t2=$(date +%s.%N)

@@ -257,26 +257,14 @@ fn check_json(
     let (ia, ta) = input('a', a, ta, opts.split_bodies)?;
     let (ib, tb) = input('b', b, tb, opts.split_bodies)?;
     let rep = py.detach(move || -> meshclash::Result<String> {
-        let rep = match (&ia, &ib) {
-            (In::Source(x), In::Source(y)) => api::report(x, Some(y), &opts)?,
-            _ => {
-                let place = |i: &In, t: DMat4| -> meshclash::Result<Placed> {
-                    match i {
-                        In::Prepared(p) => p.place(t),
-                        In::Source(s) => {
-                            // A file or arrays beside a prepared mesh: prepare it here (placed
-                            // already, so the identity).
-                            let p = Arc::new(Prepared::new(&s.input.path, s.input.mesh.clone(), opts.bvh)?);
-                            let mut placed = p.place(DMat4::IDENTITY)?;
-                            placed.transform = t;
-                            Ok(placed)
-                        }
-                    }
-                };
-                let (pa, pb) = (place(&ia, ta)?, place(&ib, tb)?);
-                api::report_placed(&pa, &pb, &opts)?
+        // A prepared mesh is its mesh under its placement: the same pipeline as arrays.
+        let source = |i: &In, t: DMat4| -> meshclash::Result<api::Source> {
+            match i {
+                In::Prepared(p) => api::array_source(&p.label, p.mesh.clone(), t, false),
+                In::Source(s) => Ok((**s).clone()),
             }
         };
+        let rep = api::report(&source(&ia, ta)?, Some(&source(&ib, tb)?), &opts)?;
         Ok(meshclash::report::to_json(&rep))
     });
     rep.map_err(py_err)

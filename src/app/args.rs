@@ -2,7 +2,7 @@
 //! enums. Validation into a [`super::config::Config`] is in [`super::config`].
 
 use clap::{Parser, ValueEnum};
-use meshclash::error::{Error, Result, UsageProblem};
+
 use meshclash::output::bcf::Topics;
 use meshclash::output::{Format, OutputOptions};
 use meshclash::report::self_report::SelfFailOn;
@@ -27,8 +27,8 @@ pub struct Args {
     /// Second mesh (B).
     #[arg(required = true)]
     pub b: Option<PathBuf>,
-    /// `scene`, `clash-set`, `self`, `schema`, `completions <shell>`, `man` or `bench` instead of
-    /// a two-file check.
+    /// `scene`, `clash-set`, `self`, `plan`, `run`, `merge`, `schema`, `completions <shell>`,
+    /// `man` or `bench` instead of a two-file check.
     #[command(subcommand)]
     pub command: Option<Command>,
     /// The check's flags (shared with `scene`).
@@ -82,7 +82,7 @@ pub struct CheckArgs {
     #[arg(long, value_enum, value_name = "TOOL")]
     pub cross_check: Option<CrossCheckArg>,
     /// Pair classification: `exact` predicates, or `fast` plain f64 determinants (gives up
-    /// exactness on nearly touching or coplanar pairs; `meshclash bench --trade` measures it).
+    /// exactness on nearly touching or coplanar pairs; `meshclash-bench --trade` measures it).
     #[arg(long, value_enum, default_value_t = ModeArg::Exact)]
     pub mode: ModeArg,
     /// Stop at the first crossing pair: a quick pass/fail gate. Counts become lower bounds,
@@ -132,14 +132,14 @@ pub struct CheckArgs {
     /// --units-a/-b) are taken to be in U, with a warning. Verdicts are exact for the converted
     /// coordinates (a factor that is not a power of two rounds each coordinate once). Default:
     /// --units-a, else --units-b, else none: no conversion, lengths in the files' own units.
-    #[arg(long, value_enum, value_name = "U")]
+    #[arg(long, value_name = "U", value_parser = unit_parser())]
     pub units: Option<Unit>,
     /// Units of A's coordinates [default: m for glTF/GLB (the glTF specification), unknown for
     /// OBJ/STL]. In scene mode, the units of the file.
-    #[arg(long, value_enum, value_name = "U")]
+    #[arg(long, value_name = "U", value_parser = unit_parser())]
     pub units_a: Option<Unit>,
     /// Units of B's coordinates, as --units-a.
-    #[arg(long, value_enum, value_name = "U")]
+    #[arg(long, value_name = "U", value_parser = unit_parser())]
     pub units_b: Option<Unit>,
     /// Multiply A's coordinates by F (finite, > 0) with the unit conversion, before
     /// --transform-a/--translate-a: the coordinates are multiplied once by the f64 product of
@@ -162,6 +162,10 @@ pub struct CheckArgs {
     /// Output flags: --format, --junit, --baseline, --export-glb.
     #[command(flatten)]
     pub outputs: OutputArgs,
+    /// Colour in the text summary: auto (at a terminal, unless NO_COLOR is set or TERM is
+    /// dumb), always or never.
+    #[arg(long, value_enum, value_name = "WHEN", default_value = "auto")]
+    pub color: ColorArg,
     /// Nothing on stderr but errors: no warnings, no summary, no progress.
     #[arg(short, long)]
     pub quiet: bool,
@@ -198,6 +202,74 @@ pub enum Command {
     /// Check one mesh against itself: self-clashing triangle pairs and mesh health per part.
     #[command(name = "self")]
     SelfCheck(SelfArgs),
+    /// Shard a check across machines, step 1: write its work list (`meshclash plan <check
+    /// arguments> -o plan.json`, the check arguments exactly as they would follow `meshclash`).
+    /// Loads the geometry once, builds no triangle tree.
+    Plan(PlanArgs),
+    /// Step 2: check the pairs of one shard of a plan (`meshclash run --plan plan.json --shard
+    /// I/N -o shard-I.json`). Without --shard, I comes from JOB_COMPLETION_INDEX (Kubernetes,
+    /// 0-based), AWS_BATCH_JOB_ARRAY_INDEX, CLOUD_RUN_TASK_INDEX or SLURM_ARRAY_TASK_ID, N from
+    /// --shards, AWS_BATCH_JOB_ARRAY_SIZE, CLOUD_RUN_TASK_COUNT or SLURM_ARRAY_TASK_COUNT.
+    Run(RunArgs),
+    /// Step 3: merge the shard reports into the report the unsharded check writes (byte for
+    /// byte with --no-timings), with the outputs named here and the same exit code.
+    Merge(MergeArgs),
+}
+
+/// `meshclash plan`.
+#[derive(Debug, Clone, clap::Args)]
+pub struct PlanArgs {
+    /// The check arguments and `-o PLAN.json`.
+    #[arg(trailing_var_arg = true, allow_hyphen_values = true, num_args = 1.., required = true)]
+    pub args: Vec<std::ffi::OsString>,
+}
+
+/// `meshclash run`.
+#[derive(Debug, Clone, clap::Args)]
+pub struct RunArgs {
+    /// The plan file.
+    #[arg(long, value_name = "PLAN")]
+    pub plan: PathBuf,
+    /// This shard, I/N (1-based, as cargo-nextest --partition and Playwright --shard).
+    #[arg(long, value_name = "I/N")]
+    pub shard: Option<String>,
+    /// Number of shards when I comes from the engine's variable.
+    #[arg(long, value_name = "N")]
+    pub shards: Option<usize>,
+    /// The shard report.
+    #[arg(short, long, value_name = "FILE")]
+    pub output: PathBuf,
+    /// Worker threads (overrides the plan's --threads; 0 = one per core).
+    #[arg(long, value_name = "N")]
+    pub threads: Option<usize>,
+    /// Nothing on stderr but errors.
+    #[arg(short, long)]
+    pub quiet: bool,
+}
+
+/// `meshclash merge`.
+#[derive(Debug, Clone, clap::Args)]
+pub struct MergeArgs {
+    /// The shard reports, in any order.
+    #[arg(required = true, value_name = "SHARD")]
+    pub shards: Vec<PathBuf>,
+    /// Write the report to FILE (atomically) instead of stdout.
+    #[arg(short, long, value_name = "FILE")]
+    pub output: Option<PathBuf>,
+    /// Merge what is there when shards are missing: the report says `"complete": false` and
+    /// names the missing shards, the JUnit file has a failing case for them, the exit code is 1
+    /// (a partial merge never passes), and --baseline refuses the report later.
+    #[arg(long)]
+    pub allow_partial: bool,
+    /// The outputs of the merged check (as on the check's own command line).
+    #[command(flatten)]
+    pub outputs: OutputArgs,
+    /// Worker threads (overrides the plan's --threads; 0 = one per core).
+    #[arg(long, value_name = "N")]
+    pub threads: Option<usize>,
+    /// Nothing on stderr but errors.
+    #[arg(short, long)]
+    pub quiet: bool,
 }
 
 /// `meshclash bench ARGS..`: forwarded to `meshclash-bench`.
@@ -206,6 +278,32 @@ pub struct BenchForward {
     /// Arguments for `meshclash-bench` (see `cargo run --release -p meshclash-bench -- --help`).
     #[arg(trailing_var_arg = true, allow_hyphen_values = true, num_args = 0..)]
     pub args: Vec<std::ffi::OsString>,
+}
+
+/// `--color` values.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
+pub enum ColorArg {
+    /// At a terminal, unless NO_COLOR is set (not empty) or TERM is `dumb`.
+    Auto,
+    /// Always, even in a pipe.
+    Always,
+    /// Never.
+    Never,
+}
+
+impl ColorArg {
+    /// Colour text for a stream that is (or is not) a terminal?
+    pub fn enabled(self, terminal: bool) -> bool {
+        match self {
+            ColorArg::Always => true,
+            ColorArg::Never => false,
+            ColorArg::Auto => {
+                let no_color = std::env::var_os("NO_COLOR").is_some_and(|v| !v.is_empty());
+                let dumb = std::env::var_os("TERM").is_some_and(|t| t == "dumb");
+                terminal && !no_color && !dumb
+            }
+        }
+    }
 }
 
 /// `--fail-on` values.
@@ -303,23 +401,17 @@ pub struct OutputArgs {
 }
 
 impl OutputArgs {
-    /// Validate. `fail_on_new` is whether `--fail-on new` was given: it needs `--baseline`.
-    pub fn into_options(self, fail_on_new: bool) -> Result<OutputOptions> {
-        if fail_on_new && self.baseline.is_none() {
-            let why = "--fail-on new needs --baseline REPORT".to_string();
-            return Err(Error::bad_flag("fail-on", UsageProblem::Conflict(why)));
-        }
-        Ok(OutputOptions {
+    /// The output options (the baseline is the request's: it is an input).
+    pub fn into_options(self) -> OutputOptions {
+        OutputOptions {
             format: self.format.map(Into::into),
             junit: self.junit,
-            baseline: self.baseline,
             export_glb: self.export_glb,
             html: self.html,
             bcf: self.bcf.map(|p| (p, self.bcf_topics.into())),
             bcf_version: self.bcf_version.into(),
             up: self.up.into(),
-            fail_on_new,
-        })
+        }
     }
 }
 
@@ -407,74 +499,13 @@ impl From<UpArg> for meshclash::output::glb::Up {
     }
 }
 
-/// A unit of length (`--units`, `--units-a`, `--units-b`).
-#[derive(
-    Debug, Clone, Copy, PartialEq, Eq, ValueEnum, serde::Serialize, serde::Deserialize, schemars::JsonSchema,
-)]
-pub enum Unit {
-    /// Micrometre.
-    #[value(name = "um")]
-    #[serde(rename = "um")]
-    Um,
-    /// Millimetre.
-    #[value(name = "mm")]
-    #[serde(rename = "mm")]
-    Mm,
-    /// Centimetre.
-    #[value(name = "cm")]
-    #[serde(rename = "cm")]
-    Cm,
-    /// Metre (glTF's unit by specification).
-    #[value(name = "m")]
-    #[serde(rename = "m")]
-    M,
-    /// Inch (25.4 mm exactly).
-    #[value(name = "in")]
-    #[serde(rename = "in")]
-    In,
-    /// Foot (12 in).
-    #[value(name = "ft")]
-    #[serde(rename = "ft")]
-    Ft,
-    /// Yard (3 ft).
-    #[value(name = "yd")]
-    #[serde(rename = "yd")]
-    Yd,
-}
+pub use meshclash::pipeline::Unit;
 
-impl Unit {
-    /// Its name on the command line and in the report.
-    pub fn name(self) -> &'static str {
-        match self {
-            Unit::Um => "um",
-            Unit::Mm => "mm",
-            Unit::Cm => "cm",
-            Unit::M => "m",
-            Unit::In => "in",
-            Unit::Ft => "ft",
-            Unit::Yd => "yd",
-        }
-    }
-
-    /// Its length in micrometres: an exact integer for every unit (the inch is 25.4 mm by
-    /// definition).
-    pub fn micrometres(self) -> u32 {
-        match self {
-            Unit::Um => 1,
-            Unit::Mm => 1_000,
-            Unit::Cm => 10_000,
-            Unit::M => 1_000_000,
-            Unit::In => 25_400,
-            Unit::Ft => 304_800,
-            Unit::Yd => 914_400,
-        }
-    }
-
-    /// The factor that converts coordinates in `self` to `to`: the exact ratio of two integers,
-    /// rounded once to f64 (one IEEE division of exactly representable operands).
-    pub fn factor_to(self, to: Unit) -> f64 {
-        f64::from(self.micrometres()) / f64::from(to.micrometres())
-    }
+/// `--units U`: the unit names, each with its help line.
+fn unit_parser() -> impl clap::builder::TypedValueParser<Value = Unit> {
+    use clap::builder::{PossibleValue, PossibleValuesParser, TypedValueParser};
+    PossibleValuesParser::new(Unit::ALL.map(|u| PossibleValue::new(u.name()).help(u.help())))
+        .map(|s| Unit::from_name(&s).expect("a listed unit"))
 }
 
 /// The subcommands beside the main `meshclash A B` job. Each prints to stdout.

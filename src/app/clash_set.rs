@@ -24,7 +24,7 @@
 //!
 //! Each check is turned into the argument list of the equivalent `meshclash` command line and
 //! parsed by the same [`super::args::Args`], validated by the same [`super::args::Args::into_config`]
-//! and run by the same [`super::run::check_in_pool`]: its report is byte for byte the report that
+//! and run by the same [`super::run::check`]: its report is byte for byte the report that
 //! command prints. Every check is validated before any runs, and nothing is written unless every
 //! check ran.
 
@@ -221,11 +221,12 @@ struct NameOnly {
 }
 
 /// A validated check: its name, the argument list it stands for, and its configuration.
-#[derive(Debug, Clone, PartialEq)]
+#[derive(Debug, Clone)]
 pub struct Check {
     /// The check's name.
     pub name: String,
     /// The equivalent command line (argv\[0\] is `meshclash`).
+    #[cfg_attr(not(test), allow(dead_code))]
     pub argv: Vec<OsString>,
     /// What [`super::args::Args::into_config`] made of it.
     pub config: config::Config,
@@ -472,13 +473,14 @@ pub fn run_with_progress(args: &ClashSetArgs, progress: &(dyn Fn(Phase) + Sync))
         .filter_map(|(f, p)| Some((f, p.as_deref()?)))
         .collect();
     let mut inputs = vec![file];
-    inputs.extend(checks.iter().flat_map(|c| super::run::input_paths(&c.config)));
+    inputs.extend(checks.iter().flat_map(|c| c.config.input_paths()));
     meshclash::output::write::check_outputs(&outputs, &inputs)?;
-    let entries = run::in_pool(args.threads, |threads| {
+    let entries = run::in_pool(args.threads, |_| {
         checks
             .iter()
             .map(|c| {
-                let rep = run::check_in_pool(&c.config, threads, progress).map_err(|e| {
+                // A check of a clash set names no output files: nothing is staged.
+                let rep = run::check(&c.config, progress).map(|(rep, _)| rep).map_err(|e| {
                     let at = Location::Check(CheckRef::Name(c.name.clone()));
                     Error::at(file, at, InputProblem::InCheck(Box::new(e)))
                 })?;
@@ -668,13 +670,13 @@ mod tests {
             ]
         );
         let c = &cs[0].config;
-        assert_eq!(c.clearance, config::Tol::Abs(2.0));
-        assert_eq!(c.touch, config::Tol::Rel(1e-6));
-        assert_eq!(c.units.report, Some(Unit::Mm));
-        assert_eq!(c.units.inputs, [Some(Unit::In), None]);
-        assert_eq!(c.units.scale, [None, Some(0.5)]);
-        assert!(cs[1].config.selection.scene);
-        assert!(cs[1].config.selection.exclude.is_empty());
+        assert_eq!(c.request.clearance, meshclash::pipeline::Tolerance::Abs(2.0));
+        assert_eq!(c.request.touch, meshclash::pipeline::Tolerance::Rel(1e-6));
+        assert_eq!(c.request.units.report, Some(Unit::Mm));
+        assert_eq!(c.request.units.inputs, [Some(Unit::In), None]);
+        assert_eq!(c.request.units.scale, [None, Some(0.5)]);
+        assert!(cs[1].config.request.selection.scene);
+        assert!(cs[1].config.request.selection.exclude.is_empty());
     }
 
     #[test]
@@ -685,7 +687,10 @@ mod tests {
             r#"{"version": 1, "checks": [{"name": "n", "a": "a.obj", "b": "b.obj", "clearance": 0.10000000000000002}]}"#,
         )
         .unwrap();
-        assert_eq!(cs[0].config.clearance, config::Tol::Abs(f64::from_bits(0.1f64.to_bits() + 1)));
+        assert_eq!(
+            cs[0].config.request.clearance,
+            meshclash::pipeline::Tolerance::Abs(f64::from_bits(0.1f64.to_bits() + 1))
+        );
     }
 
     #[test]
@@ -696,8 +701,8 @@ mod tests {
             &run(),
         )
         .unwrap();
-        assert!(!cs[0].config.selection.scene);
-        assert_eq!(cs[0].config.inputs[0].path, PathBuf::from("./scene"));
+        assert!(!cs[0].config.request.selection.scene);
+        assert_eq!(cs[0].config.request.inputs[0].path(), Path::new("./scene"));
     }
 
     #[test]

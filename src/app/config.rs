@@ -1,12 +1,12 @@
 //! Validation of the parsed command line into a [`Config`] (the library never sees clap).
 
-use super::args::{Args, BvhArg, CheckArgs, Command, DetailArg, FailOnArg, ModeArg, TopicsArg, Unit};
+use super::args::{Args, BvhArg, CheckArgs, Command, DetailArg, FailOnArg, ModeArg, TopicsArg};
 use glam::{DMat4, DVec3, DVec4};
 use meshclash::bvh::{BuildOptions, Strategy};
-use meshclash::check::query::{Detail, DistanceError, FailOn, InputSpec, Mode, Settings};
+use meshclash::check::query::{Detail, DistanceError, FailOn, Mode, Settings};
 use meshclash::error::{Error, Result, UsageProblem};
 use meshclash::geom::predicates::Tolerances;
-use meshclash::report;
+use meshclash::pipeline::{Gate, InputRequest, Request, Source, Tolerance, Units};
 use std::path::PathBuf;
 
 fn nonneg(flag: &str, v: f64) -> Result<f64> {
@@ -17,106 +17,23 @@ fn nonneg(flag: &str, v: f64) -> Result<f64> {
     }
 }
 
-/// A validated configuration.
-#[derive(Debug, Clone, PartialEq)]
+/// A validated configuration: the pipeline's request and what the command writes.
+#[derive(Debug, Clone)]
 pub struct Config {
-    /// Inputs A and B with their placements.
-    pub inputs: [InputSpec; 2],
+    /// The check.
+    pub request: Request,
     /// Where the report goes (None = stdout).
     pub output: Option<PathBuf>,
-    /// Touch tolerance as given.
-    pub touch: Tol,
-    /// Clearance as given.
-    pub clearance: Tol,
-    /// Search settings (tolerances are resolved to absolute values once the inputs are loaded).
-    pub settings: Settings,
-    /// Failure threshold.
-    pub fail_on: FailOn,
-    /// Worker threads (0 = default).
-    pub threads: usize,
-    /// Cap on listed pairs.
-    pub max_pairs: usize,
-    /// Deterministic report.
-    pub deterministic: bool,
-    /// Run parry3d-f64 too.
-    pub cross_check: bool,
-    /// Scene mode and part selections.
-    pub selection: meshclash::check::assembly::Selection,
-    /// Output format, JUnit and GLB files, baseline.
+    /// Output format and side files (JUnit, GLB, HTML, BCF).
     pub outputs: meshclash::output::OutputOptions,
-    /// Units and scales (`--units`, `--units-a/-b`, `--scale-a/-b`).
-    pub units: UnitsConfig,
-    /// `--split-bodies`.
-    pub split_bodies: bool,
-    /// `--penetration`.
-    pub penetration: bool,
-    /// `--self` (scene mode): the conditions that fail the run on self-clash and health.
-    pub self_check: Option<Vec<meshclash::report::self_report::SelfFailOn>>,
+    /// Worker threads (0 = one per core).
+    pub threads: usize,
 }
 
-/// Units and raw scales, validated. Indices follow [`Config::inputs`] (in scene mode the file is
-/// input 1, and `--units-a`/`--scale-a` are stored there).
-#[derive(Debug, Clone, Copy, PartialEq, Default)]
-pub struct UnitsConfig {
-    /// `--units`, or the default (`--units-a`, else `--units-b`); None: no conversion.
-    pub report: Option<Unit>,
-    /// Declared units of each input.
-    pub inputs: [Option<Unit>; 2],
-    /// Raw multipliers (None = 1).
-    pub scale: [Option<f64>; 2],
-}
-
-impl UnitsConfig {
-    /// True if any units or scale flag was given (otherwise inputs load exactly as before, and
-    /// the report has no `inputs.*.units` blocks).
-    pub fn active(&self) -> bool {
-        self.report.is_some()
-            || self.inputs.iter().any(Option::is_some)
-            || self.scale.iter().any(Option::is_some)
-    }
-
-    /// The report's `settings.units`: the report unit, or `model`.
-    pub fn report_name(&self) -> &'static str {
-        self.report.map_or("model", Unit::name)
-    }
-
-    /// Resolve input `i` of format `format`: the multiplier, the report block and a warning when
-    /// the units were assumed. `flag` names the units flag for the warning.
-    pub fn resolve(
-        &self,
-        i: usize,
-        format: meshclash::load::Format,
-        flag: &str,
-    ) -> (f64, report::InputUnitsReport, Option<String>) {
-        let scale = self.scale[i].unwrap_or(1.0);
-        let gltf = matches!(format, meshclash::load::Format::Gltf | meshclash::load::Format::Glb);
-        let (units, source, warning) = match (self.report, self.inputs[i]) {
-            (None, _) => (None, None, None),
-            (Some(_), Some(u)) => (Some(u), Some("given"), None),
-            (Some(_), None) if gltf => (Some(Unit::M), Some("gltf"), None),
-            (Some(r), None) => (
-                Some(r),
-                Some("assumed"),
-                Some(format!(
-                    "units unknown ({} files carry none): taken to be {}, the report units; give {flag} to declare them",
-                    format.name().to_uppercase(),
-                    r.name()
-                )),
-            ),
-        };
-        let factor = match (units, self.report) {
-            (Some(u), Some(r)) => u.factor_to(r),
-            _ => 1.0,
-        };
-        let multiplier = factor * scale;
-        let block = report::InputUnitsReport {
-            units: units.map(|u| u.name().to_string()),
-            source: source.map(str::to_string),
-            factor,
-            scale,
-            multiplier,
-        };
-        (multiplier, block, warning)
+impl Config {
+    /// The mesh files the check reads (in scene mode, the one file).
+    pub fn input_paths(&self) -> Vec<&std::path::Path> {
+        self.request.inputs.iter().map(|i| i.path()).collect()
     }
 }
 
@@ -174,46 +91,6 @@ fn placement(name: char, transform: &Option<String>, translate: &Option<String>)
     Ok(m)
 }
 
-/// A tolerance as given: absolute (model units) or relative to the model size.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub enum Tol {
-    /// Model units.
-    Abs(f64),
-    /// Times the diagonal of the box around both inputs.
-    Rel(f64),
-}
-
-impl Tol {
-    /// The absolute value for a model of size `size`.
-    pub fn resolve(self, size: f64) -> f64 {
-        match self {
-            Tol::Abs(v) => v,
-            Tol::Rel(r) => r * size,
-        }
-    }
-
-    /// As written on the command line (canonical form).
-    pub fn spec(self) -> String {
-        match self {
-            Tol::Abs(v) => format!("{v}"),
-            Tol::Rel(r) => format!("{r}rel"),
-        }
-    }
-}
-
-/// Parse `1.5` or `1e-6rel`: finite, >= 0.
-pub fn parse_tolerance(flag: &str, s: &str) -> Result<Tol> {
-    let t = s.trim();
-    let (num, rel) = match t.strip_suffix("rel") {
-        Some(n) => (n, true),
-        None => (t, false),
-    };
-    match num.trim().parse::<f64>() {
-        Ok(v) if v.is_finite() && v >= 0.0 => Ok(if rel { Tol::Rel(v) } else { Tol::Abs(v) }),
-        _ => Err(Error::bad_flag(flag, UsageProblem::BadTolerance { text: s.to_string() })),
-    }
-}
-
 impl Args {
     /// Validate into a [`Config`] (a two-file check, or `scene FILE`).
     pub fn into_config(self) -> Result<Config> {
@@ -234,19 +111,7 @@ impl CheckArgs {
     /// Validate the flags of a check of `a` against `b` (`scene_mode`: `b`'s parts against
     /// each other).
     pub fn into_config(self, a: Option<PathBuf>, b: Option<PathBuf>, scene_mode: bool) -> Result<Config> {
-        if !(1..=64).contains(&self.leaf_size) {
-            let problem = UsageProblem::OutOfRange { value: self.leaf_size.into(), min: 1, max: 64 };
-            return Err(Error::bad_flag("leaf-size", problem));
-        }
-        if self.self_check && !scene_mode {
-            return Err(Error::bad_flag(
-                "self",
-                UsageProblem::Conflict(
-                    "--self works with scene (meshclash scene FILE --self); for one mesh use meshclash self FILE"
-                        .into(),
-                ),
-            ));
-        }
+        let conflict = |flag: &str, why: &str| Error::bad_flag(flag, UsageProblem::Conflict(why.into()));
         if self.detail == DetailArg::Parts {
             let o = &self.outputs;
             let needs_regions = [
@@ -264,46 +129,64 @@ impl CheckArgs {
                 let why = format!(
                     "--{flag}{note} needs the triangle pairs that --detail parts does not keep: drop one of them"
                 );
-                return Err(Error::bad_flag(flag, UsageProblem::Conflict(why)));
+                return Err(conflict(flag, &why));
             }
         }
-        if scene_mode && self.cross_check.is_some() {
-            let why = "--cross-check works on two files, not with scene".to_string();
-            return Err(Error::bad_flag("cross-check", UsageProblem::Conflict(why)));
-        }
-        let touch = parse_tolerance("touch-tolerance", &self.touch_tolerance)?;
-        let clearance = parse_tolerance("clearance", &self.clearance)?;
+        let touch = Tolerance::parse("touch-tolerance", &self.touch_tolerance)?;
+        let clearance = Tolerance::parse("clearance", &self.clearance)?;
         let scale = [positive_scale("scale-a", self.scale_a)?, positive_scale("scale-b", self.scale_b)?];
-        let units = if scene_mode {
-            if self.units_b.is_some() || self.scale_b.is_some() {
-                let flag = if self.units_b.is_some() { "units-b" } else { "scale-b" };
-                let why = "scene has one file: give its units and scale with --units-a and --scale-a";
-                return Err(Error::bad_flag(flag, UsageProblem::Conflict(why.into())));
+        let (inputs, units) = if scene_mode {
+            let b_flag = [
+                (self.units_b.is_some(), "units-b"),
+                (self.scale_b.is_some(), "scale-b"),
+                (self.transform_b.is_some(), "transform-b"),
+                (self.translate_b.is_some(), "translate-b"),
+            ];
+            if let Some((_, flag)) = b_flag.iter().find(|(given, _)| *given) {
+                let why =
+                    "scene has one file: give its units, scale and placement with --units-a, --scale-a, \
+                           --transform-a and --translate-a";
+                return Err(conflict(flag, why));
             }
-            UnitsConfig {
+            let file = b.ok_or_else(|| Error::usage(UsageProblem::Missing("scene FILE".into())))?;
+            let input = InputRequest {
+                source: Source::File(file),
+                transform: placement('a', &self.transform_a, &self.translate_a)?,
+            };
+            let units = Units {
                 report: self.units.or(self.units_a),
-                inputs: [None, self.units_a],
-                scale: [None, scale[0]],
-            }
+                inputs: [self.units_a, None],
+                scale: [scale[0], None],
+            };
+            (vec![input], units)
         } else {
-            UnitsConfig {
+            let side = |path: Option<PathBuf>, name: char, transform, translate| -> Result<InputRequest> {
+                let what = format!("mesh {}", name.to_ascii_uppercase());
+                Ok(InputRequest {
+                    source: Source::File(path.ok_or_else(|| Error::usage(UsageProblem::Missing(what)))?),
+                    transform: placement(name, transform, translate)?,
+                })
+            };
+            let inputs = vec![
+                side(a, 'a', &self.transform_a, &self.translate_a)?,
+                side(b, 'b', &self.transform_b, &self.translate_b)?,
+            ];
+            let units = Units {
                 report: self.units.or(self.units_a).or(self.units_b),
                 inputs: [self.units_a, self.units_b],
                 scale,
-            }
+            };
+            (inputs, units)
         };
-        Ok(Config {
-            inputs: [
-                InputSpec {
-                    path: a.ok_or_else(|| Error::usage(UsageProblem::Missing("mesh A".into())))?,
-                    transform: placement('a', &self.transform_a, &self.translate_a)?,
-                },
-                InputSpec {
-                    path: b.ok_or_else(|| Error::usage(UsageProblem::Missing("mesh B".into())))?,
-                    transform: placement('b', &self.transform_b, &self.translate_b)?,
-                },
-            ],
-            output: self.output,
+        let verdict_gate = |f: FailOnArg| match f {
+            FailOnArg::Clash => FailOn::Clash,
+            FailOnArg::Touching => FailOn::Touching,
+            FailOnArg::Clearance => FailOn::Clearance,
+            FailOnArg::Never | FailOnArg::New => FailOn::Never,
+        };
+        let request = Request {
+            inputs,
+            units,
             touch,
             clearance,
             settings: Settings {
@@ -330,25 +213,10 @@ impl CheckArgs {
                     abs: nonneg("distance-abs-err", self.distance_abs_err)?,
                 },
             },
-            self_check: self.self_check.then(|| {
-                let base = match self.fail_on {
-                    FailOnArg::Clash => FailOn::Clash,
-                    FailOnArg::Touching => FailOn::Touching,
-                    FailOnArg::Clearance => FailOn::Clearance,
-                    FailOnArg::Never | FailOnArg::New => FailOn::Never,
-                };
-                let extra: Vec<meshclash::report::self_report::SelfFailOn> =
-                    self.self_fail_on.iter().map(|&f| f.into()).collect();
-                meshclash::report::self_report::scene_fail_on(base, &extra)
-            }),
-            fail_on: match self.fail_on {
-                FailOnArg::Clash => FailOn::Clash,
-                FailOnArg::Touching => FailOn::Touching,
-                FailOnArg::Clearance => FailOn::Clearance,
-                // `new` is decided after the baseline comparison (meshclash::output::finish).
-                FailOnArg::Never | FailOnArg::New => FailOn::Never,
+            gate: match self.fail_on {
+                FailOnArg::New => Gate::New,
+                f => Gate::Verdict(verdict_gate(f)),
             },
-            threads: self.threads,
             max_pairs: self.max_pairs,
             deterministic: self.no_timings,
             cross_check: self.cross_check.is_some(),
@@ -359,10 +227,22 @@ impl CheckArgs {
                 exclude: self.exclude.clone(),
                 hook: None,
             },
-            outputs: self.outputs.into_options(self.fail_on == FailOnArg::New)?,
-            units,
             split_bodies: self.split_bodies,
             penetration: self.penetration,
+            self_check: self.self_check.then(|| {
+                let extra: Vec<meshclash::report::self_report::SelfFailOn> =
+                    self.self_fail_on.iter().map(|&f| f.into()).collect();
+                meshclash::report::self_report::scene_fail_on(verdict_gate(self.fail_on), &extra)
+            }),
+            baseline: self.outputs.baseline.clone(),
+            missing_shards: Vec::new(),
+        };
+        request.validate()?;
+        Ok(Config {
+            request,
+            output: self.output,
+            outputs: self.outputs.into_options(),
+            threads: self.threads,
         })
     }
 }

@@ -1,4 +1,4 @@
-//! Progress: the phases [`super::run::run_with_progress`] reports through its callback, and a
+//! Progress: the phases the pipeline reports through its callback ([`Phase`]), and a
 //! [`Spinner`] the binary draws on stderr when a phase runs for longer than a delay.
 //!
 //! The library draws nothing by itself: the spinner draws only on the target its caller hands it
@@ -9,30 +9,7 @@ use std::sync::{Arc, Condvar, Mutex};
 use std::thread::JoinHandle;
 use std::time::{Duration, Instant};
 
-/// A phase of a run, in order.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum Phase {
-    /// Reading and parsing both files.
-    Load,
-    /// Building both trees and walking them (pairs, closest points, containment).
-    Check,
-    /// Running parry3d-f64 (`--cross-check parry`).
-    CrossCheck,
-    /// Baseline comparison and writing the report, JUnit and GLB files.
-    Write,
-}
-
-impl Phase {
-    /// What the spinner says.
-    pub fn label(self) -> &'static str {
-        match self {
-            Phase::Load => "loading meshes",
-            Phase::Check => "building trees and walking them",
-            Phase::CrossCheck => "cross-checking with parry3d-f64",
-            Phase::Write => "writing outputs",
-        }
-    }
-}
+pub use meshclash::pipeline::Phase;
 
 /// The default delay before a spinner appears.
 pub const DEFAULT_DELAY: Duration = Duration::from_millis(500);

@@ -80,10 +80,16 @@ fn run_in_pool(args: &SelfArgs, threads: usize) -> Result<SelfOutcome> {
     let whole_name = args.file.display().to_string();
     let choice = if args.whole_file { PartChoice::Whole(&whole_name) } else { PartChoice::Objects(&keep) };
     let (parts, health_ms, query_ms) = check_parts(&input.mesh, choice, opts, args.first_n);
-    let mut warnings: Vec<String> =
+    let warnings: Vec<String> =
         input.warnings.iter().map(|w| format!("{}: {w}", args.file.display())).collect();
-    if parts.is_empty() {
-        warnings.push(format!("{}: no part matches the selection", args.file.display()));
+    if parts.is_empty() && !args.whole_file {
+        // As in the other modes: a selection that leaves nothing to check is an error.
+        let why = if args.select.is_empty() {
+            "no part left to check after --exclude".to_string()
+        } else {
+            format!("--select {} matches no part", args.select.join(","))
+        };
+        return Err(Error::in_file(&args.file, InputProblem::Selection(why)));
     }
     let mut fail_on: Vec<SelfFailOn> = args.fail_on.iter().map(|&f| f.into()).collect();
     fail_on.sort_unstable();

@@ -1,12 +1,15 @@
-//! `meshclash plan | run | merge` (issue 14): the command-line side of [`meshclash::shard`].
+//! `meshclash plan | run | merge`: the command-line side of [`meshclash::shard`].
 //!
 //! App layer: the check arguments of a plan are parsed by the ordinary [`super::args::Args`] into
-//! the ordinary [`super::config::Config`], and every step runs the ordinary check
-//! ([`super::run::check_staged`], [`super::run::run_with_progress`]) with a
-//! [`meshclash::check::assembly::Hook`] in its selection. The binary calls [`dispatch`] before
-//! parsing its own arguments.
+//! the ordinary [`super::config::Config`], and every step runs the ordinary pipeline
+//! ([`super::run::check`], [`super::run::run_with_progress`]) with a
+//! [`meshclash::check::assembly::Hook`] in its selection.
+//!
+//! A plan carries the check, never its outputs: the files a step writes come from that step's
+//! own command line (`merge --junit J --html H ...`), so an edited plan or shard report cannot
+//! make the merging machine write anywhere.
 
-use super::args::{Args, CheckArgs, Command};
+use super::args::{Args, CheckArgs, Command, MergeArgs, PlanArgs, RunArgs};
 use super::config::Config;
 use super::run as cli;
 use clap::Parser;
@@ -16,116 +19,22 @@ use meshclash::output::write::{self, Staged};
 use meshclash::shard::plan::{self, Plan, PlanInput};
 use meshclash::shard::{sha256, Covered, MergeHook, PlanHook, ShardHook, ShardReport, SHARD_SCHEMA};
 use std::collections::{BTreeMap, BTreeSet};
-use std::ffi::OsString;
 use std::path::{Path, PathBuf};
 use std::sync::{Arc, Mutex};
 
-/// Shard a check across machines: `plan`, then `run` once per shard (any batch engine), then
-/// `merge`.
-#[derive(Debug, Parser)]
-#[command(name = "meshclash", version)]
-pub struct ShardCli {
-    /// The step.
-    #[command(subcommand)]
-    pub cmd: ShardCommand,
-}
-
-/// `plan`, `run`, `merge`.
-#[derive(Debug, clap::Subcommand)]
-pub enum ShardCommand {
-    /// Write the work list of a check: `meshclash plan <check arguments> -o plan.json`, the
-    /// check arguments exactly as they would follow `meshclash` (`scene site.glb --clearance 10
-    /// --no-timings`, `a.glb b.stl`). Loads the geometry once, builds no triangle tree.
-    Plan(PlanArgs),
-    /// Check the pairs of one shard of a plan: `meshclash run --plan plan.json --shard I/N -o
-    /// shard-I.json`. Without --shard, I comes from JOB_COMPLETION_INDEX (Kubernetes, 0-based),
-    /// AWS_BATCH_JOB_ARRAY_INDEX, CLOUD_RUN_TASK_INDEX or SLURM_ARRAY_TASK_ID, N from --shards,
-    /// AWS_BATCH_JOB_ARRAY_SIZE, CLOUD_RUN_TASK_COUNT or SLURM_ARRAY_TASK_COUNT.
-    Run(RunArgs),
-    /// Merge the shard reports into the report the unsharded check writes (byte for byte
-    /// with --no-timings), with its JUnit, baseline status and exit code.
-    Merge(MergeArgs),
-}
-
-/// `meshclash plan`.
-#[derive(Debug, Clone, clap::Args)]
-pub struct PlanArgs {
-    /// The check arguments and `-o PLAN.json`.
-    #[arg(trailing_var_arg = true, allow_hyphen_values = true, num_args = 1.., required = true)]
-    pub args: Vec<OsString>,
-}
-
-/// `meshclash run`.
-#[derive(Debug, Clone, clap::Args)]
-pub struct RunArgs {
-    /// The plan file.
-    #[arg(long, value_name = "PLAN")]
-    pub plan: PathBuf,
-    /// This shard, I/N (1-based, as cargo-nextest --partition and Playwright --shard).
-    #[arg(long, value_name = "I/N")]
-    pub shard: Option<String>,
-    /// Number of shards when I comes from the engine's variable.
-    #[arg(long, value_name = "N")]
-    pub shards: Option<usize>,
-    /// The shard report.
-    #[arg(short, long, value_name = "FILE")]
-    pub output: PathBuf,
-    /// Worker threads (overrides the plan's --threads; 0 = one per core).
-    #[arg(long, value_name = "N")]
-    pub threads: Option<usize>,
-    /// Nothing on stderr but errors.
-    #[arg(short, long)]
-    pub quiet: bool,
-}
-
-/// `meshclash merge`.
-#[derive(Debug, Clone, clap::Args)]
-pub struct MergeArgs {
-    /// The shard reports, in any order.
-    #[arg(required = true, value_name = "SHARD")]
-    pub shards: Vec<PathBuf>,
-    /// Write the report to FILE (atomically) instead of stdout.
-    #[arg(short, long, value_name = "FILE")]
-    pub output: Option<PathBuf>,
-    /// Merge what is there when shards are missing: the report says `"complete": false` (and
-    /// --baseline refuses it later).
-    #[arg(long)]
-    pub allow_partial: bool,
-    /// Worker threads (overrides the plan's --threads; 0 = one per core).
-    #[arg(long, value_name = "N")]
-    pub threads: Option<usize>,
-    /// Nothing on stderr but errors.
-    #[arg(short, long)]
-    pub quiet: bool,
-}
-
-/// If the first argument is `plan`, `run` or `merge`, do that and return the exit code.
-pub fn dispatch() -> Option<u8> {
-    let first = std::env::args_os().nth(1)?;
-    if !matches!(first.to_str(), Some("plan" | "run" | "merge")) {
-        return None;
-    }
-    let cli = match ShardCli::try_parse() {
-        Ok(c) => c,
-        Err(e) if e.use_stderr() => {
-            let msg = e.to_string();
-            eprintln!("meshclash: error: {}", msg.trim_start_matches("error: ").trim_end());
-            return Some(2);
-        }
-        Err(e) => {
-            let _ = e.print();
-            return Some(0);
-        }
+/// Run `plan`, `run` or `merge`; the exit code (errors are printed here, exit 2).
+pub fn dispatch(cmd: super::args::Command) -> u8 {
+    use super::args::Command;
+    let outcome = match cmd {
+        Command::Plan(a) => plan_cmd(a),
+        Command::Run(a) => run_cmd(a),
+        Command::Merge(a) => merge_cmd(a),
+        _ => unreachable!("only the shard steps come here"),
     };
-    let outcome = match cli.cmd {
-        ShardCommand::Plan(a) => plan_cmd(a),
-        ShardCommand::Run(a) => run_cmd(a),
-        ShardCommand::Merge(a) => merge_cmd(a),
-    };
-    Some(outcome.unwrap_or_else(|e| {
+    outcome.unwrap_or_else(|e| {
         eprintln!("meshclash: error: {e}");
         2
-    }))
+    })
 }
 
 /// A problem with the command or with how the plan, shards and reports fit together (exit 2),
@@ -171,16 +80,28 @@ fn check_flags(a: &Args) -> &CheckArgs {
 }
 
 /// The configuration of a plan's check (no report file; `--cross-check` and `--first-hit`
-/// refused: neither splits into part pairs).
+/// refused: neither splits into part pairs; no output files: they are the merge's).
 fn config_of(args: &[String]) -> Result<Config> {
     let cfg = parse_check(args)?.into_config()?;
-    if cfg.cross_check {
+    if let Some((flag, _)) = cfg.outputs.files().first() {
+        return Err(conflict(
+            flag.trim_start_matches("--"),
+            format!("a plan carries the check, not its outputs: give {flag} to `meshclash merge`"),
+        ));
+    }
+    if cfg.outputs.format.is_some() {
+        return Err(conflict(
+            "format",
+            "a plan carries the check, not its outputs: give --format to `meshclash merge`",
+        ));
+    }
+    if cfg.request.cross_check {
         return Err(conflict(
             "cross-check",
             "--cross-check runs parry on the whole inputs: it cannot be sharded",
         ));
     }
-    if cfg.settings.first_hit {
+    if cfg.request.settings.first_hit {
         return Err(conflict(
             "first-hit",
             "--first-hit stops at a timing-dependent pair: it cannot be sharded",
@@ -208,7 +129,7 @@ fn strip_output(raw: &[String]) -> Vec<String> {
 
 /// The input files a configuration reads, with their hashes.
 fn hash_inputs(cfg: &Config) -> Result<Vec<PlanInput>> {
-    cli::input_paths(cfg)
+    cfg.input_paths()
         .into_iter()
         .map(|p| {
             let err = |e: std::io::Error| unreadable(p, Reading::Input, &e);
@@ -223,7 +144,7 @@ fn hash_inputs(cfg: &Config) -> Result<Vec<PlanInput>> {
 
 /// Refuse to go on when an input no longer matches the plan.
 fn verify_inputs(plan: &Plan, cfg: &Config) -> Result<()> {
-    let now = cli::input_paths(cfg);
+    let now = cfg.input_paths();
     if now.len() != plan.inputs.len() {
         return Err(usage("the plan's arguments and inputs disagree: plan again"));
     }
@@ -261,12 +182,11 @@ fn plan_cmd(a: PlanArgs) -> Result<u8> {
     let quiet = check_flags(&full).quiet;
     let stored = strip_output(&raw);
     let mut cfg = config_of(&stored)?;
-    write::check_outputs(&[("-o", &out)], &cli::input_paths(&cfg))?;
+    write::check_outputs(&[("-o", &out)], &cfg.input_paths())?;
     let inputs = hash_inputs(&cfg)?;
-    let hook = Arc::new(PlanHook { files: !cfg.selection.by_parts(), ..Default::default() });
-    cfg.selection.hook = Some(Hook(hook.clone()));
-    cfg.outputs = Default::default();
-    let rep = cli::in_pool(cfg.threads, |t| cli::check_staged(&cfg, t, &|_| {}, &mut Staged::new()))?;
+    let hook = Arc::new(PlanHook { files: !cfg.request.selection.by_parts(), ..Default::default() });
+    cfg.request.selection.hook = Some(Hook(hook.clone()));
+    let (rep, _) = cli::in_pool(cfg.threads, |_| cli::check(&cfg, &|_| {}))?;
     warn(quiet, &rep.warnings);
     let margin = rep.settings.touch_tolerance + rep.settings.clearance;
     let plan = hook.plan(stored, inputs, margin);
@@ -405,7 +325,10 @@ fn run_cmd(a: RunArgs) -> Result<u8> {
 
 fn run_shard(a: &RunArgs, plan: &Plan, plan_hash: &str, i: usize, n: usize) -> Result<()> {
     let mut cfg = config_of(&plan.args)?;
-    write::check_outputs(&[("-o", &a.output)], &cli::input_paths(&cfg))?;
+    // The plan is an input too: `-o` may not name it.
+    let mut inputs = cfg.input_paths();
+    inputs.push(&a.plan);
+    write::check_outputs(&[("-o", &a.output)], &inputs)?;
     verify_inputs(plan, &cfg)?;
     if let Some(t) = a.threads {
         cfg.threads = t;
@@ -425,12 +348,11 @@ fn run_shard(a: &RunArgs, plan: &Plan, plan_hash: &str, i: usize, n: usize) -> R
         pairs: mine.iter().filter_map(|p| Some((p.a?, p.b?))).collect(),
         needed: meshclash::shard::needed_parts(plan.pairs.iter().map(|p| (p.a, p.b)), &plan.extra_needed),
         owned,
-        bvh: cfg.settings.bvh,
+        bvh: cfg.request.settings.bvh,
         captured: Mutex::new(None),
     });
-    cfg.selection.hook = Some(Hook(hook.clone()));
-    cfg.outputs = Default::default();
-    let rep = cli::in_pool(cfg.threads, |t| cli::check_staged(&cfg, t, &|_| {}, &mut Staged::new()))?;
+    cfg.request.selection.hook = Some(Hook(hook.clone()));
+    let (rep, _) = cli::in_pool(cfg.threads, |_| cli::check(&cfg, &|_| {}))?;
     warn(a.quiet, &rep.warnings);
     if rep.parts.len() != plan.parts {
         return Err(usage(format!(
@@ -476,13 +398,13 @@ fn read_shard(path: &Path) -> Result<ShardReport> {
     serde_json::from_value(v).map_err(|e| invalid(path, format!("bad shard report: {e}")))
 }
 
-/// Check that the shard reports make one whole plan; returns them sorted by index and whether
-/// some are missing (only with `allow_partial`).
+/// Check that the shard reports make one whole plan; returns them sorted by index and the
+/// missing shards ("2/3"; some only with `allow_partial`).
 pub fn validate(
     files: &[PathBuf],
     reports: Vec<ShardReport>,
     allow_partial: bool,
-) -> Result<(Vec<ShardReport>, bool)> {
+) -> Result<(Vec<ShardReport>, Vec<String>)> {
     // The plan most reports belong to (the first one's on a tie) decides which are foreign.
     let mut votes: BTreeMap<&str, (usize, usize)> = BTreeMap::new();
     for (k, r) in reports.iter().enumerate() {
@@ -560,23 +482,34 @@ pub fn validate(
     if missing.is_empty() && ids.len() != plan.work_pairs {
         return Err(usage(format!("the shards cover {} pairs, the plan has {}", ids.len(), plan.work_pairs)));
     }
-    Ok((shards, !missing.is_empty()))
+    Ok((shards, missing))
 }
 
 fn merge_cmd(a: MergeArgs) -> Result<u8> {
     let reports = a.shards.iter().map(|p| read_shard(p)).collect::<Result<Vec<_>>>()?;
-    let (shards, partial) = validate(&a.shards, reports, a.allow_partial)?;
+    let (shards, missing) = validate(&a.shards, reports, a.allow_partial)?;
     let plan = shards[0].plan.clone();
     let mut cfg = config_of(&plan.args)?;
     verify_inputs(&plan, &cfg)?;
     if let Some(t) = a.threads {
         cfg.threads = t;
     }
-    cfg.output = a.output.clone();
-    cfg.selection.hook = Some(Hook(Arc::new(MergeHook { plan, shards, partial })));
-    if partial {
-        return merge_partial(&cfg, a.quiet);
+    // The outputs are this command line's own; a baseline given here replaces the plan's.
+    if a.outputs.baseline.is_some() {
+        cfg.request.baseline = a.outputs.baseline.clone();
     }
+    cfg.outputs = a.outputs.clone().into_options();
+    cfg.output = a.output.clone();
+    cfg.request.missing_shards = missing.clone();
+    cfg.request.validate()?;
+    let partial = !missing.is_empty();
+    cfg.request.selection.hook = Some(Hook(Arc::new(MergeHook { plan, shards, partial })));
+    // The shard reports are inputs: no output may name one.
+    let mut outputs: Vec<write::Named> = cfg.output.iter().map(|p| ("-o", p.as_path())).collect();
+    outputs.extend(cfg.outputs.files());
+    let mut inputs = cfg.input_paths();
+    inputs.extend(a.shards.iter().map(PathBuf::as_path));
+    write::check_outputs(&outputs, &inputs)?;
     let out = cli::run_with_progress(&cfg, &|_| {})?;
     warn(a.quiet, &out.warnings);
     let written = match (&out.stdout, out.json_stdout) {
@@ -585,41 +518,14 @@ fn merge_cmd(a: MergeArgs) -> Result<u8> {
         (None, false) => Ok(true),
     };
     written.map_err(|e| usage(format!("cannot write to stdout: {e}")))?;
-    Ok(out.exit_code as u8)
-}
-
-/// `--allow-partial` with shards missing: the JSON report with `"complete": false` first.
-fn merge_partial(cfg: &Config, quiet: bool) -> Result<u8> {
-    if cfg.outputs.format.is_some_and(|f| f != meshclash::output::Format::Json) {
-        return Err(conflict("allow-partial", "--allow-partial writes the JSON report only (no --format)"));
-    }
-    cli::check_outputs(cfg)?;
-    let mut staged = Staged::new();
-    let rep = cli::in_pool(cfg.threads, |t| cli::check_staged(cfg, t, &|_| {}, &mut staged))?;
-    warn(quiet, &rep.warnings);
-    let mut text = Vec::new();
-    meshclash::output::write_report_json(&mut text, &rep)
-        .map_err(|e| usage(format!("cannot serialise: {e}")))?;
-    let text = String::from_utf8(text).expect("JSON is UTF-8");
-    let text = match text.strip_prefix("{\n") {
-        Some(rest) => format!("{{\n  \"complete\": false,\n{rest}"),
-        None => text,
-    };
-    match &cfg.output {
-        Some(p) => {
-            staged.stage(p, text.as_bytes())?;
-            staged.commit()?;
-        }
-        None => {
-            staged.commit()?;
-            write::to_stdout(|w| w.write_all(text.as_bytes()))
-                .map_err(|e| usage(format!("cannot write to stdout: {e}")))?;
-        }
-    }
-    if !quiet {
+    out.staged.commit()?;
+    if partial && !a.quiet {
         eprintln!(
-            "meshclash: warning: partial merge: shards are missing, the report says \"complete\": false"
+            "meshclash: warning: partial merge: shard{} {} missing; the report says \"complete\": false and \
+             the run fails",
+            if missing.len() > 1 { "s" } else { "" },
+            missing.join(", ")
         );
     }
-    Ok(meshclash::error::ExitCode::from_failed(rep.failed) as u8)
+    Ok(out.exit_code as u8)
 }

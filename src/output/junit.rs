@@ -129,6 +129,22 @@ pub fn cases(r: &Report) -> Vec<Case> {
         time_s: r.timings_ms.as_ref().map_or(0.0, |t| t.total / 1e3),
         output: super::text::render(r, false),
     }];
+    // A partial merge never passes: say which shards are missing, as a failure of its own.
+    if !r.missing_shards.is_empty() {
+        let names = r.missing_shards.join(", ");
+        cases.push(Case {
+            name: "merge: every shard present".into(),
+            verdict: "incomplete".into(),
+            counts: format!("missing shard{} {names}", if r.missing_shards.len() > 1 { "s" } else { "" }),
+            findings: vec![format!(
+                "the missing shards were not checked: their part pairs may clash (merge shards {names} too)"
+            )],
+            total: r.missing_shards.len() as u64,
+            failed: true,
+            time_s: 0.0,
+            output: String::new(),
+        });
+    }
     // Two single-part inputs: the part pair is the whole run; say it once.
     if r.assembly.mode == "parts" || r.parts.len() > 2 {
         cases.extend(part_pair_cases(r));

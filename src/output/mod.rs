@@ -1,7 +1,7 @@
-//! CI-facing outputs built from a finished [`Report`]: the human summary ([`text`]), JUnit XML
-//! ([`junit`]), the baseline diff with stable finding ids ([`baseline`]), a visual GLB scene
-//! ([`glb`]), the HTML and BCF exports, the JSON Schema of the report, and the staged writer
-//! ([`write`]).
+//! CI-facing outputs, each a projection of a finished [`Report`] (and, for the pictures, of the
+//! geometry of the [`Outcome`] it was built from): the human summary ([`text`]), JUnit XML
+//! ([`junit`]), a visual GLB scene ([`glb`]), the HTML and BCF exports, the JSON Schema of the
+//! report, and the staged writer ([`write`]). No function here takes a `&mut Report`.
 //!
 //! Everything here returns strings or bytes, or writes the files it was asked to write; the
 //! library never prints. The binary decides what goes to stdout and stderr.
@@ -13,11 +13,9 @@ pub mod junit;
 pub mod text;
 pub mod write;
 
-use crate::check::query::ClashResult;
 use crate::error::Result;
-use crate::report::baseline;
+use crate::pipeline::Outcome;
 use crate::report::Report;
-use crate::scene::mesh::Mesh;
 use std::path::PathBuf;
 
 /// `--format`: what goes to stdout.
@@ -38,8 +36,6 @@ pub struct OutputOptions {
     pub format: Option<Format>,
     /// `--junit FILE`.
     pub junit: Option<PathBuf>,
-    /// `--baseline REPORT`.
-    pub baseline: Option<PathBuf>,
     /// `--export-glb FILE`.
     pub export_glb: Option<PathBuf>,
     /// `--html FILE`.
@@ -50,8 +46,26 @@ pub struct OutputOptions {
     pub bcf_version: bcf::Version,
     /// `--up`.
     pub up: glb::Up,
-    /// `--fail-on new`: fail only on new crossings and new containment (needs a baseline).
-    pub fail_on_new: bool,
+}
+
+impl OutputOptions {
+    /// The files these options write, each with the flag that names it.
+    pub fn files(&self) -> Vec<write::Named<'_>> {
+        let mut out: Vec<write::Named> = Vec::new();
+        if let Some(p) = &self.junit {
+            out.push(("--junit", p));
+        }
+        if let Some(p) = &self.export_glb {
+            out.push(("--export-glb", p));
+        }
+        if let Some(p) = &self.html {
+            out.push(("--html", p));
+        }
+        if let Some((p, _)) = &self.bcf {
+            out.push(("--bcf", p));
+        }
+        out
+    }
 }
 
 /// The JSON Schema of [`Report`], pretty-printed with a trailing newline.
@@ -62,45 +76,29 @@ pub fn schema_json() -> String {
     s
 }
 
-/// Complete the report after [`crate::report::build`] and write the side files: finding ids (always),
-/// the baseline comparison and `--fail-on new` (with `--baseline`), the JUnit file and the GLB.
-/// Sets `rep.failed` for `--fail-on new`. `meshes` are the two placed inputs the result was
-/// computed on.
-pub fn finish(
+/// Stage the side files of a run (JUnit, GLB, HTML, BCF): each a projection of the report and
+/// of the geometry the outcome was computed on. Nothing here decides or changes the report.
+pub fn stage_files(
     opts: &OutputOptions,
-    rep: &mut Report,
-    result: &ClashResult,
-    meshes: [&Mesh; 2],
+    rep: &Report,
+    outcome: &Outcome,
     staged: &mut write::Staged,
 ) -> Result<()> {
-    // Every pair's id for a baseline comparison; without one, only the listed pairs show theirs.
-    let listed = if opts.baseline.is_some() { result.pairs.len() } else { rep.pairs.len() };
-    let findings = baseline::findings(&result.pairs[..listed], meshes[0], meshes[1]);
-    baseline::assign_ids(rep, &findings);
-    if let Some(path) = &opts.baseline {
-        let base = baseline::read(path)?;
-        baseline::compare(rep, &findings, &base);
-    }
-    if opts.fail_on_new {
-        rep.settings.fail_on = "new".into();
-        // `--fail-on new` replaces the verdict's condition; a failing `self` block (scene --self,
-        // its own --self-fail-on) still fails the run.
-        rep.failed = rep.baseline.as_ref().is_some_and(baseline::fails_on_new)
-            || rep.self_check.as_ref().is_some_and(|s| s.failed);
-    }
+    let result = &outcome.assembly.result;
+    let [a, b] = outcome.meshes();
     if let Some(path) = &opts.junit {
         staged.stage(path, junit::from_report(rep).as_bytes())?;
     }
     if let Some(path) = &opts.export_glb {
         let z_up = opts.up.z_up(&rep.inputs.a.format);
-        staged.stage(path, &glb::export(rep, result, meshes[0], meshes[1], z_up))?;
+        staged.stage(path, &glb::export(rep, result, a, b, z_up))?;
     }
     if let Some(path) = &opts.html {
         let z_up = opts.up.z_up(&rep.inputs.a.format);
-        staged.stage(path, html::export(rep, result, meshes[0], meshes[1], z_up).as_bytes())?;
+        staged.stage(path, html::export(rep, result, a, b, z_up).as_bytes())?;
     }
     if let Some((path, topics)) = &opts.bcf {
-        staged.stage(path, &bcf::export(rep, result, meshes[0], meshes[1], *topics, opts.bcf_version))?;
+        staged.stage(path, &bcf::export(rep, result, a, b, *topics, opts.bcf_version))?;
     }
     Ok(())
 }

@@ -9,20 +9,23 @@
 //! every id.
 //!
 //! **Status**: a finding of the current run is `new` if no finding of the baseline has its id,
-//! else `persistent`; a baseline finding whose id is not found now is `resolved`. Only the
-//! baseline's *listed* pairs are known (its `--max-pairs`); `complete` says whether that list was
-//! cut. The current run's ids cover every pair found, listed or not.
+//! else `persistent`; a baseline finding whose id is not found now is `resolved`. A comparison
+//! needs every finding of the baseline: a report whose `pairs` list was cut records the ids of
+//! the findings it does not list (`unlisted`), and a report that cannot say what it found (cut
+//! by an older version, `--first-hit`, `--detail parts`, a partial merge) is refused as a
+//! baseline. The current run's ids cover every pair found, listed or not.
 //!
 //! **`--fail-on new`** fails (exit 1) exactly when `new_crossing > 0` (a crossing pair whose id
 //! was not a crossing pair of the baseline: a new pair, or one that only touched or came within
 //! the clearance before) or `new_containment` (the report says one part is inside the other,
-//! `a_in_b|b_in_a|a_partly_in_b|b_partly_in_a`, and the baseline did not say the same).
-//! New touching or clearance pairs are listed but do not fail it.
+//! `a_in_b|b_in_a|a_partly_in_b|b_partly_in_a|volumes_overlap`, and the baseline did not say the
+//! same). New touching or clearance pairs are listed but do not fail it.
 
 use crate::check::query::{PairFinding, PairKind};
 use crate::error::{Error, InputProblem, Reading, Result};
-use crate::report::{Report, ReportContainment, ReportPairKind};
+use crate::report::{ReportContainment, UnlistedFindings};
 use crate::scene::mesh::Mesh;
+use serde::de::{self, Deserializer, IgnoredAny, Visitor};
 use serde::{Deserialize, Serialize};
 use std::collections::{BTreeSet, HashMap, HashSet};
 use std::path::Path;
@@ -45,8 +48,7 @@ pub struct BaselineReport {
     pub new_crossing: u64,
     /// The run reports containment (one part inside the other) that the baseline did not.
     pub new_containment: bool,
-    /// False when the baseline's pair list was truncated (`pairs_truncated`): findings it did
-    /// not list count as new here, and resolved ones it did not list are missing.
+    /// Always true: a baseline that does not record every finding is refused.
     pub complete: bool,
 }
 
@@ -59,17 +61,33 @@ pub struct Finding {
     pub kind: PairKind,
 }
 
-/// What is needed from a baseline report.
+/// What is needed from a baseline report: every finding id it records (listed or not), with
+/// whether a finding with that id was a crossing, and its containment. Ids are held as the 64-bit
+/// numbers their 16 hex digits spell (a large baseline stays small in memory).
 #[derive(Debug, Clone, PartialEq, Default)]
 pub struct Baseline {
     /// Path as given.
     pub path: String,
-    /// Listed finding ids, each with whether any finding with that id was a crossing.
-    pub ids: HashMap<String, bool>,
+    /// Every finding id, each with whether any finding with that id was a crossing.
+    pub ids: HashMap<u64, bool>,
     /// Its `summary.contained` (a value this version does not know reads as none).
     pub contained: Option<ReportContainment>,
-    /// Its `pairs_truncated`.
-    pub truncated: bool,
+}
+
+impl Baseline {
+    /// Does the baseline have a finding with this id?
+    pub fn contains(&self, id: &str) -> bool {
+        parse_hex(id).is_some_and(|k| self.ids.contains_key(&k))
+    }
+
+    fn crossing(&self, id: &str) -> bool {
+        parse_hex(id).and_then(|k| self.ids.get(&k)).copied().unwrap_or(false)
+    }
+}
+
+/// A finding id's number (16 hex digits), or None.
+fn parse_hex(id: &str) -> Option<u64> {
+    (id.len() == 16).then(|| u64::from_str_radix(id, 16).ok()).flatten()
 }
 
 pub use crate::check::finding_id::finding_id;
@@ -80,11 +98,20 @@ pub fn findings(pairs: &[PairFinding], a: &Mesh, b: &Mesh) -> Vec<Finding> {
     pairs.par_iter().map(|p| Finding { id: finding_id(a, p.a, b, p.b), kind: p.kind }).collect()
 }
 
-/// Set `id` on the listed pairs: `rep.pairs` are the first of the pairs `findings` was made from.
-pub fn assign_ids(rep: &mut Report, findings: &[Finding]) {
-    for (p, f) in rep.pairs.iter_mut().zip(findings) {
-        p.id = Some(f.id.clone());
+/// The ids of the findings a cut list does not show (`listed`: the indices it shows, sorted),
+/// split by whether the finding is a crossing, each list sorted and without repeats.
+pub fn unlisted(all: &[Finding], listed: &[usize]) -> UnlistedFindings {
+    let mut shown = listed.iter().copied().peekable();
+    let (mut crossing, mut other) = (BTreeSet::new(), BTreeSet::new());
+    for (i, f) in all.iter().enumerate() {
+        if shown.peek() == Some(&i) {
+            shown.next();
+            continue;
+        }
+        if f.kind == PairKind::Crossing { &mut crossing } else { &mut other }.insert(f.id.as_str());
     }
+    let list = |s: BTreeSet<&str>| s.into_iter().map(str::to_string).collect();
+    UnlistedFindings { crossing_ids: list(crossing), other_ids: list(other) }
 }
 
 /// Read a baseline report (any `meshclash.report/*` written with finding ids; unknown fields
@@ -99,12 +126,108 @@ pub fn read(path: &Path) -> Result<Baseline> {
     parse(&path.display().to_string(), &bytes).map_err(|msg| Error::in_file(path, InputProblem::Invalid(msg)))
 }
 
+/// A finding id as read from a baseline (16 hex digits; None when malformed).
+struct HexId(Option<u64>);
+
+impl<'de> Deserialize<'de> for HexId {
+    fn deserialize<D: Deserializer<'de>>(d: D) -> std::result::Result<Self, D::Error> {
+        struct V;
+        impl Visitor<'_> for V {
+            type Value = HexId;
+            fn expecting(&self, f: &mut std::fmt::Formatter) -> std::fmt::Result {
+                f.write_str("a finding id")
+            }
+            fn visit_str<E: de::Error>(self, s: &str) -> std::result::Result<HexId, E> {
+                Ok(HexId(parse_hex(s)))
+            }
+        }
+        d.deserialize_str(V)
+    }
+}
+
+/// A pair kind as read from a baseline: is it `crossing`? (Kinds this version does not know
+/// read as not crossing.)
+struct IsCrossing(bool);
+
+impl<'de> Deserialize<'de> for IsCrossing {
+    fn deserialize<D: Deserializer<'de>>(d: D) -> std::result::Result<Self, D::Error> {
+        struct V;
+        impl Visitor<'_> for V {
+            type Value = IsCrossing;
+            fn expecting(&self, f: &mut std::fmt::Formatter) -> std::fmt::Result {
+                f.write_str("a pair kind")
+            }
+            fn visit_str<E: de::Error>(self, s: &str) -> std::result::Result<IsCrossing, E> {
+                Ok(IsCrossing(s == "crossing"))
+            }
+        }
+        d.deserialize_any(V)
+    }
+}
+
+/// The fields a comparison reads; everything else is skipped unread.
+#[derive(Deserialize)]
+struct BaseFile {
+    schema: Option<serde_json::Value>,
+    complete: Option<IgnoredOr<bool>>,
+    settings: Option<BaseSettings>,
+    summary: Option<BaseSummary>,
+    pairs: Option<Vec<BasePair>>,
+    pairs_truncated: Option<IgnoredOr<bool>>,
+    unlisted: Option<BaseUnlisted>,
+}
+
+/// A value of the expected type, or anything else (read as absent).
+#[derive(Deserialize)]
+#[serde(untagged)]
+enum IgnoredOr<T> {
+    Value(T),
+    Other(IgnoredAny),
+}
+
+impl<T: Copy> IgnoredOr<T> {
+    fn get(o: &Option<Self>) -> Option<T> {
+        match o {
+            Some(IgnoredOr::Value(v)) => Some(*v),
+            _ => None,
+        }
+    }
+}
+
+#[derive(Deserialize)]
+struct BaseSettings {
+    first_hit: Option<IgnoredOr<bool>>,
+    detail: Option<IgnoredAny>,
+}
+
+#[derive(Deserialize)]
+struct BaseSummary {
+    contained: Option<serde_json::Value>,
+}
+
+#[derive(Deserialize)]
+struct BasePair {
+    id: Option<HexId>,
+    kind: Option<IsCrossing>,
+}
+
+#[derive(Deserialize)]
+struct BaseUnlisted {
+    crossing_ids: Vec<HexId>,
+    other_ids: Vec<HexId>,
+}
+
 /// Parse a baseline report's JSON; the error is a one-line message.
 pub fn parse(path: &str, bytes: &[u8]) -> std::result::Result<Baseline, String> {
-    let v: serde_json::Value =
-        serde_json::from_slice(bytes).map_err(|e| format!("baseline is not JSON: {e}"))?;
+    let v: BaseFile = serde_json::from_slice(bytes).map_err(|e| {
+        if e.is_data() {
+            format!("baseline is not a meshclash report: {e}")
+        } else {
+            format!("baseline is not JSON: {e}")
+        }
+    })?;
     // Any version of the report format will do: only ids, kinds and containment are read.
-    match v.get("schema") {
+    match &v.schema {
         Some(serde_json::Value::String(s)) if s.starts_with("meshclash.report/") => {}
         Some(serde_json::Value::String(s)) => {
             let hint = if s.starts_with("meshclash.") {
@@ -112,62 +235,93 @@ pub fn parse(path: &str, bytes: &[u8]) -> std::result::Result<Baseline, String> 
             } else {
                 ""
             };
-            let s = crate::load::clip(s, 60);
+            // At most 60 characters, control characters shown as `?` (one printable line).
+            let mut shown: String =
+                s.chars().take(60).map(|c| if c.is_control() { '?' } else { c }).collect();
+            if s.chars().nth(60).is_some() {
+                shown.push('…');
+            }
+            let s = shown;
             return Err(format!("baseline is not a meshclash report: its schema is '{s}'{hint}"));
         }
         Some(_) => return Err("baseline is not a meshclash report: its \"schema\" is not a string".into()),
         None => return Err("baseline is not a meshclash report: it has no \"schema\"".into()),
     }
-    if v.get("complete") == Some(&serde_json::Value::Bool(false)) {
-        // `meshclash merge --allow-partial` (issue 14): pairs not re-checked must not read as resolved.
+    if IgnoredOr::get(&v.complete) == Some(false) {
+        // A partial merge: pairs not checked must not read as resolved.
         return Err("baseline is a partial merge (\"complete\": false): merge every shard first".into());
     }
-    let pairs = v.get("pairs").and_then(|p| p.as_array()).ok_or("baseline has no pairs list")?;
-    let mut ids = HashMap::new();
-    for (i, p) in pairs.iter().enumerate() {
-        let id = p.get("id").and_then(|s| s.as_str()).ok_or_else(|| {
-            format!("baseline pair {i} has no id (written by an older meshclash? regenerate it)")
-        })?;
-        let kind = p.get("kind").and_then(|k| ReportPairKind::deserialize(k).ok());
-        let crossing = kind == Some(ReportPairKind::Crossing);
-        *ids.entry(id.to_string()).or_insert(false) |= crossing;
+    if let Some(s) = &v.settings {
+        if IgnoredOr::get(&s.first_hit) == Some(true) {
+            return Err("baseline was written with --first-hit, which stops at the first crossing: it \
+                        does not record every finding (write it without --first-hit)"
+                .into());
+        }
+        if s.detail.is_some() && v.pairs.as_ref().is_none_or(Vec::is_empty) && v.unlisted.is_none() {
+            return Err("baseline was written with --detail parts, which keeps no triangle pairs: it \
+                        cannot be compared (write it with the default --detail pairs)"
+                .into());
+        }
     }
-    Ok(Baseline {
-        path: path.to_string(),
-        ids,
-        contained: v.pointer("/summary/contained").and_then(|c| ReportContainment::deserialize(c).ok()),
-        truncated: v.get("pairs_truncated").and_then(|t| t.as_bool()).unwrap_or(false),
-    })
+    let pairs = v.pairs.ok_or("baseline has no pairs list")?;
+    let truncated = IgnoredOr::get(&v.pairs_truncated).unwrap_or(false);
+    if truncated && v.unlisted.is_none() {
+        return Err(format!(
+            "baseline lists {} pairs and was cut at its --max-pairs without recording the others' ids \
+             (written by an older meshclash?): regenerate it, so that new and resolved findings can be \
+             told apart",
+            pairs.len()
+        ));
+    }
+    let mut ids: HashMap<u64, bool> = HashMap::with_capacity(pairs.len());
+    for (i, p) in pairs.iter().enumerate() {
+        let id = match &p.id {
+            None => {
+                return Err(format!(
+                    "baseline pair {i} has no id (written by an older meshclash? regenerate it)"
+                ))
+            }
+            Some(HexId(None)) => return Err(format!("baseline pair {i} has a malformed id (16 hex digits)")),
+            Some(HexId(Some(id))) => *id,
+        };
+        let crossing = p.kind.as_ref().is_some_and(|k| k.0);
+        *ids.entry(id).or_insert(false) |= crossing;
+    }
+    if let Some(u) = &v.unlisted {
+        for (list, crossing) in [(&u.crossing_ids, true), (&u.other_ids, false)] {
+            for (i, id) in list.iter().enumerate() {
+                let id =
+                    id.0.ok_or_else(|| format!("baseline unlisted id {i} is malformed (16 hex digits)"))?;
+                *ids.entry(id).or_insert(false) |= crossing;
+            }
+        }
+    }
+    let contained = v.summary.and_then(|s| s.contained).and_then(|c| ReportContainment::deserialize(c).ok());
+    Ok(Baseline { path: path.to_string(), ids, contained })
 }
 
 fn is_containment_clash(c: Option<ReportContainment>) -> bool {
     c.is_some_and(ReportContainment::is_clash)
 }
 
-/// Mark the listed pairs `new`/`persistent` and add the `baseline` block. `findings` are all the
-/// pairs of this run (the listed ones first, in order).
-pub fn compare(rep: &mut Report, findings: &[Finding], base: &Baseline) {
-    let now: HashSet<&str> = findings.iter().map(|f| f.id.as_str()).collect();
-    for (p, f) in rep.pairs.iter_mut().zip(findings) {
-        p.status = Some(if base.ids.contains_key(&f.id) { "persistent" } else { "new" }.to_string());
-    }
-    let persistent = findings.iter().filter(|f| base.ids.contains_key(&f.id)).count() as u64;
-    let new_crossing = findings
-        .iter()
-        .filter(|f| f.kind == PairKind::Crossing && base.ids.get(&f.id) != Some(&true))
-        .count() as u64;
-    let resolved: BTreeSet<&String> = base.ids.keys().filter(|id| !now.contains(id.as_str())).collect();
-    let contained = rep.summary.contained;
-    rep.baseline = Some(BaselineReport {
+/// Compare every finding of this run (`all`) with a baseline that records all of its own;
+/// `contained` is this run's containment.
+pub fn compare(all: &[Finding], base: &Baseline, contained: Option<ReportContainment>) -> BaselineReport {
+    let now: HashSet<u64> = all.iter().filter_map(|f| parse_hex(&f.id)).collect();
+    let persistent = all.iter().filter(|f| base.contains(&f.id)).count() as u64;
+    let new_crossing =
+        all.iter().filter(|f| f.kind == PairKind::Crossing && !base.crossing(&f.id)).count() as u64;
+    let resolved: BTreeSet<u64> = base.ids.keys().filter(|id| !now.contains(id)).copied().collect();
+    BaselineReport {
         path: base.path.clone(),
-        new: findings.len() as u64 - persistent,
+        new: all.len() as u64 - persistent,
         persistent,
         resolved: resolved.len() as u64,
-        resolved_ids: resolved.into_iter().cloned().collect(),
+        resolved_ids: resolved.into_iter().map(|k| format!("{k:016x}")).collect(),
         new_crossing,
         new_containment: is_containment_clash(contained) && base.contained != contained,
-        complete: !base.truncated,
-    });
+        complete: true,
+    }
 }
 
 /// Does the comparison fail `--fail-on new`? (See the module docs.)
@@ -248,13 +402,34 @@ mod tests {
         assert!(!e.contains("Some("), "{e}");
         let e = parse("x.json", br#"{"pairs": []}"#).unwrap_err();
         assert_eq!(e, "baseline is not a meshclash report: it has no \"schema\"");
-        let ok = br#"{"schema": "meshclash.report/1", "pairs_truncated": true, "summary": {"contained": "a_in_b"},
-            "pairs": [{"id": "01", "kind": "touching"}, {"id": "01", "kind": "crossing"}, {"id": "02", "kind": "touching"}]}"#;
-        let b = parse("b.json", ok).unwrap();
+        let (id1, id2, id3) = ("00000000000000a1", "00000000000000a2", "00000000000000a3");
+        let ok = format!(
+            r#"{{"schema": "meshclash.report/1", "pairs_truncated": false, "summary": {{"contained": "a_in_b"}},
+            "pairs": [{{"id": "{id1}", "kind": "touching"}}, {{"id": "{id1}", "kind": "crossing"}}, {{"id": "{id2}", "kind": "touching"}}]}}"#
+        );
+        let b = parse("b.json", ok.as_bytes()).unwrap();
         assert_eq!(b.ids.len(), 2);
-        assert!(b.ids["01"]);
-        assert!(!b.ids["02"]);
-        assert!(b.truncated);
+        assert!(b.contains(id1) && b.crossing(id1));
+        assert!(b.contains(id2) && !b.crossing(id2));
+        assert!(!b.contains(id3));
+        // A cut list without the ids of what it does not list cannot be compared: refused.
+        let cut = ok.replace("\"pairs_truncated\": false", "\"pairs_truncated\": true");
+        let e = parse("b.json", cut.as_bytes()).unwrap_err();
+        assert!(e.contains("cut at its --max-pairs"), "{e}");
+        // With the unlisted ids it is complete: every id counts, crossing or not.
+        let whole = cut.replacen(
+            "\"pairs\":",
+            &format!(r#""unlisted": {{"crossing_ids": ["{id3}"], "other_ids": []}}, "pairs":"#),
+            1,
+        );
+        let b = parse("b.json", whole.as_bytes()).unwrap();
+        assert_eq!(b.ids.len(), 3);
+        assert!(b.contains(id3) && b.crossing(id3));
+        // A first-hit report or a malformed id is refused too.
+        let fh = ok.replacen("{\"schema\"", "{\"settings\": {\"first_hit\": true}, \"schema\"", 1);
+        assert!(parse("b.json", fh.as_bytes()).unwrap_err().contains("--first-hit"));
+        let bad = ok.replace(id2, "xyz");
+        assert!(parse("b.json", bad.as_bytes()).unwrap_err().contains("malformed id"));
         assert_eq!(b.contained, Some(ReportContainment::AInB));
     }
 }

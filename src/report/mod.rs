@@ -57,10 +57,12 @@ pub mod baseline;
 pub mod clash_set;
 pub mod self_report;
 
-use crate::check::query::{ClashResult, Input, PairFinding, TreeStats, Verdict};
-use crate::geom::{Aabb, DVec3};
-use glam::DMat4;
+use crate::check::query::{ClashResult, Verdict};
+use crate::geom::DVec3;
 use serde::{Deserialize, Serialize};
+
+/// The `format` an in-memory input has in the report.
+pub const ARRAY_FORMAT: &str = "array";
 
 /// The schema identifier written in every report.
 pub const SCHEMA: &str = "meshclash.report/2";
@@ -173,18 +175,6 @@ impl ReportContact {
     }
 }
 
-impl From<crate::narrow::tri_tri::Contact> for ReportContact {
-    fn from(c: crate::narrow::tri_tri::Contact) -> Self {
-        use crate::narrow::tri_tri::Contact;
-        match c {
-            Contact::Point => ReportContact::Point,
-            Contact::Segment => ReportContact::Segment,
-            Contact::CoplanarArea => ReportContact::CoplanarArea,
-            Contact::CoplanarBoundary => ReportContact::CoplanarBoundary,
-        }
-    }
-}
-
 /// Containment as written in reports (`summary.contained`, `part_pairs[].contained`); every
 /// value but `undecided` is a clash.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize, Deserialize, schemars::JsonSchema)]
@@ -260,6 +250,13 @@ wire_name!(ReportVerdict, ReportPairKind, ReportContact, ReportContainment);
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize, schemars::JsonSchema)]
 #[serde(deny_unknown_fields)]
 pub struct Report {
+    /// `false` for a partial merge (shards missing; such a report always fails and is refused
+    /// as a baseline); absent otherwise.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub complete: Option<bool>,
+    /// The shards a partial merge is missing ("2/3"); absent otherwise.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub missing_shards: Vec<String>,
     /// Always [`SCHEMA`].
     pub schema: String,
     /// Who wrote it.
@@ -276,10 +273,16 @@ pub struct Report {
     pub summary: Summary,
     /// The closest pair of points.
     pub closest: Option<ClosestReport>,
-    /// The pairs found, sorted by (a, b), at most `settings.max_pairs`.
+    /// The pairs found, sorted by (a, b), at most `settings.max_pairs`: when there are more,
+    /// the worst are kept (crossing, then touching, then within the touch tolerance, then
+    /// clearance by distance; ties by (a, b)).
     pub pairs: Vec<PairReport>,
     /// True if `pairs` was cut at `max_pairs`.
     pub pairs_truncated: bool,
+    /// When `pairs` was cut: the ids of every finding it does not list, so that the report is a
+    /// complete baseline whatever `--max-pairs` listed; absent otherwise.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub unlisted: Option<UnlistedFindings>,
     /// Tree sizes.
     pub bvh: Trees,
     /// What parry3d-f64 says on the same input (`--cross-check parry`), else null.
@@ -304,6 +307,17 @@ pub struct Report {
     /// [`self_report::SceneSelfReport`]); absent otherwise.
     #[serde(rename = "self", default, skip_serializing_if = "Option::is_none")]
     pub self_check: Option<self_report::SceneSelfReport>,
+}
+
+/// The finding ids a cut `pairs` list does not show.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, schemars::JsonSchema)]
+#[serde(deny_unknown_fields)]
+pub struct UnlistedFindings {
+    /// Ids of the unlisted crossing pairs, sorted, without repeats.
+    pub crossing_ids: Vec<String>,
+    /// Ids of the other unlisted pairs (touching, within tolerance, clearance), sorted, without
+    /// repeats.
+    pub other_ids: Vec<String>,
 }
 
 /// How deep one part reaches into the other at a region.
@@ -803,164 +817,9 @@ pub struct TimingsReport {
     pub total: f64,
 }
 
-/// What the report needs beyond the result.
-#[derive(Debug, Clone)]
-pub struct Context<'a> {
-    /// The two inputs.
-    pub inputs: [&'a Input; 2],
-    /// The two transforms applied (identity = none).
-    pub transforms: [DMat4; 2],
-    /// Settings as shown.
-    pub settings: SettingsReport,
-    /// Whether the verdict fails the run.
-    pub failed: bool,
-    /// Load and total times, or None in deterministic mode.
-    pub times: Option<(f64, f64)>,
-    /// The cross-check block, if one was run.
-    pub cross_check: Option<CrossCheckReport>,
-    /// The part view (see [`assembly_view`]).
-    pub assembly: (AssemblyReport, Vec<PartReport>, Vec<PartPairReport>),
-}
-
-fn v3(p: DVec3) -> [f64; 3] {
+/// A point as written in reports.
+pub fn v3(p: DVec3) -> [f64; 3] {
     p.to_array()
-}
-
-fn input_report(
-    input: &Input,
-    m: &DMat4,
-    info: &crate::check::query::MeshInfo,
-    closed: Option<bool>,
-) -> InputReport {
-    let Aabb { min, max } = info.bounds;
-    InputReport {
-        path: input.path.display().to_string(),
-        format: input.format.name().to_string(),
-        vertices: info.vertices,
-        triangles: info.triangles,
-        degenerate_triangles: info.degenerate_triangles,
-        closed,
-        objects: info.objects.iter().map(|(n, t)| ObjectReport { name: n.clone(), triangles: *t }).collect(),
-        bounds: Bounds { min: v3(min), max: v3(max) },
-        transform: (*m != DMat4::IDENTITY).then(|| m.transpose().to_cols_array().to_vec()),
-        units: None,
-    }
-}
-
-fn tree_report(s: &TreeStats) -> TreeReport {
-    TreeReport {
-        nodes: s.nodes,
-        leaves: s.leaves,
-        depth: s.depth,
-        sah_cost: s.sah_cost,
-        bytes: s.bytes,
-        cells: s.cells,
-    }
-}
-
-fn pair_report(p: &PairFinding, ca: &[u32], cb: &[u32]) -> PairReport {
-    PairReport {
-        a: p.a,
-        b: p.b,
-        a_object: ca[p.a as usize],
-        b_object: cb[p.b as usize],
-        kind: p.kind.into(),
-        contact: match (p.contact, p.kind) {
-            (Some(c), _) => Some(c.into()),
-            (None, crate::check::query::PairKind::Touching) => Some(ReportContact::WithinTolerance),
-            (None, _) => None,
-        },
-        distance: p.distance,
-        segment: p.segment.map(|[s, t]| [v3(s), v3(t)]),
-        id: None,
-        status: None,
-    }
-}
-
-/// Assemble the report.
-pub fn build(ctx: &Context, r: &ClashResult) -> Report {
-    let [ia, ib] = ctx.inputs;
-    let (infa, infb) =
-        (crate::check::query::MeshInfo::of(&ia.mesh), crate::check::query::MeshInfo::of(&ib.mesh));
-    let (oa, ob) = (&ia.mesh.tri_object, &ib.mesh.tri_object);
-    let max = ctx.settings.max_pairs;
-    let warnings = ctx
-        .inputs
-        .iter()
-        .flat_map(|i| i.warnings.iter().map(move |w| format!("{}: {}", i.path.display(), w)))
-        .collect();
-    Report {
-        schema: SCHEMA.to_string(),
-        tool: Tool::this(),
-        inputs: Inputs {
-            a: input_report(ia, &ctx.transforms[0], &infa, r.closed[0]),
-            b: input_report(ib, &ctx.transforms[1], &infb, r.closed[1]),
-        },
-        settings: ctx.settings.clone(),
-        verdict: r.verdict.into(),
-        failed: ctx.failed,
-        summary: Summary {
-            crossing_pairs: r.counts.crossing,
-            touching_pairs: r.counts.touching,
-            within_tolerance_pairs: r.counts.within_tolerance,
-            clearance_pairs: r.counts.clearance,
-            min_distance: r.closest.map(|c| c.distance),
-            contained: ReportContainment::of(&r.containment),
-            contained_reason: match &r.containment {
-                crate::check::containment::Containment::Undecided(why) => Some(why.clone()),
-                _ => None,
-            },
-        },
-        closest: r.closest.map(|c| ClosestReport {
-            distance: c.distance,
-            a: Witness { triangle: c.a.0, object: oa[c.a.0 as usize], point: v3(c.a.1) },
-            b: Witness { triangle: c.b.0, object: ob[c.b.0 as usize], point: v3(c.b.1) },
-        }),
-        pairs: r.pairs.iter().take(max).map(|p| pair_report(p, oa, ob)).collect(),
-        pairs_truncated: r.pairs.len() > max || (r.pairs.is_empty() && r.counts.total() > 0),
-        bvh: Trees { a: tree_report(&r.trees[0]), b: tree_report(&r.trees[1]) },
-        cross_check: ctx.cross_check.clone(),
-        assembly: ctx.assembly.0.clone(),
-        parts: ctx.assembly.1.clone(),
-        part_pairs: ctx.assembly.2.clone(),
-        regions: {
-            let mut regs = crate::check::regions::regions(&r.pairs, &ia.mesh, &ib.mesh);
-            if ctx.settings.penetration && !ctx.settings.first_hit {
-                let opts = crate::bvh::BuildOptions::default();
-                crate::check::regions::estimate_penetration(&mut regs, &r.pairs, &ia.mesh, &ib.mesh, opts);
-            }
-            regs
-        }
-        .into_iter()
-        .map(|g| RegionReport {
-            a_name: ia.mesh.objects[g.objects.0 as usize].name.clone(),
-            b_name: ib.mesh.objects[g.objects.1 as usize].name.clone(),
-            id: g.id,
-            a_object: g.objects.0,
-            b_object: g.objects.1,
-            pairs: g.pairs,
-            crossing_pairs: g.crossing,
-            center: v3(g.center),
-            bounds: Bounds { min: v3(g.bounds.min), max: v3(g.bounds.max) },
-            extent: g.extent,
-            penetration: g.penetration.map(|p| PenetrationReport {
-                depth: p.depth,
-                point: v3(p.point),
-                side: if p.side == 0 { "a_in_b" } else { "b_in_a" }.to_string(),
-                samples: p.samples,
-            }),
-        })
-        .collect(),
-        warnings,
-        timings_ms: ctx.times.map(|(load, total)| TimingsReport {
-            load,
-            build: r.timings.build_ms,
-            query: r.timings.query_ms,
-            total,
-        }),
-        baseline: None,
-        self_check: None,
-    }
 }
 
 /// Verdict severity from its report name (for readers of old reports).

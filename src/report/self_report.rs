@@ -334,7 +334,7 @@ fn finding(f: &Finding) -> FindingReport {
     FindingReport { count: f.count, triangles: f.triangles.clone() }
 }
 
-fn health_report(h: &Health) -> HealthReport {
+pub(crate) fn health_report(h: &Health) -> HealthReport {
     HealthReport {
         closed: h.closed,
         volume: h.volume,
@@ -349,7 +349,7 @@ fn health_report(h: &Health) -> HealthReport {
 }
 
 /// The listed pairs (sorted by (a, b), at most `max_pairs`) and whether the list was cut.
-fn pairs_of(
+pub(crate) fn pairs_of(
     mesh: &crate::scene::mesh::Mesh,
     parts: &[PartResult],
     max_pairs: usize,
@@ -376,7 +376,7 @@ fn pairs_of(
 }
 
 /// Sums over the parts.
-fn summary_of(parts: &[PartResult]) -> SelfSummary {
+pub(crate) fn summary_of(parts: &[PartResult]) -> SelfSummary {
     let sum = |f: &dyn Fn(&PartResult) -> u64| parts.iter().map(f).sum::<u64>();
     SelfSummary {
         parts: parts.len(),
@@ -395,7 +395,7 @@ fn summary_of(parts: &[PartResult]) -> SelfSummary {
 }
 
 /// `clash` if a pair crosses, `touching` if pairs only touch, else `clear`.
-fn verdict_of(s: &SelfSummary) -> ReportVerdict {
+pub(crate) fn verdict_of(s: &SelfSummary) -> ReportVerdict {
     if s.crossing_pairs > 0 {
         ReportVerdict::Clash
     } else if s.touching_pairs > 0 {
@@ -638,58 +638,6 @@ pub fn scene_fail_on(fail_on: crate::check::query::FailOn, extra: &[SelfFailOn])
     v
 }
 
-/// Check every selected part of `mesh` (the scene's one file, parts in
-/// [`crate::check::assembly::parts_of`] order, which is the report's `parts` order) against
-/// itself and build the `self` block. `keep` selects parts by name. Instances are checked once
-/// per distinct placed geometry ([`crate::check::self_clash::check_part_list`]).
-pub fn scene_self(
-    mesh: &crate::scene::mesh::Mesh,
-    keep: &dyn Fn(&str) -> bool,
-    opts: crate::bvh::BuildOptions,
-    fail_on: &[SelfFailOn],
-    max_pairs: usize,
-    deterministic: bool,
-) -> SceneSelfReport {
-    let t = std::time::Instant::now();
-    let all = crate::check::assembly::parts_of(mesh, 0);
-    let chosen: Vec<usize> = (0..all.len()).filter(|&i| keep(&all[i].name)).collect();
-    let specs = chosen
-        .iter()
-        .map(|&i| (Some(all[i].object), all[i].name.clone(), all[i].triangles.clone()))
-        .collect();
-    let (results, _, _) = crate::check::self_clash::check_part_list(mesh, specs, opts, SCENE_FIRST_N, true);
-    let (pairs, pairs_truncated) = pairs_of(mesh, &results, max_pairs);
-    let summary = summary_of(&results);
-    let failed_on: Vec<SelfFailOn> =
-        fail_on.iter().copied().filter(|f| results.iter().any(|p| f.hit(p))).collect();
-    let names = |v: &[SelfFailOn]| v.iter().map(|f| f.name().to_string()).collect::<Vec<_>>();
-    SceneSelfReport {
-        fail_on: names(fail_on),
-        verdict: verdict_of(&summary),
-        failed: !failed_on.is_empty(),
-        failed_on: names(&failed_on),
-        checks: results.iter().filter(|p| p.same_as.is_none()).count(),
-        summary,
-        pairs,
-        pairs_truncated,
-        parts: results
-            .iter()
-            .zip(&chosen)
-            .map(|(p, &i)| SceneSelfPart {
-                part: i,
-                object: all[i].object,
-                name: p.name.clone(),
-                triangles: p.triangles,
-                crossing_pairs: p.crossing,
-                touching_pairs: p.pairs.len() as u64 - p.crossing,
-                same_as: p.same_as.map(|l| chosen[l]),
-                health: health_report(&p.health),
-            })
-            .collect(),
-        time_ms: (!deterministic).then(|| t.elapsed().as_secs_f64() * 1e3),
-    }
-}
-
 /// What is wrong with one part, for a person: `3 crossing pairs, 12 boundary edges, ...`.
 pub fn part_problems(crossing: u64, touching: u64, h: &HealthReport) -> Vec<String> {
     let mut v = Vec::new();
@@ -759,25 +707,4 @@ pub fn scene_text(x: &SceneSelfReport) -> String {
         let _ = writeln!(out, "    … and {} more parts with findings", listed.len() - SCENE_TEXT_PARTS);
     }
     out
-}
-
-/// Attach the `self` block to a finished scene report: `rep.failed` also becomes true when the
-/// block fails. Parts are those the selection checks (`--select-a`, `--select-b`, `--exclude`).
-pub fn attach_scene_self(
-    rep: &mut crate::report::Report,
-    mesh: &crate::scene::mesh::Mesh,
-    sel: &crate::check::assembly::Selection,
-    opts: crate::bvh::BuildOptions,
-    fail_on: &[SelfFailOn],
-    max_pairs: usize,
-    deterministic: bool,
-) {
-    use crate::check::assembly::glob_match;
-    let keep = |name: &str| {
-        let any = |g: &[String]| g.iter().any(|p| glob_match(p, name));
-        !any(&sel.exclude) && (sel.select_a.is_empty() || any(&sel.select_a) || any(&sel.select_b))
-    };
-    let block = scene_self(mesh, &keep, opts, fail_on, max_pairs, deterministic);
-    rep.failed |= block.failed;
-    rep.self_check = Some(block);
 }

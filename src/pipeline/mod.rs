@@ -1,0 +1,719 @@
+//! The one pipeline: a [`Request`] in, an [`Outcome`] out.
+//!
+//! Every way of asking for a check — the two-file command, `scene`, each check of a clash set,
+//! the steps of a sharded run, the Python package — builds a [`Request`] and calls [`run`]. It
+//! loads and places the inputs (units, transforms, `--split-bodies`), resolves the tolerances,
+//! runs the check ([`crate::check::assembly::run`]), the parry cross-check, the clash regions and
+//! their penetration estimates, the finding ids, the scene self-check and the baseline
+//! comparison, and decides **once** whether the run fails ([`Outcome::failed`]).
+//!
+//! Nothing downstream decides or computes again: [`report::build`] projects an [`Outcome`] into
+//! the wire format, and every output (JSON, text, JUnit, GLB, HTML, BCF) is a
+//! projection of that report and the outcome's geometry.
+//!
+//! Combinations whose answer the pipeline cannot give exactly are refused by
+//! [`Request::validate`] (exit 2), whichever path asked: `--first-hit` with a baseline (the walk
+//! stops before the findings a comparison needs), `--fail-on new` without one, `--detail parts`
+//! with what needs triangle pairs.
+
+use crate::bvh::BuildOptions;
+use crate::check::assembly::{self, Selection};
+use crate::check::query::{self, Detail, FailOn, Input, InputSpec, PairFinding, PairKind, Settings};
+use crate::error::{Error, InputProblem, Result, UsageProblem};
+use crate::geom::predicates::Tolerances;
+use crate::geom::Aabb;
+use crate::load::Format;
+use crate::report::baseline::{self, Baseline, BaselineReport, Finding};
+use crate::report::self_report::{SceneSelfReport, SelfFailOn};
+use crate::report::{CrossCheckReport, InputUnitsReport, SettingsReport};
+use crate::scene::mesh::{Loaded, Mesh};
+use glam::DMat4;
+use std::path::{Path, PathBuf};
+use std::time::Instant;
+
+pub mod report;
+mod self_block;
+
+/// A phase of a run, in order (for a progress display).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Phase {
+    /// Reading and parsing the files.
+    Load,
+    /// Building trees and walking them (pairs, closest points, containment).
+    Check,
+    /// Running parry3d-f64 (`--cross-check parry`).
+    CrossCheck,
+    /// Regions, finding ids, the baseline comparison; then the outputs.
+    Write,
+}
+
+impl Phase {
+    /// What a progress display says.
+    pub fn label(self) -> &'static str {
+        match self {
+            Phase::Load => "loading meshes",
+            Phase::Check => "building trees and walking them",
+            Phase::CrossCheck => "cross-checking with parry3d-f64",
+            Phase::Write => "writing outputs",
+        }
+    }
+}
+
+/// A unit of length (`--units`, `--units-a`, `--units-b`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize, serde::Deserialize, schemars::JsonSchema)]
+pub enum Unit {
+    /// Micrometre.
+    #[serde(rename = "um")]
+    Um,
+    /// Millimetre.
+    #[serde(rename = "mm")]
+    Mm,
+    /// Centimetre.
+    #[serde(rename = "cm")]
+    Cm,
+    /// Metre (glTF's unit by specification).
+    #[serde(rename = "m")]
+    M,
+    /// Inch (25.4 mm exactly).
+    #[serde(rename = "in")]
+    In,
+    /// Foot (12 in).
+    #[serde(rename = "ft")]
+    Ft,
+    /// Yard (3 ft).
+    #[serde(rename = "yd")]
+    Yd,
+}
+
+impl Unit {
+    /// Every unit, in the order the help lists them.
+    pub const ALL: [Unit; 7] = [Unit::Um, Unit::Mm, Unit::Cm, Unit::M, Unit::In, Unit::Ft, Unit::Yd];
+
+    /// Its name on the command line and in the report.
+    pub fn name(self) -> &'static str {
+        match self {
+            Unit::Um => "um",
+            Unit::Mm => "mm",
+            Unit::Cm => "cm",
+            Unit::M => "m",
+            Unit::In => "in",
+            Unit::Ft => "ft",
+            Unit::Yd => "yd",
+        }
+    }
+
+    /// What the help says of it.
+    pub fn help(self) -> &'static str {
+        match self {
+            Unit::Um => "Micrometre",
+            Unit::Mm => "Millimetre",
+            Unit::Cm => "Centimetre",
+            Unit::M => "Metre (glTF's unit by specification)",
+            Unit::In => "Inch (25.4 mm exactly)",
+            Unit::Ft => "Foot (12 in)",
+            Unit::Yd => "Yard (3 ft)",
+        }
+    }
+
+    /// The unit of that name.
+    pub fn from_name(name: &str) -> Option<Unit> {
+        Unit::ALL.into_iter().find(|u| u.name() == name)
+    }
+
+    /// Its length in micrometres: an exact integer for every unit (the inch is 25.4 mm by
+    /// definition).
+    pub fn micrometres(self) -> u32 {
+        match self {
+            Unit::Um => 1,
+            Unit::Mm => 1_000,
+            Unit::Cm => 10_000,
+            Unit::M => 1_000_000,
+            Unit::In => 25_400,
+            Unit::Ft => 304_800,
+            Unit::Yd => 914_400,
+        }
+    }
+
+    /// The factor that converts coordinates in `self` to `to`: the exact ratio of two integers,
+    /// rounded once to f64 (one IEEE division of exactly representable operands).
+    pub fn factor_to(self, to: Unit) -> f64 {
+        f64::from(self.micrometres()) / f64::from(to.micrometres())
+    }
+}
+
+/// Units and raw scales. Indices follow [`Request::inputs`].
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct Units {
+    /// The report's unit (`--units`, or the first declared input unit); None: no conversion.
+    pub report: Option<Unit>,
+    /// Declared units of each input.
+    pub inputs: [Option<Unit>; 2],
+    /// Raw multipliers (None = 1).
+    pub scale: [Option<f64>; 2],
+}
+
+impl Units {
+    /// True if any unit or scale was given (otherwise inputs load exactly as they are, and the
+    /// report has no `inputs.*.units` blocks).
+    pub fn active(&self) -> bool {
+        self.report.is_some()
+            || self.inputs.iter().any(Option::is_some)
+            || self.scale.iter().any(Option::is_some)
+    }
+
+    /// The report's `settings.units`: the report unit, or `model`.
+    pub fn report_name(&self) -> &'static str {
+        self.report.map_or("model", Unit::name)
+    }
+
+    /// Resolve input `i` of format `format`: the multiplier, the report block and a warning when
+    /// the units were assumed. `flag` names the units flag for the warning.
+    pub fn resolve(&self, i: usize, format: Format, flag: &str) -> (f64, InputUnitsReport, Option<String>) {
+        let scale = self.scale[i].unwrap_or(1.0);
+        let gltf = matches!(format, Format::Gltf | Format::Glb);
+        let (units, source, warning) = match (self.report, self.inputs[i]) {
+            (None, _) => (None, None, None),
+            (Some(_), Some(u)) => (Some(u), Some("given"), None),
+            (Some(_), None) if gltf => (Some(Unit::M), Some("gltf"), None),
+            (Some(r), None) => (
+                Some(r),
+                Some("assumed"),
+                Some(format!(
+                    "units unknown ({} files carry none): taken to be {}, the report units; give {flag} to declare them",
+                    format.name().to_uppercase(),
+                    r.name()
+                )),
+            ),
+        };
+        let factor = match (units, self.report) {
+            (Some(u), Some(r)) => u.factor_to(r),
+            _ => 1.0,
+        };
+        let multiplier = factor * scale;
+        let block = InputUnitsReport {
+            units: units.map(|u| u.name().to_string()),
+            source: source.map(str::to_string),
+            factor,
+            scale,
+            multiplier,
+        };
+        (multiplier, block, warning)
+    }
+}
+
+/// A tolerance as given: absolute, or relative to the diagonal of the box around both inputs
+/// (the command line's `1e-6rel`).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Tolerance {
+    /// Model units.
+    Abs(f64),
+    /// Times the diagonal of the box around both inputs.
+    Rel(f64),
+}
+
+impl Default for Tolerance {
+    fn default() -> Self {
+        Tolerance::Abs(0.0)
+    }
+}
+
+impl Tolerance {
+    /// Parse `0.5` or `1e-6rel` (finite, >= 0); the error names `flag`.
+    pub fn parse(flag: &str, s: &str) -> Result<Tolerance> {
+        let t = s.trim();
+        let (num, rel) = match t.strip_suffix("rel") {
+            Some(n) => (n, true),
+            None => (t, false),
+        };
+        match num.trim().parse::<f64>() {
+            Ok(v) if v.is_finite() && v >= 0.0 => Ok(if rel { Tolerance::Rel(v) } else { Tolerance::Abs(v) }),
+            _ => Err(Error::bad_flag(flag, UsageProblem::BadTolerance { text: s.to_string() })),
+        }
+    }
+
+    /// The absolute value for a model of size `size`.
+    pub fn resolve(self, size: f64) -> f64 {
+        match self {
+            Tolerance::Abs(v) => v,
+            Tolerance::Rel(r) => r * size,
+        }
+    }
+
+    /// As written on the command line (canonical form).
+    pub fn spec(self) -> String {
+        match self {
+            Tolerance::Abs(v) => format!("{v}"),
+            Tolerance::Rel(r) => format!("{r}rel"),
+        }
+    }
+}
+
+/// Where an input comes from.
+#[derive(Debug, Clone)]
+pub enum Source {
+    /// A mesh file (OBJ, STL, glTF, GLB).
+    File(PathBuf),
+    /// A mesh handed over in memory; `label` stands for its path in the report and in errors,
+    /// and its `format` in the report is `array`.
+    Mesh {
+        /// Its name in the report and in error messages.
+        label: PathBuf,
+        /// The mesh, validated (see [`crate::api::mesh_from_arrays`]).
+        mesh: Mesh,
+    },
+}
+
+/// One input and its placement.
+#[derive(Debug, Clone)]
+pub struct InputRequest {
+    /// The file or mesh.
+    pub source: Source,
+    /// Affine placement applied to every vertex (in f64) after units and scale.
+    pub transform: DMat4,
+}
+
+impl InputRequest {
+    /// A file, unplaced.
+    pub fn file(path: impl Into<PathBuf>) -> InputRequest {
+        InputRequest { source: Source::File(path.into()), transform: DMat4::IDENTITY }
+    }
+
+    /// The path (or label) errors and the report name it by.
+    pub fn path(&self) -> &Path {
+        match &self.source {
+            Source::File(p) => p,
+            Source::Mesh { label, .. } => label,
+        }
+    }
+}
+
+/// When the run fails (exit 1).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Gate {
+    /// The verdict is at or above this.
+    Verdict(FailOn),
+    /// A crossing or a containment that the baseline did not have (needs a baseline).
+    New,
+}
+
+impl Default for Gate {
+    fn default() -> Self {
+        Gate::Verdict(FailOn::Clash)
+    }
+}
+
+impl Gate {
+    /// The report's `settings.fail_on`.
+    pub fn name(self) -> &'static str {
+        match self {
+            Gate::Verdict(f) => f.name(),
+            Gate::New => "new",
+        }
+    }
+}
+
+/// Everything a check needs: what to load and how, what to look for, when to fail.
+#[derive(Debug, Clone, Default)]
+pub struct Request {
+    /// A and B (two entries), or the one file of a scene (one entry, with `selection.scene`).
+    pub inputs: Vec<InputRequest>,
+    /// Units and scales (indices follow `inputs`).
+    pub units: Units,
+    /// `--touch-tolerance`.
+    pub touch: Tolerance,
+    /// `--clearance`.
+    pub clearance: Tolerance,
+    /// Search settings; `settings.tolerances` is replaced by the resolved `touch`/`clearance`.
+    pub settings: Settings,
+    /// When the run fails.
+    pub gate: Gate,
+    /// Pairs listed in the report (the worst ones; counts stay complete).
+    pub max_pairs: usize,
+    /// No timings and no thread count in the report (byte-identical reports).
+    pub deterministic: bool,
+    /// Run parry3d-f64 on the same inputs and report every disagreement.
+    pub cross_check: bool,
+    /// Scene mode and part selections (and a sharding hook).
+    pub selection: Selection,
+    /// `--split-bodies`.
+    pub split_bodies: bool,
+    /// `--penetration`.
+    pub penetration: bool,
+    /// `scene --self`: the conditions that fail the run on self-clash and health.
+    pub self_check: Option<Vec<SelfFailOn>>,
+    /// `--baseline REPORT`.
+    pub baseline: Option<PathBuf>,
+    /// Shards a partial merge is missing ("1/3", ...): such a run never passes.
+    pub missing_shards: Vec<String>,
+}
+
+impl Request {
+    /// A two-file request with default settings.
+    pub fn files(a: impl Into<PathBuf>, b: impl Into<PathBuf>) -> Request {
+        Request { inputs: vec![InputRequest::file(a), InputRequest::file(b)], ..Request::defaults() }
+    }
+
+    /// A scene request (the file's parts against each other) with default settings.
+    pub fn scene(file: impl Into<PathBuf>) -> Request {
+        let mut r = Request { inputs: vec![InputRequest::file(file)], ..Request::defaults() };
+        r.selection.scene = true;
+        r
+    }
+
+    /// The command line's defaults (no inputs).
+    pub fn defaults() -> Request {
+        Request { max_pairs: 1000, ..Request::default() }
+    }
+
+    /// Refuse what the pipeline cannot answer exactly (exit 2), whichever path asked.
+    pub fn validate(&self) -> Result<()> {
+        let conflict = |flag: &str, why: &str| Err(Error::bad_flag(flag, UsageProblem::Conflict(why.into())));
+        let want = if self.selection.scene { 1 } else { 2 };
+        if self.inputs.len() != want {
+            let what = if self.selection.scene { "scene FILE" } else { "mesh A and mesh B" };
+            return Err(Error::usage(UsageProblem::Missing(what.into())));
+        }
+        let leaf = self.settings.bvh.leaf_size;
+        if !(1..=64).contains(&leaf) {
+            let problem = UsageProblem::OutOfRange { value: leaf.into(), min: 1, max: 64 };
+            return Err(Error::bad_flag("leaf-size", problem));
+        }
+        let de = self.settings.distance_error;
+        for (flag, v) in [("distance-rel-err", de.rel), ("distance-abs-err", de.abs)] {
+            if !(v.is_finite() && v >= 0.0) {
+                return Err(Error::bad_flag(flag, UsageProblem::NotNonNegative { value: v }));
+            }
+        }
+        if self.gate == Gate::New && self.baseline.is_none() {
+            return conflict("fail-on", "--fail-on new needs --baseline REPORT");
+        }
+        if self.settings.first_hit && self.baseline.is_some() {
+            return conflict(
+                "first-hit",
+                "--first-hit stops at the first crossing, so a baseline comparison would call unseen findings \
+                 resolved and miss new ones: drop --first-hit or --baseline",
+            );
+        }
+        if self.settings.detail == Detail::Parts {
+            if self.baseline.is_some() {
+                return conflict(
+                    "baseline",
+                    "--baseline needs the triangle pairs that --detail parts does not keep: drop one of them",
+                );
+            }
+            if self.cross_check {
+                return conflict(
+                    "cross-check",
+                    "--cross-check needs the triangle pairs that --detail parts does not keep: drop one of them",
+                );
+            }
+        }
+        if self.self_check.is_some() && !self.selection.scene {
+            return conflict(
+                "self",
+                "--self works with scene (meshclash scene FILE --self); for one mesh use meshclash self FILE",
+            );
+        }
+        if self.selection.scene && self.cross_check {
+            return conflict("cross-check", "--cross-check works on two files, not with scene");
+        }
+        Ok(())
+    }
+}
+
+/// A loaded, placed input as the check saw it.
+#[derive(Debug, Clone)]
+pub struct LoadedInput {
+    /// The mesh in world coordinates, with its path, format and warnings.
+    pub input: Input,
+    /// The placement applied.
+    pub transform: DMat4,
+    /// The units block (when units or scales were given).
+    pub units: Option<InputUnitsReport>,
+    /// An in-memory mesh (reported with format `array`).
+    pub array: bool,
+}
+
+/// The baseline comparison of a run.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Comparison {
+    /// The report's `baseline` block.
+    pub block: BaselineReport,
+    /// For each listed pair (in [`Outcome::listed`] order): was it in the baseline?
+    pub persistent: Vec<bool>,
+}
+
+/// Everything a check found and decided; the report is a projection of it.
+#[derive(Debug, Clone)]
+pub struct Outcome {
+    /// A and B (in scene mode both are the one file).
+    pub inputs: [std::sync::Arc<LoadedInput>; 2],
+    /// The settings as the report shows them (tolerances resolved).
+    pub settings: SettingsReport,
+    /// The check: result, parts, part pairs.
+    pub assembly: assembly::Outcome,
+    /// parry3d-f64's answer, when asked.
+    pub cross_check: Option<CrossCheckReport>,
+    /// Connected interferences (with penetration estimates when asked).
+    pub regions: Vec<crate::check::regions::Region>,
+    /// Indices into `assembly.result.pairs` of the pairs the report lists: all of them, or when
+    /// there are more than `max_pairs`, the worst (crossing, then touching, then within the
+    /// touch tolerance, then clearance by distance), sorted by (a, b).
+    pub listed: Vec<usize>,
+    /// The finding ids of the listed pairs (same order).
+    pub listed_ids: Vec<String>,
+    /// When the list is cut: the ids of every finding it does not show, so that this report
+    /// can serve as a complete baseline.
+    pub unlisted: Option<crate::report::UnlistedFindings>,
+    /// The baseline comparison (`--baseline`).
+    pub comparison: Option<Comparison>,
+    /// The scene self-check block (`scene --self`).
+    pub self_check: Option<SceneSelfReport>,
+    /// Shards a partial merge is missing.
+    pub missing_shards: Vec<String>,
+    /// The one decision: does this run fail (exit 1)?
+    pub failed: bool,
+    /// Load and total times in ms (None in deterministic mode).
+    pub times: Option<(f64, f64)>,
+}
+
+impl Outcome {
+    /// The two meshes the check ran on.
+    pub fn meshes(&self) -> [&Mesh; 2] {
+        [&self.inputs[0].input.mesh, &self.inputs[1].input.mesh]
+    }
+
+    /// Loader and units warnings, each prefixed with its file (in scene mode once).
+    pub fn warnings(&self) -> Vec<String> {
+        let inputs: Vec<&Input> = if std::sync::Arc::ptr_eq(&self.inputs[0], &self.inputs[1]) {
+            vec![&self.inputs[0].input]
+        } else {
+            self.inputs.iter().map(|i| &i.input).collect()
+        };
+        inputs
+            .iter()
+            .flat_map(|i| i.warnings.iter().map(move |w| format!("{}: {}", i.path.display(), w)))
+            .collect()
+    }
+}
+
+/// Load input `i` of `req`: units, placement, `--split-bodies`.
+fn load_input(req: &Request, i: usize, flag: &str) -> Result<LoadedInput> {
+    let r = &req.inputs[i];
+    let spec = InputSpec { path: r.path().to_path_buf(), transform: r.transform };
+    let (loaded, format, array) = match &r.source {
+        Source::File(p) => {
+            let (loaded, format) = crate::load::load_path(p)?;
+            (loaded, format, false)
+        }
+        Source::Mesh { mesh, .. } => (Loaded { mesh: mesh.clone(), warnings: Vec::new() }, Format::Obj, true),
+    };
+    let (mut input, units) = if req.units.active() {
+        let (multiplier, block, warning) = req.units.resolve(i, format, flag);
+        (query::prepare_input(&spec, loaded, format, multiplier, warning)?, Some(block))
+    } else {
+        (query::prepare_input(&spec, loaded, format, 1.0, None)?, None)
+    };
+    if req.split_bodies {
+        crate::scene::bodies::split_bodies(&mut input.mesh);
+    }
+    Ok(LoadedInput { input, transform: r.transform, units, array })
+}
+
+/// The input whose file a selection error names: A's when A's selection (`--select-a`,
+/// `--exclude`) leaves no part (the side checked first), else B's; in scene mode the one file.
+fn problem_side(req: &Request, a: &Mesh) -> usize {
+    use crate::check::assembly::{glob_match, parts_of};
+    let sel = &req.selection;
+    let kept = |name: &str| {
+        (sel.select_a.is_empty() || sel.select_a.iter().any(|g| glob_match(g, name)))
+            && !sel.exclude.iter().any(|g| glob_match(g, name))
+    };
+    let a_empty = !parts_of(a, 0).iter().any(|p| kept(&p.name));
+    if !sel.scene && a_empty {
+        0
+    } else {
+        req.inputs.len() - 1
+    }
+}
+
+/// How bad a pair is, for choosing which pairs a cut list keeps (smaller is worse).
+fn severity(p: &PairFinding) -> (u8, f64) {
+    match (p.kind, p.contact) {
+        (PairKind::Crossing, _) => (0, 0.0),
+        (PairKind::Touching, Some(_)) => (1, 0.0),
+        (PairKind::Touching, None) => (2, p.distance),
+        (PairKind::Clearance, _) => (3, p.distance),
+    }
+}
+
+/// Indices of the pairs a list of at most `max` shows: all when they fit, else the `max` worst
+/// (ties by (a, b)), in (a, b) order. `pairs` is sorted by (a, b).
+pub fn listed_pairs(pairs: &[PairFinding], max: usize) -> Vec<usize> {
+    if pairs.len() <= max {
+        return (0..pairs.len()).collect();
+    }
+    let mut idx: Vec<usize> = (0..pairs.len()).collect();
+    let key = |&i: &usize| {
+        let (s, d) = severity(&pairs[i]);
+        (s, d.to_bits(), i)
+    };
+    if max > 0 {
+        idx.select_nth_unstable_by_key(max - 1, key);
+    }
+    idx.truncate(max);
+    idx.sort_unstable();
+    idx
+}
+
+/// Run a check: see the module docs. `progress` is called as each phase starts.
+pub fn run(req: &Request, progress: &(dyn Fn(Phase) + Sync)) -> Result<Outcome> {
+    req.validate()?;
+    // Read the baseline first: a bad one costs nothing, and it is read before any output is
+    // written (so `--baseline r.json -o r.json` updates a baseline in place).
+    let base = req.baseline.as_deref().map(baseline::read).transpose()?;
+    progress(Phase::Load);
+    let t0 = Instant::now();
+    let inputs = if req.selection.scene {
+        let one = std::sync::Arc::new(load_input(req, 0, "--units-a")?);
+        [one.clone(), one]
+    } else {
+        let (a, b) = rayon::join(|| load_input(req, 0, "--units-a"), || load_input(req, 1, "--units-b"));
+        [std::sync::Arc::new(a?), std::sync::Arc::new(b?)]
+    };
+    let (a, b) = (&inputs[0].input, &inputs[1].input);
+    let load_ms = t0.elapsed().as_secs_f64() * 1e3;
+    let size = Aabb::of_points(&a.mesh.positions).union(Aabb::of_points(&b.mesh.positions)).extent().length();
+    let mut settings = req.settings;
+    settings.tolerances =
+        Tolerances { touch: req.touch.resolve(size), clearance: req.clearance.resolve(size) };
+    if !settings.tolerances.touch.is_finite() || !settings.tolerances.clearance.is_finite() {
+        return Err(Error::usage(UsageProblem::ToleranceOverflow));
+    }
+    progress(Phase::Check);
+    let outcome = assembly::run(&a.mesh, &b.mesh, &req.selection, &settings).map_err(|e| {
+        Error::in_file(req.inputs[problem_side(req, &a.mesh)].path(), InputProblem::Selection(e))
+    })?;
+    let cross_check = if req.cross_check {
+        progress(Phase::CrossCheck);
+        let p = crate::check::cross_check::parry_f64(&a.mesh, &b.mesh, true)
+            .map_err(|e| Error::bad_flag("cross-check", UsageProblem::CrossCheck(e.to_string())))?;
+        Some(crate::report::cross_check_report(&outcome.result, &p, req.max_pairs, req.deterministic))
+    } else {
+        None
+    };
+    progress(Phase::Write);
+    let result = &outcome.result;
+    let mut regions = crate::check::regions::regions(&result.pairs, &a.mesh, &b.mesh);
+    if req.penetration && !settings.first_hit {
+        let opts = BuildOptions::default();
+        crate::check::regions::estimate_penetration(&mut regions, &result.pairs, &a.mesh, &b.mesh, opts);
+    }
+    let listed = listed_pairs(&result.pairs, req.max_pairs);
+    let cut = listed.len() < result.pairs.len();
+    // Every finding's id when the list is cut (the report records the unlisted ones) or a
+    // baseline compares; else only the listed pairs'.
+    let all: Option<Vec<Finding>> =
+        (cut || base.is_some()).then(|| baseline::findings(&result.pairs, &a.mesh, &b.mesh));
+    let listed_ids: Vec<String> = match &all {
+        Some(f) => listed.iter().map(|&i| f[i].id.clone()).collect(),
+        None => {
+            let pairs: Vec<PairFinding> = listed.iter().map(|&i| result.pairs[i]).collect();
+            baseline::findings(&pairs, &a.mesh, &b.mesh).into_iter().map(|f| f.id).collect()
+        }
+    };
+    let unlisted = match (&all, cut) {
+        (Some(f), true) => Some(baseline::unlisted(f, &listed)),
+        _ => None,
+    };
+    let contained = crate::report::ReportContainment::of(&result.containment);
+    let comparison = match (&base, &all) {
+        (Some(base), Some(all)) => Some(compare(base, all, &listed, contained)),
+        _ => None,
+    };
+    let self_check = req.self_check.as_ref().map(|fail_on| {
+        self_block::scene_self_block(
+            &a.mesh,
+            &req.selection,
+            req.settings.bvh,
+            fail_on,
+            req.max_pairs,
+            req.deterministic,
+        )
+    });
+    let failed = decide(
+        req.gate,
+        result.verdict,
+        comparison.as_ref().map(|c| &c.block),
+        self_check.as_ref(),
+        &req.missing_shards,
+    );
+    let threads = rayon::current_num_threads();
+    let settings_report = SettingsReport {
+        touch_tolerance: settings.tolerances.touch,
+        clearance: settings.tolerances.clearance,
+        touch_tolerance_given: req.touch.spec(),
+        clearance_given: req.clearance.spec(),
+        model_size: size,
+        units: req.units.report_name().into(),
+        fail_on: req.gate.name().into(),
+        bvh: req.settings.bvh.strategy.name().into(),
+        mode: req.settings.mode.name().into(),
+        first_hit: req.settings.first_hit,
+        penetration: req.penetration,
+        distance_rel_err: req.settings.distance_error.rel,
+        distance_abs_err: req.settings.distance_error.abs,
+        leaf_size: req.settings.bvh.leaf_size,
+        max_pairs: req.max_pairs,
+        threads: (!req.deterministic).then_some(threads),
+        detail: (req.settings.detail != Detail::Pairs).then(|| req.settings.detail.name().into()),
+    };
+    Ok(Outcome {
+        settings: settings_report,
+        assembly: outcome,
+        cross_check,
+        regions,
+        listed,
+        listed_ids,
+        unlisted,
+        comparison,
+        self_check,
+        missing_shards: req.missing_shards.clone(),
+        failed,
+        times: (!req.deterministic).then(|| (load_ms, t0.elapsed().as_secs_f64() * 1e3)),
+        inputs,
+    })
+}
+
+/// Compare every finding of this run (`all`, in pair order) with a complete baseline.
+fn compare(
+    base: &Baseline,
+    all: &[Finding],
+    listed: &[usize],
+    contained: Option<crate::report::ReportContainment>,
+) -> Comparison {
+    let block = baseline::compare(all, base, contained);
+    let persistent = listed.iter().map(|&i| base.contains(&all[i].id)).collect();
+    Comparison { block, persistent }
+}
+
+/// The one fail decision of a run.
+///
+/// - the gate: the verdict at or above `--fail-on`, or with `--fail-on new` a new crossing or a
+///   new containment against the baseline;
+/// - a failing scene self-check (its own `--self-fail-on`) fails the run whatever the gate;
+/// - a partial merge never passes: the missing shards may hold what would fail it.
+pub fn decide(
+    gate: Gate,
+    verdict: query::Verdict,
+    comparison: Option<&BaselineReport>,
+    self_check: Option<&SceneSelfReport>,
+    missing_shards: &[String],
+) -> bool {
+    let gate_fails = match gate {
+        Gate::Verdict(f) => f.fails(verdict),
+        // Validation guarantees a baseline; without one nothing could be called new, so fail.
+        Gate::New => comparison.is_none_or(baseline::fails_on_new),
+    };
+    gate_fails || self_check.is_some_and(|s| s.failed) || !missing_shards.is_empty()
+}

@@ -1,0 +1,158 @@
+//! The report of a run: a pure projection of the pipeline's [`Outcome`] into the wire format
+//! of [`crate::report`]. It computes nothing that decides: the verdict, the fail decision, the
+//! regions, the finding ids and the baseline comparison are the outcome's. Nothing writes to a
+//! [`Report`] after [`build`] returns it.
+
+use super::{LoadedInput, Outcome};
+use crate::check::query::{MeshInfo, PairFinding, TreeStats};
+use crate::geom::Aabb;
+use crate::report::*;
+use glam::DMat4;
+
+fn input_report(l: &LoadedInput, info: &MeshInfo, closed: Option<bool>) -> InputReport {
+    let Aabb { min, max } = info.bounds;
+    let input = &l.input;
+    InputReport {
+        path: input.path.display().to_string(),
+        format: if l.array { ARRAY_FORMAT.to_string() } else { input.format.name().to_string() },
+        vertices: info.vertices,
+        triangles: info.triangles,
+        degenerate_triangles: info.degenerate_triangles,
+        closed,
+        objects: info.objects.iter().map(|(n, t)| ObjectReport { name: n.clone(), triangles: *t }).collect(),
+        bounds: Bounds { min: v3(min), max: v3(max) },
+        transform: (l.transform != DMat4::IDENTITY).then(|| l.transform.transpose().to_cols_array().to_vec()),
+        units: l.units.clone(),
+    }
+}
+
+fn tree_report(s: &TreeStats) -> TreeReport {
+    TreeReport {
+        nodes: s.nodes,
+        leaves: s.leaves,
+        depth: s.depth,
+        sah_cost: s.sah_cost,
+        bytes: s.bytes,
+        cells: s.cells,
+    }
+}
+
+fn pair_report(p: &PairFinding, ca: &[u32], cb: &[u32]) -> PairReport {
+    PairReport {
+        a: p.a,
+        b: p.b,
+        a_object: ca[p.a as usize],
+        b_object: cb[p.b as usize],
+        kind: p.kind.into(),
+        contact: match (p.contact, p.kind) {
+            (Some(c), _) => Some(c.into()),
+            (None, crate::check::query::PairKind::Touching) => Some(ReportContact::WithinTolerance),
+            (None, _) => None,
+        },
+        distance: p.distance,
+        segment: p.segment.map(|[s, t]| [v3(s), v3(t)]),
+        id: None,
+        status: None,
+    }
+}
+
+/// The report of a run: a projection of the pipeline's [`Outcome`], computing nothing that
+/// decides (the verdict, the fail decision, regions, ids and the baseline comparison are the
+/// outcome's).
+pub fn build(o: &Outcome) -> Report {
+    let [ia, ib] = [&o.inputs[0], &o.inputs[1]];
+    let r = &o.assembly.result;
+    let (infa, infb) = (MeshInfo::of(&ia.input.mesh), MeshInfo::of(&ib.input.mesh));
+    let (oa, ob) = (&ia.input.mesh.tri_object, &ib.input.mesh.tri_object);
+    let (assembly, parts, part_pairs) = assembly_view(&o.assembly, o.settings.max_pairs);
+    let pairs = o
+        .listed
+        .iter()
+        .enumerate()
+        .map(|(k, &i)| {
+            let mut p = pair_report(&r.pairs[i], oa, ob);
+            p.id = o.listed_ids.get(k).cloned();
+            p.status =
+                o.comparison.as_ref().map(|c| if c.persistent[k] { "persistent" } else { "new" }.to_string());
+            p
+        })
+        .collect();
+    Report {
+        complete: (!o.missing_shards.is_empty()).then_some(false),
+        missing_shards: o.missing_shards.clone(),
+        schema: SCHEMA.to_string(),
+        tool: Tool::this(),
+        inputs: Inputs { a: input_report(ia, &infa, r.closed[0]), b: input_report(ib, &infb, r.closed[1]) },
+        settings: o.settings.clone(),
+        verdict: r.verdict.into(),
+        failed: o.failed,
+        summary: Summary {
+            crossing_pairs: r.counts.crossing,
+            touching_pairs: r.counts.touching,
+            within_tolerance_pairs: r.counts.within_tolerance,
+            clearance_pairs: r.counts.clearance,
+            min_distance: r.closest.map(|c| c.distance),
+            contained: ReportContainment::of(&r.containment),
+            contained_reason: match &r.containment {
+                crate::check::containment::Containment::Undecided(why) => Some(why.clone()),
+                _ => None,
+            },
+        },
+        closest: r.closest.map(|c| ClosestReport {
+            distance: c.distance,
+            a: Witness { triangle: c.a.0, object: oa[c.a.0 as usize], point: v3(c.a.1) },
+            b: Witness { triangle: c.b.0, object: ob[c.b.0 as usize], point: v3(c.b.1) },
+        }),
+        pairs,
+        pairs_truncated: o.listed.len() < r.pairs.len() || (r.pairs.is_empty() && r.counts.total() > 0),
+        unlisted: o.unlisted.clone(),
+        bvh: Trees { a: tree_report(&r.trees[0]), b: tree_report(&r.trees[1]) },
+        cross_check: o.cross_check.clone(),
+        assembly,
+        parts,
+        part_pairs,
+        regions: o
+            .regions
+            .iter()
+            .map(|g| RegionReport {
+                a_name: ia.input.mesh.objects[g.objects.0 as usize].name.clone(),
+                b_name: ib.input.mesh.objects[g.objects.1 as usize].name.clone(),
+                id: g.id.clone(),
+                a_object: g.objects.0,
+                b_object: g.objects.1,
+                pairs: g.pairs,
+                crossing_pairs: g.crossing,
+                center: v3(g.center),
+                bounds: Bounds { min: v3(g.bounds.min), max: v3(g.bounds.max) },
+                extent: g.extent,
+                penetration: g.penetration.map(|p| PenetrationReport {
+                    depth: p.depth,
+                    point: v3(p.point),
+                    side: if p.side == 0 { "a_in_b" } else { "b_in_a" }.to_string(),
+                    samples: p.samples,
+                }),
+            })
+            .collect(),
+        warnings: o.warnings(),
+        timings_ms: o.times.map(|(load, total)| TimingsReport {
+            load,
+            build: r.timings.build_ms,
+            query: r.timings.query_ms,
+            total,
+        }),
+        baseline: o.comparison.as_ref().map(|c| c.block.clone()),
+        self_check: o.self_check.clone(),
+    }
+}
+
+impl From<crate::narrow::tri_tri::Contact> for ReportContact {
+    fn from(c: crate::narrow::tri_tri::Contact) -> Self {
+        use crate::narrow::tri_tri::Contact;
+        match c {
+            Contact::Point => ReportContact::Point,
+            Contact::Segment => ReportContact::Segment,
+            Contact::CoplanarArea => ReportContact::CoplanarArea,
+            Contact::CoplanarBoundary => ReportContact::CoplanarBoundary,
+        }
+    }
+}
