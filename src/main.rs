@@ -26,8 +26,13 @@ fn main() -> ExitCode {
             return Code::Error.into();
         }
         Err(e) => {
-            let _ = e.print(); // --help, --version
-            return ExitCode::SUCCESS;
+            // --help, --version: to stdout, and a stdout that cannot take them is an error.
+            let text = if std::io::stdout().is_terminal() {
+                e.render().ansi().to_string()
+            } else {
+                e.render().to_string()
+            };
+            return print_stdout(&text);
         }
     };
     if let Some(cli::Command::ClashSet(set)) = args.command {

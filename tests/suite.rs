@@ -56,6 +56,8 @@ mod self_clash;
 mod self_scene;
 #[path = "shard.rs"]
 mod shard;
+#[path = "shard_limits.rs"]
+mod shard_limits;
 #[path = "tri_tri_oracle.rs"]
 mod tri_tri_oracle;
 #[path = "trust.rs"]

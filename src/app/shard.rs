@@ -17,7 +17,9 @@ use meshclash::check::assembly::Hook;
 use meshclash::error::{Error, InputProblem, Reading, Result, UsageProblem};
 use meshclash::output::write::{self, Staged};
 use meshclash::shard::plan::{self, Plan, PlanInput};
-use meshclash::shard::{sha256, Covered, MergeHook, PlanHook, ShardHook, ShardReport, SHARD_SCHEMA};
+use meshclash::shard::{
+    sha256, Covered, MergeHook, PlanHook, ShardHook, ShardReport, MAX_SHARDS, SHARD_SCHEMA,
+};
 use std::collections::{BTreeMap, BTreeSet};
 use std::path::{Path, PathBuf};
 use std::sync::{Arc, Mutex};
@@ -262,7 +264,8 @@ pub fn shard_index(shard: Option<&str>, shards: Option<usize>) -> Result<(usize,
                     let i = v
                         .checked_sub(base)
                         .ok_or_else(|| usage(format!("{name}={v} is below its base {base}")))?;
-                    found = Some((name, i + 1));
+                    let i = i.checked_add(1).ok_or_else(|| usage(format!("{name}={v} is out of range")))?;
+                    found = Some((name, i));
                     break;
                 }
             }
@@ -289,6 +292,9 @@ pub fn shard_index(shard: Option<&str>, shards: Option<usize>) -> Result<(usize,
     };
     if n == 0 || i == 0 || i > n {
         return Err(usage(format!("shard {i}/{n} does not exist: shards are 1/N to N/N with N >= 1")));
+    }
+    if n > MAX_SHARDS {
+        return Err(usage(format!("{n} shards: at most {MAX_SHARDS} shards of one plan")));
     }
     Ok((i, n))
 }
@@ -349,6 +355,7 @@ fn run_shard(a: &RunArgs, plan: &Plan, plan_hash: &str, i: usize, n: usize) -> R
         needed: meshclash::shard::needed_parts(plan.pairs.iter().map(|p| (p.a, p.b)), &plan.extra_needed),
         owned,
         bvh: cfg.request.settings.bvh,
+        parts: plan.parts,
         captured: Mutex::new(None),
     });
     cfg.request.selection.hook = Some(Hook(hook.clone()));
@@ -428,6 +435,12 @@ pub fn validate(
                     reference.display(),
                     &hash[..12.min(hash.len())]
                 ),
+            ));
+        }
+        if r.shards > MAX_SHARDS || r.shard > MAX_SHARDS {
+            return Err(invalid(
+                f,
+                format!("shard {}/{}: at most {MAX_SHARDS} shards of one plan", r.shard, r.shards),
             ));
         }
         if r.shards != n {

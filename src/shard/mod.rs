@@ -28,6 +28,10 @@ use std::collections::{BTreeSet, HashMap, HashSet};
 use std::sync::Mutex;
 use wire::WireOutcome;
 
+/// The most shards one plan may be split into (a count is data from a command line, an
+/// engine's variable or a shard report: nothing is allocated per shard beyond this).
+pub const MAX_SHARDS: usize = 1_000_000;
+
 /// `schema` of a shard report.
 pub const SHARD_SCHEMA: &str = "meshclash.shard/1";
 
@@ -222,6 +226,8 @@ pub struct ShardHook {
     pub owned: BTreeSet<usize>,
     /// Tree options of the check.
     pub bvh: crate::bvh::BuildOptions,
+    /// The plan's part count (the inputs must have as many).
+    pub parts: usize,
     /// The outcome and the tree sizes, once seen.
     pub captured: Mutex<Option<Captured>>,
 }
@@ -236,6 +242,13 @@ impl PartsHook for ShardHook {
         parts: &[Part],
         selected: [usize; 2],
     ) -> Option<Result<Outcome, String>> {
+        if parts.len() != self.parts {
+            return Some(Err(format!(
+                "the inputs have {} parts, the plan {}: plan again",
+                parts.len(),
+                self.parts
+            )));
+        }
         (self.files && !self.has_files_unit).then(|| Ok(empty_outcome(parts, selected, "files")))
     }
     fn seen(&self, meshes: [&Mesh; 2], o: &Outcome) {
@@ -276,6 +289,36 @@ impl PartsHook for MergeHook {
     fn seen(&self, _: [&Mesh; 2], _: &Outcome) {}
 }
 
+/// Every triangle index of a shard's outcome names a triangle of its mesh (a shard report is data
+/// from a file).
+fn in_range(o: &Outcome, meshes: [&Mesh; 2]) -> Result<(), String> {
+    let n = [meshes[0].triangles.len(), meshes[1].triangles.len()];
+    let check = |side: usize, t: u32| {
+        if (t as usize) < n[side] {
+            Ok(())
+        } else {
+            Err(format!("triangle index {t} out of range ({} triangles)", n[side]))
+        }
+    };
+    let r = &o.result;
+    for p in &r.pairs {
+        check(0, p.a)?;
+        check(1, p.b)?;
+    }
+    let closest = r.closest.iter().chain(o.part_pairs.iter().filter_map(|p| p.closest.as_ref()));
+    for c in closest {
+        check(0, c.a.0)?;
+        check(1, c.b.0)?;
+    }
+    for pp in &o.part_pairs {
+        for &(a, b) in &pp.pairs {
+            check(0, a)?;
+            check(1, b)?;
+        }
+    }
+    Ok(())
+}
+
 impl MergeHook {
     fn merge(&self, meshes: [&Mesh; 2], parts: &[Part], selected: [usize; 2]) -> Result<Outcome, String> {
         if parts.len() != self.plan.parts {
@@ -285,9 +328,11 @@ impl MergeHook {
         for s in &self.shards {
             // A shard without work (files mode) carries an empty stand-in: leave it out.
             if let (Some(o), false) = (&s.outcome, s.pairs.is_empty()) {
-                outcomes.push(
-                    o.outcome(parts.len()).map_err(|e| format!("shard {}/{}: {e}", s.shard, s.shards))?,
-                );
+                let o = o
+                    .outcome(parts.len())
+                    .and_then(|o| in_range(&o, meshes).map(|()| o))
+                    .map_err(|e| format!("shard {}/{}: {e}", s.shard, s.shards))?;
+                outcomes.push(o);
             }
         }
         if self.plan.mode == "files" {

@@ -119,13 +119,16 @@ pub fn pair_cost(a: &Part, b: &Part, margin: f64) -> u64 {
 pub fn partition(pairs: &[PlanPair], n: usize) -> Vec<usize> {
     let mut order: Vec<usize> = (0..pairs.len()).collect();
     order.sort_by_key(|&i| (std::cmp::Reverse(pairs[i].cost), i));
+    // More shards than pairs: each pair gets an empty shard, the lowest first, so only the
+    // first `pairs.len()` shards can hold any (the rest are empty; no memory per shard).
+    let bins = n.min(pairs.len()).max(1);
     let mut heap: std::collections::BinaryHeap<std::cmp::Reverse<(u64, usize)>> =
-        (0..n).map(|s| std::cmp::Reverse((0u64, s))).collect();
+        (0..bins).map(|s| std::cmp::Reverse((0u64, s))).collect();
     let mut of = vec![0usize; pairs.len()];
     for i in order {
         let std::cmp::Reverse((load, s)) = heap.pop().expect("n > 0");
         of[i] = s;
-        heap.push(std::cmp::Reverse((load + pairs[i].cost, s)));
+        heap.push(std::cmp::Reverse((load.saturating_add(pairs[i].cost), s)));
     }
     of
 }
@@ -140,6 +143,17 @@ impl Plan {
             None => return Err(format!("no schema field (not a {PLAN_SCHEMA} file)")),
         }
         let p: Plan = serde_json::from_value(v).map_err(|e| format!("bad plan: {e}"))?;
+        // Indices are data from a file: every one must name a part of the plan.
+        let bad = |i: usize| i >= p.parts;
+        if let Some(i) = p
+            .pairs
+            .iter()
+            .flat_map(|q| q.a.into_iter().chain(q.b))
+            .chain(p.extra_needed.iter().copied())
+            .find(|&i| bad(i))
+        {
+            return Err(format!("part index {i} out of range (the plan has {} parts)", p.parts));
+        }
         if p.tool_version != env!("CARGO_PKG_VERSION") {
             return Err(format!(
                 "written by meshclash {}, this is {}: plan again with this version",
@@ -162,6 +176,15 @@ mod tests {
 
     fn pp(cost: u64) -> PlanPair {
         PlanPair { id: String::new(), a: Some(0), b: Some(1), names: ["a".into(), "b".into()], cost }
+    }
+
+    #[test]
+    fn more_shards_than_pairs_cost_nothing_and_match_the_one_pair_per_shard_split() {
+        let pairs: Vec<PlanPair> = [5, 9, 1].into_iter().map(pp).collect();
+        let few = partition(&pairs, 3);
+        assert_eq!(partition(&pairs, usize::MAX), few);
+        assert_eq!(partition(&pairs, 10_000_000_000), few);
+        assert!(partition(&[], usize::MAX).is_empty());
     }
 
     #[test]

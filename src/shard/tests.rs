@@ -124,6 +124,7 @@ fn plan_shards_merge_equals_the_single_check_on_random_layouts() {
                     needed: needed.clone(),
                     owned: owners.iter().filter(|(_, &s)| s == i).map(|(&p, _)| p).collect(),
                     bvh: settings.bvh,
+                    parts: plan.parts,
                     captured: Mutex::new(None),
                 });
                 assembly::run(&mesh, &mesh, &hooked(&sel, hook.clone()), &settings).unwrap();
