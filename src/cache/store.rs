@@ -168,7 +168,10 @@ impl Store {
                     if !(is_fanout_name(&name) || name.starts_with(TEMP_PREFIX) || name == TAG_FILE) {
                         return Err(open_error(
                             &dir,
-                            format!("is not empty and not a meshclash cache (it holds '{name}'); give an empty or new directory"),
+                            format!(
+                                "is not empty and not a meshclash cache (it holds '{name}'); \
+                                 give an empty or new directory"
+                            ),
                         ));
                     }
                 }
@@ -276,7 +279,8 @@ impl Store {
         if len > limit {
             if !self.too_large_warned.swap(true, Ordering::Relaxed) {
                 self.warn(format!(
-                    "cache: a result of {len} bytes is over the {limit}-byte entry limit; such results are not stored"
+                    "cache: a result of {len} bytes is over the {limit}-byte entry limit; \
+                     such results are not stored"
                 ));
             }
             return;
