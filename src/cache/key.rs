@@ -5,6 +5,7 @@
 
 use glam::DVec3;
 
+use crate::check::assembly::Part;
 use crate::scene::mesh::Mesh;
 use crate::shard::sha256::Sha256;
 
@@ -78,6 +79,13 @@ impl PartKey {
     /// space (placed, in the run's units).
     pub fn of_mesh_part(name: &str, mesh: &Mesh, triangles: &[u32]) -> PartKey {
         PartKey::of(name, triangles.iter().map(|&t| crate::bvh::triangle(mesh, t)))
+    }
+
+    /// The keys of `parts` of `mesh` (world space), each named by its [`Part::name`], in the
+    /// order of `parts`; computed in parallel (the keys do not depend on the thread count).
+    pub fn of_parts(mesh: &Mesh, parts: &[Part]) -> Vec<PartKey> {
+        use rayon::prelude::*;
+        parts.par_iter().map(|p| PartKey::of_mesh_part(&p.name, mesh, &p.triangles)).collect()
     }
 
     /// The 32 digest bytes.

@@ -90,6 +90,14 @@ fn part_key_of_a_mesh_part_and_incrementally_agree() {
     };
     let direct = PartKey::of("n", [[DVec3::ZERO, DVec3::Y, DVec3::Z], [DVec3::X, DVec3::Y, DVec3::Z]]);
     assert_eq!(PartKey::of_mesh_part("n", &mesh, &[1, 2]), direct);
+    let objects = ["x", "y"].map(|n| crate::scene::mesh::Object { name: n.into(), ..Default::default() });
+    let mesh = Mesh { tri_object: vec![1, 0, 1], objects: objects.to_vec(), ..mesh };
+    let parts = crate::check::assembly::parts_of(&mesh, 0);
+    let keys: Vec<PartKey> =
+        parts.iter().map(|p| PartKey::of_mesh_part(&p.name, &mesh, &p.triangles)).collect();
+    assert_eq!(keys.len(), 2);
+    assert_ne!(keys[0], keys[1]);
+    assert_eq!(PartKey::of_parts(&mesh, &parts), keys);
     let mut h = PartHasher::new("n");
     h.triangle([DVec3::ZERO, DVec3::Y, DVec3::Z]);
     h.triangle([DVec3::X, DVec3::Y, DVec3::Z]);
