@@ -35,6 +35,9 @@ const TAG: &str = "Signature: 8a477f597d28d172789f06886806bc55\n\
                    # This directory is a meshclash result cache: every entry is re-created on demand.\n";
 const TAG_MARK: &str = "meshclash result cache";
 
+/// The most of a tag file that is read (ours is under 200 bytes).
+const MAX_TAG_BYTES: u64 = 4096;
+
 /// The name prefix of temporary files (an entry being written, the tag being written).
 const TEMP_PREFIX: &str = ".tmp-";
 
@@ -150,15 +153,15 @@ impl Store {
             Err(e) => return Err(open_error(&dir, format!("cannot inspect: {e}"))),
         }
         let tag = dir.join(TAG_FILE);
-        match fs::read(&tag) {
-            Ok(t) if String::from_utf8_lossy(&t).contains(TAG_MARK) => {}
-            Ok(_) => {
+        match read_tag(&tag) {
+            Ok(Some(t)) if String::from_utf8_lossy(&t).contains(TAG_MARK) => {}
+            Ok(Some(_)) => {
                 return Err(open_error(
                     &dir,
                     "holds another program's CACHEDIR.TAG; give meshclash a directory of its own",
                 ))
             }
-            Err(e) if e.kind() == io::ErrorKind::NotFound => {
+            Ok(None) => {
                 let listing =
                     fs::read_dir(&dir).map_err(|e| open_error(&dir, format!("cannot list: {e}")))?;
                 for item in listing {
@@ -178,7 +181,7 @@ impl Store {
                 write_atomically(&dir, &tag, TAG.as_bytes())
                     .map_err(|e| open_error(&dir, format!("is not writable: {e}")))?;
             }
-            Err(e) => return Err(open_error(&dir, format!("cannot read {TAG_FILE}: {e}"))),
+            Err(why) => return Err(open_error(&dir, format!("{TAG_FILE}: {why}"))),
         }
         // The tag may predate a permission change: prove a file can be created.
         tempfile::Builder::new()
@@ -453,15 +456,10 @@ fn write_atomically(dir: &Path, path: &Path, bytes: &[u8]) -> io::Result<()> {
     Ok(())
 }
 
-/// Open and read the entry at `path`: `None` if there is none; the open file (to touch) and
-/// its bytes when the header matches `key` and this build; else why not. The file is opened
-/// without following a symbolic link and without blocking (a FIFO planted there cannot hang
-/// the run); nothing is allocated beyond `limit` bytes or what the file holds.
-fn read_entry(
-    path: &Path,
-    key: &PairKey,
-    limit: u64,
-) -> std::result::Result<Option<(File, Vec<u8>)>, Rejected> {
+/// Open `path` without following a symbolic link and without blocking (a FIFO planted there
+/// cannot hang the run): `None` if there is none; the file and its length if it is a regular
+/// file of at most `limit` bytes; else why not.
+fn open_regular(path: &Path, limit: u64) -> std::result::Result<Option<(File, u64)>, Rejected> {
     let flags = OFlags::RDONLY | OFlags::NOFOLLOW | OFlags::NONBLOCK | OFlags::CLOEXEC;
     let fd = match rustix::fs::open(path, flags, Mode::empty()) {
         Ok(fd) => fd,
@@ -477,7 +475,26 @@ fn read_entry(
     if len > limit {
         return Err(Rejected::TooLarge { len, limit });
     }
-    let mut file = File::from(fd);
+    Ok(Some((File::from(fd), len)))
+}
+
+/// The tag file's bytes, `None` when there is none.
+fn read_tag(path: &Path) -> std::result::Result<Option<Vec<u8>>, Rejected> {
+    let Some((mut file, len)) = open_regular(path, MAX_TAG_BYTES)? else { return Ok(None) };
+    let mut bytes = vec![0u8; len as usize];
+    file.read_exact(&mut bytes).map_err(|e| Rejected::Io(e.to_string()))?;
+    Ok(Some(bytes))
+}
+
+/// Read the entry at `path`: `None` if there is none; the open file (to touch) and its bytes
+/// when the header matches `key` and this build; else why not. Nothing is allocated beyond
+/// `limit` bytes or what the file holds.
+fn read_entry(
+    path: &Path,
+    key: &PairKey,
+    limit: u64,
+) -> std::result::Result<Option<(File, Vec<u8>)>, Rejected> {
+    let Some((mut file, len)) = open_regular(path, limit)? else { return Ok(None) };
     let mut head = vec![0u8; (len as usize).min(MAX_HEADER)];
     file.read_exact(&mut head).map_err(|e| Rejected::Io(e.to_string()))?;
     entry::check_header(&head, len, key, TOOL_VERSION)?;

@@ -465,6 +465,17 @@ fn open_refuses_what_is_not_a_cache_directory() {
     fs::create_dir(&other).unwrap();
     fs::write(other.join("CACHEDIR.TAG"), "Signature: 8a477f597d28d172789f06886806bc55\n# cargo\n").unwrap();
     assert!(open_err(&other).contains("another program's CACHEDIR.TAG"));
+    // A tag that is a FIFO or a link is not read (no hang, no following).
+    let fifo = d.path().join("fifo");
+    fs::create_dir(&fifo).unwrap();
+    let mode = rustix::fs::Mode::from_raw_mode(0o600);
+    rustix::fs::mknodat(rustix::fs::CWD, &fifo.join("CACHEDIR.TAG"), rustix::fs::FileType::Fifo, mode, 0)
+        .unwrap();
+    assert!(open_err(&fifo).contains("CACHEDIR.TAG: not a regular file"));
+    let linked = d.path().join("linked");
+    fs::create_dir(&linked).unwrap();
+    std::os::unix::fs::symlink(other.join("CACHEDIR.TAG"), linked.join("CACHEDIR.TAG")).unwrap();
+    assert!(open_err(&linked).contains("CACHEDIR.TAG: not a regular file"));
 }
 
 #[test]
