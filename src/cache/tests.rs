@@ -469,7 +469,7 @@ fn open_refuses_what_is_not_a_cache_directory() {
     let fifo = d.path().join("fifo");
     fs::create_dir(&fifo).unwrap();
     let mode = rustix::fs::Mode::from_raw_mode(0o600);
-    rustix::fs::mknodat(rustix::fs::CWD, &fifo.join("CACHEDIR.TAG"), rustix::fs::FileType::Fifo, mode, 0)
+    rustix::fs::mknodat(rustix::fs::CWD, fifo.join("CACHEDIR.TAG"), rustix::fs::FileType::Fifo, mode, 0)
         .unwrap();
     assert!(open_err(&fifo).contains("CACHEDIR.TAG: not a regular file"));
     let linked = d.path().join("linked");
