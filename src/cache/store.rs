@@ -265,6 +265,8 @@ impl Store {
     /// The value is stored only if its encoding decodes back to a value that encodes to the
     /// same bytes (so every f64 comes back bit for bit; a non-finite float, which JSON cannot
     /// hold, is refused here rather than failing every later read); hence `DeserializeOwned`.
+    /// Values must serialize deterministically: a `HashMap` inside (iteration order varies) is
+    /// refused the same way; use `BTreeMap` or a `Vec`.
     pub fn put<T: Serialize + DeserializeOwned>(&self, key: &PairKey, value: &T) {
         if self.writes_off.load(Ordering::Relaxed) {
             return;
