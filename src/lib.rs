@@ -20,6 +20,7 @@
 
 pub mod api;
 pub mod bvh;
+pub mod cache;
 pub mod check;
 pub mod error;
 pub mod geom;

@@ -1,0 +1,329 @@
+//! The keys of the result cache: [`PartKey`] (a part's exact world-space triangles and its
+//! name), [`Fingerprint`] (the settings that change an answer) and [`PairKey`] (two parts, the
+//! settings and the tool version). Every key is a SHA-256 over a byte layout written out in the
+//! doc comment of its constructor and pinned by a test vector.
+
+use glam::DVec3;
+
+use crate::check::assembly::Part;
+use crate::scene::mesh::Mesh;
+use crate::shard::sha256::Sha256;
+
+/// The entry layout number: part of every [`PairKey`] and of every entry's header. Bump it when
+/// the key layouts, the entry header or the meaning of a stored value change, so that entries
+/// written before the change are never found.
+pub const FORMAT: u32 = 1;
+
+/// The tool version that goes into every [`PairKey`] and entry header: a cache written by
+/// another version of meshclash is never read.
+pub const TOOL_VERSION: &str = env!("CARGO_PKG_VERSION");
+
+const PART_TAG: &[u8] = b"meshclash.cache.part\0";
+const SETTINGS_TAG: &[u8] = b"meshclash.cache.settings\0";
+const PAIR_TAG: &[u8] = b"meshclash.cache.pair\0";
+
+/// A SHA-256 digest, the 32 bytes of every key.
+pub type Digest = [u8; 32];
+
+/// The digest of everything fed to `sha`, as bytes.
+pub(crate) fn finish(sha: Sha256) -> Digest {
+    let hex = sha.hex();
+    let mut out = [0u8; 32];
+    for (o, pair) in out.iter_mut().zip(hex.as_bytes().chunks_exact(2)) {
+        *o = (nibble(pair[0]) << 4) | nibble(pair[1]);
+    }
+    out
+}
+
+/// SHA-256 of `data`, as bytes.
+pub(crate) fn digest(data: &[u8]) -> Digest {
+    let mut sha = Sha256::default();
+    sha.update(data);
+    finish(sha)
+}
+
+fn nibble(c: u8) -> u8 {
+    match c {
+        b'0'..=b'9' => c - b'0',
+        b'a'..=b'f' => c - b'a' + 10,
+        _ => unreachable!("Sha256::hex writes lowercase hex digits only"),
+    }
+}
+
+/// `d` as 64 lowercase hex digits.
+pub(crate) fn to_hex(d: &Digest) -> String {
+    d.iter().map(|b| format!("{b:02x}")).collect()
+}
+
+fn put_len(sha: &mut Sha256, n: usize) {
+    sha.update(&(n as u64).to_le_bytes());
+}
+
+/// The key of one part: its exact world-space triangles and its name.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord)]
+pub struct PartKey(Digest);
+
+impl PartKey {
+    /// The key of part `name` whose world-space triangles (after placement and units) are
+    /// `triangles`, in triangle order. The same as feeding them one by one to a [`PartHasher`].
+    pub fn of(name: &str, triangles: impl IntoIterator<Item = [DVec3; 3]>) -> PartKey {
+        let mut h = PartHasher::new(name);
+        for t in triangles {
+            h.triangle(t);
+        }
+        h.finish()
+    }
+
+    /// The key of the part of `mesh` made of triangles `triangles` (indices into
+    /// `mesh.triangles`, in the part's order), named `name`. `mesh` must already be in world
+    /// space (placed, in the run's units).
+    pub fn of_mesh_part(name: &str, mesh: &Mesh, triangles: &[u32]) -> PartKey {
+        PartKey::of(name, triangles.iter().map(|&t| crate::bvh::triangle(mesh, t)))
+    }
+
+    /// The keys of `parts` of `mesh` (world space), each named by its [`Part::name`], in the
+    /// order of `parts`; computed in parallel (the keys do not depend on the thread count).
+    pub fn of_parts(mesh: &Mesh, parts: &[Part]) -> Vec<PartKey> {
+        use rayon::prelude::*;
+        parts.par_iter().map(|p| PartKey::of_mesh_part(&p.name, mesh, &p.triangles)).collect()
+    }
+
+    /// The 32 digest bytes.
+    pub fn as_bytes(&self) -> &Digest {
+        &self.0
+    }
+
+    /// The digest as 64 lowercase hex digits.
+    pub fn hex(&self) -> String {
+        to_hex(&self.0)
+    }
+}
+
+/// Builds a [`PartKey`] triangle by triangle (for parts whose triangles are not in one slice).
+///
+/// The SHA-256 input is, in order, with every integer little-endian:
+///
+/// | bytes | content |
+/// |---|---|
+/// | 21 | the tag `meshclash.cache.part` and a zero byte |
+/// | 8 | the name's length in bytes, u64 |
+/// | n | the name, UTF-8 |
+/// | 72 per triangle | the triangle's three vertices, x, y, z each: `f64::to_bits` as u64 |
+/// | 8 | the number of triangles, u64 |
+///
+/// Bit patterns, not values: `-0.0` and `0.0` give different keys (a miss, never a wrong hit).
+#[derive(Debug, Clone)]
+pub struct PartHasher {
+    sha: Sha256,
+    triangles: u64,
+}
+
+impl PartHasher {
+    /// Start the key of part `name`.
+    pub fn new(name: &str) -> PartHasher {
+        let mut sha = Sha256::default();
+        sha.update(PART_TAG);
+        put_len(&mut sha, name.len());
+        sha.update(name.as_bytes());
+        PartHasher { sha, triangles: 0 }
+    }
+
+    /// Add the next triangle (world space).
+    pub fn triangle(&mut self, t: [DVec3; 3]) {
+        let mut bytes = [0u8; 72];
+        let coords = t.iter().flat_map(|v| [v.x, v.y, v.z]);
+        for (chunk, c) in bytes.chunks_exact_mut(8).zip(coords) {
+            chunk.copy_from_slice(&c.to_bits().to_le_bytes());
+        }
+        self.sha.update(&bytes);
+        self.triangles += 1;
+    }
+
+    /// The key.
+    pub fn finish(mut self) -> PartKey {
+        self.sha.update(&self.triangles.to_le_bytes());
+        PartKey(finish(self.sha))
+    }
+}
+
+/// One setting's value, as the settings [`Fingerprint`] encodes it. Each kind has its own tag,
+/// so `3_u64` and `3.0_f64` are different settings.
+#[derive(Debug, Clone, PartialEq)]
+pub enum Setting {
+    /// Absent (an unset optional setting).
+    None,
+    /// A flag.
+    Bool(bool),
+    /// A whole number.
+    U64(u64),
+    /// A signed whole number.
+    I64(i64),
+    /// A number, by its bit pattern (`-0.0` and `0.0` differ).
+    F64(f64),
+    /// A text (a mode, a detail level, a list rendered canonically by the caller).
+    Str(String),
+}
+
+impl Setting {
+    /// Append this value's bytes: a tag byte then the value, integers little-endian.
+    fn encode(&self, out: &mut Vec<u8>) {
+        match self {
+            Setting::None => out.push(0),
+            Setting::Bool(b) => out.extend([1, u8::from(*b)]),
+            Setting::U64(v) => {
+                out.push(2);
+                out.extend(v.to_le_bytes());
+            }
+            Setting::I64(v) => {
+                out.push(3);
+                out.extend(v.to_le_bytes());
+            }
+            Setting::F64(v) => {
+                out.push(4);
+                out.extend(v.to_bits().to_le_bytes());
+            }
+            Setting::Str(s) => {
+                out.push(5);
+                out.extend((s.len() as u64).to_le_bytes());
+                out.extend(s.as_bytes());
+            }
+        }
+    }
+}
+
+impl From<bool> for Setting {
+    fn from(v: bool) -> Self {
+        Setting::Bool(v)
+    }
+}
+impl From<u64> for Setting {
+    fn from(v: u64) -> Self {
+        Setting::U64(v)
+    }
+}
+impl From<u32> for Setting {
+    fn from(v: u32) -> Self {
+        Setting::U64(v.into())
+    }
+}
+impl From<usize> for Setting {
+    fn from(v: usize) -> Self {
+        Setting::U64(v as u64)
+    }
+}
+impl From<i64> for Setting {
+    fn from(v: i64) -> Self {
+        Setting::I64(v)
+    }
+}
+impl From<f64> for Setting {
+    fn from(v: f64) -> Self {
+        Setting::F64(v)
+    }
+}
+impl From<&str> for Setting {
+    fn from(v: &str) -> Self {
+        Setting::Str(v.to_string())
+    }
+}
+impl From<String> for Setting {
+    fn from(v: String) -> Self {
+        Setting::Str(v)
+    }
+}
+impl<T: Into<Setting>> From<Option<T>> for Setting {
+    fn from(v: Option<T>) -> Self {
+        v.map_or(Setting::None, Into::into)
+    }
+}
+
+/// The fingerprint of the settings that change a part pair's answer (tolerances, mode, detail,
+/// pair limits, penetration, …): whatever is not in it must not change a stored value.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+pub struct Fingerprint(Digest);
+
+impl Fingerprint {
+    /// The fingerprint of `(name, value)` pairs, in any order: it is a function of the set of
+    /// pairs, so callers cannot get the order wrong.
+    ///
+    /// Each pair is encoded as a record: the name's length (u64, little-endian), the name
+    /// (UTF-8), then the value ([`Setting`]: a tag byte `0` none, `1` bool, `2` u64, `3` i64,
+    /// `4` f64 bits, `5` text, followed by the value: one byte for a bool, 8 bytes
+    /// little-endian for numbers, length u64 then UTF-8 for text). The records are sorted
+    /// bytewise; the SHA-256 input is the tag `meshclash.cache.settings` and a zero byte, the
+    /// record count (u64), then the sorted records.
+    pub fn of<'a>(settings: impl IntoIterator<Item = (&'a str, Setting)>) -> Fingerprint {
+        let mut records: Vec<Vec<u8>> = settings
+            .into_iter()
+            .map(|(name, value)| {
+                let mut r = (name.len() as u64).to_le_bytes().to_vec();
+                r.extend(name.as_bytes());
+                value.encode(&mut r);
+                r
+            })
+            .collect();
+        records.sort_unstable();
+        let mut sha = Sha256::default();
+        sha.update(SETTINGS_TAG);
+        put_len(&mut sha, records.len());
+        for r in &records {
+            sha.update(r);
+        }
+        Fingerprint(finish(sha))
+    }
+
+    /// The 32 digest bytes.
+    pub fn as_bytes(&self) -> &Digest {
+        &self.0
+    }
+
+    /// The digest as 64 lowercase hex digits.
+    pub fn hex(&self) -> String {
+        to_hex(&self.0)
+    }
+}
+
+/// The key of one part pair's result: the A-side part, the B-side part (in that order: the
+/// pair (x, y) and the pair (y, x) are different keys), the settings and the tool version.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord)]
+pub struct PairKey(Digest);
+
+impl PairKey {
+    /// The key of the result of part `a` (A side) against part `b` (B side) under `settings`,
+    /// for this build ([`TOOL_VERSION`], [`FORMAT`]).
+    ///
+    /// The SHA-256 input: the tag `meshclash.cache.pair` and a zero byte, the 32 bytes of `a`,
+    /// the 32 bytes of `b`, the 32 bytes of `settings`, [`FORMAT`] (u32, little-endian), the
+    /// tool version's length (u64, little-endian) and the version (UTF-8).
+    pub fn new(a: &PartKey, b: &PartKey, settings: &Fingerprint) -> PairKey {
+        PairKey::for_version(a, b, settings, TOOL_VERSION, FORMAT)
+    }
+
+    pub(crate) fn for_version(
+        a: &PartKey,
+        b: &PartKey,
+        settings: &Fingerprint,
+        version: &str,
+        format: u32,
+    ) -> PairKey {
+        let mut sha = Sha256::default();
+        sha.update(PAIR_TAG);
+        sha.update(&a.0);
+        sha.update(&b.0);
+        sha.update(&settings.0);
+        sha.update(&format.to_le_bytes());
+        put_len(&mut sha, version.len());
+        sha.update(version.as_bytes());
+        PairKey(finish(sha))
+    }
+
+    /// The 32 digest bytes.
+    pub fn as_bytes(&self) -> &Digest {
+        &self.0
+    }
+
+    /// The digest as 64 lowercase hex digits.
+    pub fn hex(&self) -> String {
+        to_hex(&self.0)
+    }
+}

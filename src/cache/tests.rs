@@ -1,0 +1,673 @@
+use std::fs;
+use std::path::Path;
+use std::time::{Duration, SystemTime};
+
+use glam::DVec3;
+use serde::{Deserialize, Serialize};
+
+use super::entry::{self, Rejected, MAGIC};
+use super::*;
+use crate::scene::mesh::Mesh;
+
+fn tri(c: [f64; 9]) -> [DVec3; 3] {
+    [DVec3::new(c[0], c[1], c[2]), DVec3::new(c[3], c[4], c[5]), DVec3::new(c[6], c[7], c[8])]
+}
+
+const UNIT: [f64; 9] = [0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0, 0.0];
+
+fn settings() -> Vec<(&'static str, Setting)> {
+    vec![
+        ("tolerance", 0.01.into()),
+        ("mode", "clash".into()),
+        ("max_pairs", 1000_u64.into()),
+        ("penetration", true.into()),
+        ("detail", None::<&str>.into()),
+    ]
+}
+
+// The digests below were computed independently (Python's hashlib over the byte layouts the
+// doc comments give); they pin the layouts: changing one must bump `FORMAT`.
+#[test]
+fn part_key_test_vector() {
+    let p = PartKey::of("p", [tri(UNIT)]);
+    assert_eq!(p.hex(), "685219fed0199e13eb837b5e3ab6cc4992a6c3be002d1bfb9ee7127654f1acac");
+    let mut q = UNIT;
+    q[8] = -0.0;
+    assert_eq!(
+        PartKey::of("q", [tri(q)]).hex(),
+        "1874258ed4d297c1e4cabc25b4f721007cf829a54c43ded800fa11ecd1cb4967"
+    );
+}
+
+#[test]
+fn settings_fingerprint_test_vector_in_any_order() {
+    let want = "3dda65bb875dfc0d0eef30838d8d1172c5db146c94ac7d080529b5267f6f74c6";
+    let mut s = settings();
+    assert_eq!(Fingerprint::of(s.clone()).hex(), want);
+    s.reverse();
+    assert_eq!(Fingerprint::of(s.clone()).hex(), want);
+    s.rotate_left(2);
+    assert_eq!(Fingerprint::of(s).hex(), want);
+}
+
+#[test]
+fn pair_key_test_vector() {
+    let p = PartKey::of("p", [tri(UNIT)]);
+    let mut q = UNIT;
+    q[8] = -0.0;
+    let q = PartKey::of("q", [tri(q)]);
+    let s = Fingerprint::of(settings());
+    let k = PairKey::for_version(&p, &q, &s, "0.1.0", 1);
+    assert_eq!(k.hex(), "141b1bc5afd6bf93834455276c1948c2c5b06ed6218ec61a0e8fea18b0a73bed");
+    assert_eq!(PairKey::new(&p, &q, &s), PairKey::for_version(&p, &q, &s, TOOL_VERSION, FORMAT));
+}
+
+#[test]
+fn part_key_follows_every_bit_name_and_order() {
+    let a = tri(UNIT);
+    let mut moved = UNIT;
+    moved[3] = f64::from_bits(1.0_f64.to_bits() + 1);
+    let b = tri(moved);
+    let base = PartKey::of("part", [a, b]);
+    assert_eq!(base, PartKey::of("part", [a, b]));
+    assert_ne!(base, PartKey::of("part", [b, a]), "triangle order");
+    assert_ne!(base, PartKey::of("Part", [a, b]), "name");
+    assert_ne!(base, PartKey::of("part", [a, a]), "one ulp of one coordinate");
+    assert_ne!(base, PartKey::of("part", [a]), "triangle count");
+    // The name's length is hashed: a name cannot borrow bytes from the triangles.
+    assert_ne!(PartKey::of("", []), PartKey::of("\0\0\0\0\0\0\0\0", []));
+    // Translated by an exact amount: still a new key (placement is part of the key).
+    let shifted = a.map(|v| v + DVec3::new(1.0, 0.0, 0.0));
+    assert_ne!(PartKey::of("part", [a]), PartKey::of("part", [shifted]));
+}
+
+#[test]
+fn part_key_of_a_mesh_part_and_incrementally_agree() {
+    let mesh = Mesh {
+        positions: vec![DVec3::ZERO, DVec3::X, DVec3::Y, DVec3::Z],
+        triangles: vec![[0, 1, 2], [0, 2, 3], [1, 2, 3]],
+        ..Mesh::default()
+    };
+    let direct = PartKey::of("n", [[DVec3::ZERO, DVec3::Y, DVec3::Z], [DVec3::X, DVec3::Y, DVec3::Z]]);
+    assert_eq!(PartKey::of_mesh_part("n", &mesh, &[1, 2]), direct);
+    let objects = ["x", "y"].map(|n| crate::scene::mesh::Object { name: n.into(), ..Default::default() });
+    let mesh = Mesh { tri_object: vec![1, 0, 1], objects: objects.to_vec(), ..mesh };
+    let parts = crate::check::assembly::parts_of(&mesh, 0);
+    let keys: Vec<PartKey> =
+        parts.iter().map(|p| PartKey::of_mesh_part(&p.name, &mesh, &p.triangles)).collect();
+    assert_eq!(keys.len(), 2);
+    assert_ne!(keys[0], keys[1]);
+    assert_eq!(PartKey::of_parts(&mesh, &parts), keys);
+    let mut h = PartHasher::new("n");
+    h.triangle([DVec3::ZERO, DVec3::Y, DVec3::Z]);
+    h.triangle([DVec3::X, DVec3::Y, DVec3::Z]);
+    assert_eq!(h.finish(), direct);
+}
+
+#[test]
+fn fingerprint_separates_kinds_values_and_absence() {
+    let f = |s: Vec<(&str, Setting)>| Fingerprint::of(s);
+    assert_ne!(f(vec![("n", 3_u64.into())]), f(vec![("n", 3.0.into())]));
+    assert_ne!(f(vec![("n", 3_u64.into())]), f(vec![("n", 3_i64.into())]));
+    assert_ne!(f(vec![("t", 0.0.into())]), f(vec![("t", (-0.0).into())]));
+    assert_ne!(f(vec![("t", None::<f64>.into())]), f(vec![]));
+    assert_eq!(f(vec![("t", Some(2.5).into())]), f(vec![("t", 2.5.into())]));
+    assert_ne!(f(vec![("a", "bc".into())]), f(vec![("ab", "c".into())]));
+    assert_ne!(f(vec![("mode", "clash".into())]), f(vec![("mode", "clearance".into())]));
+    let base = f(settings());
+    let mut s = settings();
+    s[0].1 = 0.010000000000000002.into();
+    assert_ne!(base, f(s));
+}
+
+#[test]
+fn pair_key_follows_sides_settings_version_and_layout() {
+    let p = PartKey::of("p", [tri(UNIT)]);
+    let q = PartKey::of("q", [tri(UNIT)]);
+    let s = Fingerprint::of(settings());
+    let k = PairKey::new(&p, &q, &s);
+    assert_ne!(k, PairKey::new(&q, &p, &s), "sides are ordered");
+    assert_ne!(k, PairKey::new(&p, &q, &Fingerprint::of(vec![])));
+    assert_ne!(k, PairKey::for_version(&p, &q, &s, "0.0.0-other", FORMAT));
+    assert_ne!(k, PairKey::for_version(&p, &q, &s, TOOL_VERSION, FORMAT + 1));
+}
+
+// ---------------------------------------------------------------------------------------------
+// The store.
+
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+struct Outcome {
+    verdict: String,
+    pairs: Vec<(u32, u32)>,
+    closest: Option<f64>,
+    points: Vec<[f64; 3]>,
+}
+
+fn outcome(n: u32) -> Outcome {
+    Outcome {
+        verdict: format!("clash {n}"),
+        pairs: (0..n).map(|i| (i, 2 * i + 1)).collect(),
+        closest: Some(0.1 + 0.2 * f64::from(n)),
+        points: vec![[1.0 / 3.0, -0.0, 5e-324], [f64::MAX, f64::MIN_POSITIVE, -1e300]],
+    }
+}
+
+fn key(n: u32) -> PairKey {
+    let a = PartKey::of(&format!("a{n}"), [tri(UNIT)]);
+    let b = PartKey::of("b", [tri(UNIT)]);
+    PairKey::new(&a, &b, &Fingerprint::of(settings()))
+}
+
+fn store(dir: &Path) -> Store {
+    Store::open(dir, DEFAULT_MAX_BYTES).unwrap()
+}
+
+fn one_warning(s: &Store, needle: &str) {
+    let w = s.take_warnings();
+    assert_eq!(w.len(), 1, "{w:?}");
+    assert!(w[0].contains(needle), "{w:?} lacks {needle:?}");
+    assert!(!w[0].contains('\n'));
+    assert!(w[0].starts_with("cache: "), "{w:?}");
+}
+
+#[test]
+fn put_then_get_returns_the_value_and_counts() {
+    let d = tempfile::tempdir().unwrap();
+    let s = store(d.path());
+    assert_eq!(s.get::<Outcome>(&key(1)), None);
+    s.put(&key(1), &outcome(3));
+    assert_eq!(s.get::<Outcome>(&key(1)), Some(outcome(3)));
+    assert_eq!(s.get::<Outcome>(&key(2)), None);
+    assert_eq!(s.stats(), Stats { hits: 1, misses: 2, stored: 1, evicted: 0, ignored: 0 });
+    assert!(s.take_warnings().is_empty());
+    let hex = key(1).hex();
+    assert_eq!(s.entry_path(&key(1)), d.path().join(&hex[..2]).join(&hex[2..]));
+    assert!(s.entry_path(&key(1)).is_file());
+    assert!(d.path().join("CACHEDIR.TAG").is_file());
+    // Another store on the same directory (a later run) finds it.
+    let again = store(d.path());
+    assert_eq!(again.get::<Outcome>(&key(1)), Some(outcome(3)));
+    let sum = serde_json::to_string(&again.summary()).unwrap();
+    let dir = serde_json::to_string(&d.path().to_string_lossy()).unwrap();
+    assert_eq!(sum, format!(r#"{{"part_pairs_reused":1,"part_pairs_checked":0,"dir":{dir}}}"#));
+}
+
+#[test]
+fn floats_come_back_bit_for_bit() {
+    let d = tempfile::tempdir().unwrap();
+    let s = store(d.path());
+    // Finite f64s from all over the bit space (xorshift), plus the awkward ones.
+    let mut x = 0x9e37_79b9_7f4a_7c15_u64;
+    let mut xs: Vec<f64> = vec![0.0, -0.0, 5e-324, -5e-324, f64::MIN_POSITIVE, f64::MAX, f64::MIN, 0.1 + 0.2];
+    xs.push(f64::from_bits(0x000f_ffff_ffff_ffff)); // largest subnormal
+    xs.push(f64::EPSILON);
+    while xs.len() < 20_000 {
+        x ^= x << 13;
+        x ^= x >> 7;
+        x ^= x << 17;
+        let f = f64::from_bits(x);
+        if f.is_finite() {
+            xs.push(f);
+        }
+    }
+    s.put(&key(7), &xs);
+    let back: Vec<f64> = s.get(&key(7)).expect("stored");
+    assert_eq!(back.len(), xs.len());
+    for (a, b) in xs.iter().zip(&back) {
+        assert_eq!(a.to_bits(), b.to_bits(), "{a:e} came back as {b:e}");
+    }
+}
+
+#[test]
+fn non_finite_values_are_not_stored() {
+    let d = tempfile::tempdir().unwrap();
+    let s = store(d.path());
+    for v in [f64::NAN, f64::INFINITY, f64::NEG_INFINITY] {
+        s.put(&key(1), &vec![1.0, v]);
+        one_warning(&s, "result not stored");
+    }
+    assert_eq!(s.stats().stored, 0);
+    assert!(!s.entry_path(&key(1)).exists());
+    assert_eq!(s.get::<Vec<f64>>(&key(1)), None);
+}
+
+/// Store `outcome(1)` under `key(1)`, let `spoil` change the file, and check that a lookup is a
+/// miss with one warning containing `needle`, and that the slot works again afterwards.
+fn spoiled(spoil: impl FnOnce(&Path, Vec<u8>), needle: &str) {
+    let d = tempfile::tempdir().unwrap();
+    let s = store(d.path());
+    s.put(&key(1), &outcome(1));
+    let path = s.entry_path(&key(1));
+    let bytes = fs::read(&path).unwrap();
+    spoil(&path, bytes);
+    assert_eq!(s.get::<Outcome>(&key(1)), None, "{needle}");
+    one_warning(&s, needle);
+    assert_eq!(s.stats().ignored, 1);
+    assert_eq!(s.stats().misses, 1);
+    assert!(fs::symlink_metadata(&path).is_err() || fs::symlink_metadata(&path).unwrap().is_dir());
+    // Recomputed and stored again: a hit.
+    if !path.is_dir() {
+        s.put(&key(1), &outcome(1));
+        assert_eq!(s.get::<Outcome>(&key(1)), Some(outcome(1)));
+        assert!(s.take_warnings().is_empty());
+    }
+}
+
+fn header_len() -> usize {
+    entry::header_len(TOOL_VERSION.len())
+}
+
+#[test]
+fn a_corrupt_payload_is_ignored() {
+    spoiled(
+        |p, mut b| {
+            let i = b.len() - 3;
+            b[i] ^= 0x01;
+            fs::write(p, b).unwrap()
+        },
+        "checksum mismatch",
+    );
+}
+
+#[test]
+fn a_corrupt_checksum_is_ignored() {
+    spoiled(
+        |p, mut b| {
+            let i = header_len() - 1;
+            b[i] ^= 0x80;
+            fs::write(p, b).unwrap()
+        },
+        "checksum mismatch",
+    );
+}
+
+#[test]
+fn truncated_entries_are_ignored() {
+    spoiled(|p, b| fs::write(p, &b[..b.len() - 1]).unwrap(), "truncated");
+    spoiled(|p, b| fs::write(p, &b[..header_len()]).unwrap(), "truncated");
+    spoiled(|p, b| fs::write(p, &b[..header_len() - 1]).unwrap(), "truncated");
+    spoiled(|p, b| fs::write(p, &b[..5]).unwrap(), "truncated");
+    spoiled(|p, _| fs::write(p, b"").unwrap(), "truncated");
+}
+
+#[test]
+fn padded_entries_are_ignored() {
+    spoiled(
+        |p, mut b| {
+            b.push(b' ');
+            fs::write(p, b).unwrap()
+        },
+        "padded",
+    );
+}
+
+#[test]
+fn foreign_entries_are_ignored() {
+    spoiled(
+        |p, mut b| {
+            b[0] = b'X';
+            fs::write(p, b).unwrap()
+        },
+        "bad magic",
+    );
+    spoiled(|p, _| fs::write(p, b"{\"verdict\": \"clash\"}").unwrap(), "bad magic");
+    spoiled(
+        |p, mut b| {
+            b[8..12].copy_from_slice(&(FORMAT + 1).to_le_bytes());
+            fs::write(p, b).unwrap()
+        },
+        "entry layout",
+    );
+    // Another version's entry (whole and with a valid checksum) at this key's path.
+    spoiled(
+        |p, _| fs::write(p, entry::encode(&key(1), "9.9.9-other", br#"{"x":1}"#)).unwrap(),
+        "written by meshclash 9.9.9-other",
+    );
+    // A whole, valid entry of another key.
+    spoiled(
+        |p, _| {
+            let other = serde_json::to_vec(&outcome(1)).unwrap();
+            fs::write(p, entry::encode(&key(2), TOOL_VERSION, &other)).unwrap()
+        },
+        "another key",
+    );
+}
+
+#[test]
+fn a_hostile_declared_length_allocates_nothing() {
+    spoiled(
+        |p, mut b| {
+            let at = header_len() - 40;
+            b[at..at + 8].copy_from_slice(&u64::MAX.to_le_bytes());
+            fs::write(p, b).unwrap()
+        },
+        &format!("declares {} payload bytes", u64::MAX),
+    );
+}
+
+#[test]
+fn an_entry_of_another_type_is_ignored() {
+    let d = tempfile::tempdir().unwrap();
+    let s = store(d.path());
+    s.put(&key(1), &outcome(1));
+    assert_eq!(s.get::<Vec<u64>>(&key(1)), None);
+    one_warning(&s, "payload does not decode");
+}
+
+#[test]
+fn entries_over_the_limit_are_not_read() {
+    let d = tempfile::tempdir().unwrap();
+    let s = store(d.path());
+    s.put(&key(1), &outcome(1));
+    let small = Store::open(d.path(), 64).unwrap();
+    assert_eq!(small.get::<Outcome>(&key(1)), None);
+    one_warning(&small, "over the 64-byte limit");
+    // And not written: one warning for the run, however many results.
+    small.put(&key(2), &outcome(2));
+    small.put(&key(3), &outcome(3));
+    one_warning(&small, "not stored");
+    assert_eq!(small.stats().stored, 0);
+}
+
+#[test]
+fn symlinks_fifos_and_directories_at_an_entry_path_are_not_read() {
+    let d = tempfile::tempdir().unwrap();
+    let target = d.path().join("elsewhere");
+    spoiled(
+        |p, b| {
+            fs::write(&target, b).unwrap();
+            fs::remove_file(p).unwrap();
+            std::os::unix::fs::symlink(&target, p).unwrap();
+        },
+        "not a regular file",
+    );
+    assert!(target.exists(), "only the link is removed");
+    spoiled(
+        |p, _| {
+            fs::remove_file(p).unwrap();
+            rustix::fs::mknodat(
+                rustix::fs::CWD,
+                p,
+                rustix::fs::FileType::Fifo,
+                rustix::fs::Mode::from_raw_mode(0o600),
+                0,
+            )
+            .unwrap();
+        },
+        "not a regular file",
+    );
+    spoiled(
+        |p, _| {
+            fs::remove_file(p).unwrap();
+            fs::create_dir(p).unwrap();
+        },
+        "not a regular file",
+    );
+}
+
+#[test]
+fn a_directory_at_the_entry_path_turns_storing_off_with_one_warning() {
+    let d = tempfile::tempdir().unwrap();
+    let s = store(d.path());
+    fs::create_dir_all(s.entry_path(&key(1))).unwrap();
+    s.put(&key(1), &outcome(1));
+    one_warning(&s, "storing turned off");
+    s.put(&key(2), &outcome(2));
+    assert!(s.take_warnings().is_empty());
+    assert_eq!(s.stats().stored, 0);
+    assert_eq!(s.get::<Outcome>(&key(2)), None);
+}
+
+#[test]
+fn a_symlinked_fanout_directory_is_not_written_through() {
+    let d = tempfile::tempdir().unwrap();
+    let s = store(d.path());
+    let elsewhere = tempfile::tempdir().unwrap();
+    let fanout = s.entry_path(&key(1)).parent().unwrap().to_path_buf();
+    std::os::unix::fs::symlink(elsewhere.path(), &fanout).unwrap();
+    s.put(&key(1), &outcome(1));
+    one_warning(&s, "not a directory");
+    assert_eq!(fs::read_dir(elsewhere.path()).unwrap().count(), 0);
+}
+
+fn open_err(dir: &Path) -> String {
+    let e = Store::open(dir, DEFAULT_MAX_BYTES).unwrap_err();
+    assert_eq!(e.exit_code(), crate::error::ExitCode::Error);
+    let m = e.to_string();
+    assert!(!m.contains('\n'), "{m}");
+    assert!(m.contains("--cache"), "{m}");
+    assert!(m.contains(&dir.display().to_string()), "{m}");
+    m
+}
+
+#[test]
+fn open_refuses_what_is_not_a_cache_directory() {
+    let d = tempfile::tempdir().unwrap();
+    let file = d.path().join("file");
+    fs::write(&file, "x").unwrap();
+    assert!(open_err(&file).contains("is not a directory"));
+    let to_file = d.path().join("to-file");
+    std::os::unix::fs::symlink(&file, &to_file).unwrap();
+    assert!(open_err(&to_file).contains("symbolic link to something other than a directory"));
+    let dangling = d.path().join("dangling");
+    std::os::unix::fs::symlink(d.path().join("missing"), &dangling).unwrap();
+    assert!(open_err(&dangling).contains("cannot be followed"));
+    let under_file = file.join("sub");
+    assert!(open_err(&under_file).contains("cannot"));
+    // A directory of someone's files: never filled, never evicted from.
+    let project = d.path().join("project");
+    fs::create_dir(&project).unwrap();
+    fs::write(project.join("notes.txt"), "mine").unwrap();
+    assert!(open_err(&project).contains("not empty and not a meshclash cache"));
+    assert!(!project.join("CACHEDIR.TAG").exists());
+    // Another program's cache.
+    let other = d.path().join("other");
+    fs::create_dir(&other).unwrap();
+    fs::write(other.join("CACHEDIR.TAG"), "Signature: 8a477f597d28d172789f06886806bc55\n# cargo\n").unwrap();
+    assert!(open_err(&other).contains("another program's CACHEDIR.TAG"));
+    // A tag that is a FIFO or a link is not read (no hang, no following).
+    let fifo = d.path().join("fifo");
+    fs::create_dir(&fifo).unwrap();
+    let mode = rustix::fs::Mode::from_raw_mode(0o600);
+    rustix::fs::mknodat(rustix::fs::CWD, fifo.join("CACHEDIR.TAG"), rustix::fs::FileType::Fifo, mode, 0)
+        .unwrap();
+    assert!(open_err(&fifo).contains("CACHEDIR.TAG: not a regular file"));
+    let linked = d.path().join("linked");
+    fs::create_dir(&linked).unwrap();
+    std::os::unix::fs::symlink(other.join("CACHEDIR.TAG"), linked.join("CACHEDIR.TAG")).unwrap();
+    assert!(open_err(&linked).contains("CACHEDIR.TAG: not a regular file"));
+}
+
+#[test]
+fn open_refuses_an_unwritable_directory() {
+    let d = tempfile::tempdir().unwrap();
+    let ro = d.path().join("ro");
+    Store::open(&ro, DEFAULT_MAX_BYTES).unwrap();
+    use std::os::unix::fs::PermissionsExt;
+    fs::set_permissions(&ro, fs::Permissions::from_mode(0o555)).unwrap();
+    if fs::write(ro.join("probe"), "").is_ok() {
+        println!("skipped: running with privileges that ignore directory permissions");
+        return;
+    }
+    assert!(open_err(&ro).contains("is not writable"));
+    fs::set_permissions(&ro, fs::Permissions::from_mode(0o755)).unwrap();
+}
+
+#[test]
+fn open_creates_nested_directories_and_follows_a_link_to_a_directory() {
+    let d = tempfile::tempdir().unwrap();
+    let nested = d.path().join("a/b/c");
+    let s = store(&nested);
+    s.put(&key(1), &outcome(1));
+    let link = d.path().join("link");
+    std::os::unix::fs::symlink(&nested, &link).unwrap();
+    assert_eq!(store(&link).get::<Outcome>(&key(1)), Some(outcome(1)));
+}
+
+/// Put `n` entries of equal size, then age them: entry `i` last used `n - i` hours ago.
+fn aged(s: &Store, n: u32) {
+    for i in 0..n {
+        s.put(&key(i), &outcome(1));
+    }
+    for i in 0..n {
+        let t = SystemTime::now() - Duration::from_secs(3600 * u64::from(n - i));
+        fs::File::options().write(true).open(s.entry_path(&key(i))).unwrap().set_modified(t).unwrap();
+    }
+}
+
+#[test]
+fn eviction_removes_the_least_recently_used_down_to_the_low_water_mark() {
+    let d = tempfile::tempdir().unwrap();
+    let probe = store(d.path());
+    probe.put(&key(99), &outcome(1));
+    let one = fs::metadata(probe.entry_path(&key(99))).unwrap().len();
+    fs::remove_file(probe.entry_path(&key(99))).unwrap();
+    // Room for exactly 5 entries; the low-water mark (7/8) leaves 4.
+    let s = Store::open(d.path(), 5 * one).unwrap();
+    aged(&s, 5);
+    assert_eq!(s.stats().evicted, 0);
+    // Entry 0 is the oldest, but a hit makes it the most recently used.
+    assert!(s.get::<Outcome>(&key(0)).is_some());
+    s.put(&key(5), &outcome(1));
+    let present: Vec<u32> = (0..6).filter(|&i| s.entry_path(&key(i)).exists()).collect();
+    assert_eq!(present, vec![0, 3, 4, 5]);
+    assert_eq!(s.stats().evicted, 2);
+    // Files that are not entries are never evicted.
+    let fan = s.entry_path(&key(3)).parent().unwrap().join("README");
+    fs::write(&fan, vec![b'x'; 10 * one as usize]).unwrap();
+    s.put(&key(6), &outcome(1));
+    assert!(fan.exists());
+    assert!(d.path().join("CACHEDIR.TAG").exists());
+    assert!(s.take_warnings().is_empty());
+}
+
+#[test]
+fn eviction_removes_stale_temporaries_only() {
+    let d = tempfile::tempdir().unwrap();
+    let s = store(d.path());
+    let fan = d.path().join("ab");
+    fs::create_dir(&fan).unwrap();
+    let stale = fan.join(".tmp-stale");
+    let fresh = fan.join(".tmp-fresh");
+    fs::write(&stale, "x").unwrap();
+    fs::write(&fresh, "x").unwrap();
+    let old = SystemTime::now() - Duration::from_secs(3 * 24 * 3600);
+    fs::File::options().write(true).open(&stale).unwrap().set_modified(old).unwrap();
+    // The first put scans the directory.
+    s.put(&key(1), &outcome(1));
+    assert!(!stale.exists());
+    assert!(fresh.exists());
+}
+
+#[test]
+fn threads_sharing_a_store_see_whole_entries() {
+    let d = tempfile::tempdir().unwrap();
+    let s = store(d.path());
+    let values = [outcome(1), outcome(40), outcome(200)];
+    std::thread::scope(|scope| {
+        for t in 0..6 {
+            let (s, values) = (&s, &values);
+            scope.spawn(move || {
+                for round in 0..50 {
+                    s.put(&key(round % 5), &values[(t + round as usize) % 3]);
+                    if let Some(v) = s.get::<Outcome>(&key((round + 1) % 5)) {
+                        assert!(values.contains(&v));
+                    }
+                }
+            });
+        }
+    });
+    assert!(s.take_warnings().is_empty());
+    assert_eq!(s.stats().ignored, 0);
+    assert_eq!(s.stats().stored, 300);
+    for i in 0..5 {
+        assert!(values.contains(&s.get::<Outcome>(&key(i)).unwrap()));
+    }
+}
+
+const CHILD_DIR: &str = "MESHCLASH_CACHE_TEST_CHILD_DIR";
+
+/// Run by `processes_sharing_a_directory` in child processes; does nothing otherwise.
+#[test]
+#[ignore = "a child of processes_sharing_a_directory"]
+fn child_writer() {
+    let Some(dir) = std::env::var_os(CHILD_DIR) else { return };
+    let s = store(Path::new(&dir));
+    for round in 0..200 {
+        s.put(&key(round % 4), &outcome(round % 4 * 50));
+        if let Some(v) = s.get::<Outcome>(&key((round + 1) % 4)) {
+            assert_eq!(v, outcome((round + 1) % 4 * 50));
+        }
+    }
+    assert!(s.take_warnings().is_empty());
+}
+
+#[test]
+fn processes_sharing_a_directory_see_whole_entries() {
+    let d = tempfile::tempdir().unwrap();
+    let _ = store(d.path());
+    let exe = std::env::current_exe().unwrap();
+    let children: Vec<_> = (0..2)
+        .map(|_| {
+            std::process::Command::new(&exe)
+                .args(["cache::tests::child_writer", "--exact", "--ignored", "--test-threads=1"])
+                .env(CHILD_DIR, d.path())
+                .stdout(std::process::Stdio::piped())
+                .stderr(std::process::Stdio::piped())
+                .spawn()
+                .unwrap()
+        })
+        .collect();
+    let s = store(d.path());
+    let mut children = children;
+    // Read while the children write: every hit is a whole entry of the right value.
+    while children.iter_mut().any(|c| c.try_wait().unwrap().is_none()) {
+        for i in 0..4 {
+            if let Some(v) = s.get::<Outcome>(&key(i)) {
+                assert_eq!(v, outcome(i * 50));
+            }
+        }
+    }
+    for c in children {
+        let out = c.wait_with_output().unwrap();
+        let text = String::from_utf8_lossy(&out.stdout);
+        assert!(out.status.success(), "{text}{}", String::from_utf8_lossy(&out.stderr));
+        assert!(text.contains("1 passed"), "the child ran: {text}");
+    }
+    assert!(s.take_warnings().is_empty());
+    for i in 0..4 {
+        assert_eq!(s.get::<Outcome>(&key(i)), Some(outcome(i * 50)));
+    }
+}
+
+#[test]
+fn take_warnings_empties() {
+    let d = tempfile::tempdir().unwrap();
+    let s = store(d.path());
+    s.put(&key(1), &f64::NAN);
+    assert_eq!(s.take_warnings().len(), 1);
+    assert!(s.take_warnings().is_empty());
+}
+
+#[test]
+fn decode_checks_what_check_header_checks_and_the_sum() {
+    let payload = br#"{"a":1}"#;
+    let bytes = entry::encode(&key(1), "1.2.3", payload);
+    assert_eq!(&bytes[..8], MAGIC);
+    assert_eq!(bytes.len(), entry::header_len(5) + payload.len());
+    assert_eq!(entry::decode(&bytes, &key(1), "1.2.3"), Ok(&payload[..]));
+    assert_eq!(entry::decode(&bytes, &key(2), "1.2.3"), Err(Rejected::Key));
+    assert!(matches!(entry::decode(&bytes, &key(1), "1.2.4"), Err(Rejected::Version { .. })));
+    // Every strict prefix is refused.
+    for n in 0..bytes.len() {
+        assert!(entry::decode(&bytes[..n], &key(1), "1.2.3").is_err(), "prefix {n}");
+    }
+    // Every single-bit flip is refused.
+    for i in 0..bytes.len() {
+        for bit in 0..8 {
+            let mut b = bytes.clone();
+            b[i] ^= 1 << bit;
+            assert!(entry::decode(&b, &key(1), "1.2.3").is_err(), "byte {i} bit {bit}");
+        }
+    }
+}
