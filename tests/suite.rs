@@ -22,6 +22,8 @@ mod cli_errors;
 mod cli_messages;
 #[path = "cli_subcommands.rs"]
 mod cli_subcommands;
+#[path = "exactness.rs"]
+mod exactness;
 #[path = "extremes.rs"]
 mod extremes;
 #[path = "fcl_reference.rs"]

@@ -455,13 +455,13 @@ where
     TB: Tree + ?Sized,
 {
     let phase = pair_phase(a, ta, b, tb, settings);
-    let mut r = if phase.needs_topology(a, ta, b, tb, settings) {
+    let mut r = if phase.needs_topology(a, ta, b, tb) {
         let (topo_a, topo_b) = rayon::join(|| containment::topology(a), || containment::topology(b));
-        let mut r = phase.finish(a, ta, b, tb, Some((&topo_a, &topo_b)), settings);
+        let mut r = phase.finish(a, ta, b, tb, Some((&topo_a, &topo_b)));
         r.closed = [Some(topo_a.closed), Some(topo_b.closed)];
         r
     } else {
-        phase.finish(a, ta, b, tb, None, settings)
+        phase.finish(a, ta, b, tb, None)
     };
     r.trees = [ta.stats(), tb.stats()];
     r
@@ -533,7 +533,7 @@ impl PairPhase {
     /// Does the verdict need both sides' topology? Only when no pair crosses (and the search
     /// was not cut short), and either box meets the other's vertices (nesting is possible) or
     /// faces touch (volumes may overlap).
-    pub fn needs_topology<A, TA, B, TB>(&self, a: &A, ta: &TA, b: &B, tb: &TB, settings: &Settings) -> bool
+    pub fn needs_topology<A, TA, B, TB>(&self, a: &A, ta: &TA, b: &B, tb: &TB) -> bool
     where
         A: TriMesh + ?Sized,
         TA: Tree + ?Sized,
@@ -541,7 +541,6 @@ impl PairPhase {
         TB: Tree + ?Sized,
     {
         self.counts.crossing == 0
-            && !settings.first_hit
             && (self.pairs.iter().any(|p| p.contact == Some(Contact::CoplanarArea))
                 || containment::may_nest(a, ta, b, tb))
     }
@@ -555,7 +554,6 @@ impl PairPhase {
         b: &B,
         tb: &TB,
         topo: Option<(&containment::Topology, &containment::Topology)>,
-        settings: &Settings,
     ) -> ClashResult
     where
         A: TriMesh + ?Sized,
@@ -565,13 +563,18 @@ impl PairPhase {
     {
         let PairPhase { pairs, counts, closest, started, .. } = self;
         let containment = match topo {
-            _ if counts.crossing > 0 || settings.first_hit => Containment::None,
+            _ if counts.crossing > 0 => Containment::None,
             None => Containment::None, // no nesting possible and no faces touch
             Some((ta_, tb_)) => {
-                if volumes_overlap(a, ta_, b, tb_, &pairs) {
-                    Containment::VolumesOverlap
-                } else {
-                    containment::decide(a, ta, ta_, b, tb, tb_)
+                let contacts: Vec<_> =
+                    pairs.iter().filter_map(|p| p.contact.map(|c| (p.a, p.b, c))).collect();
+                let touching = (!contacts.is_empty())
+                    .then(|| containment::decide_touching(a, ta, ta_, b, tb, tb_, &contacts))
+                    .flatten();
+                match touching {
+                    Some(c) => c,
+                    None if volumes_overlap(a, ta_, b, tb_, &pairs) => Containment::VolumesOverlap,
+                    None => containment::decide(a, ta, ta_, b, tb, tb_),
                 }
             }
         };

@@ -167,12 +167,7 @@ pub struct Frame {
 impl Frame {
     /// The frame of a set of finite values.
     pub fn of(values: impl IntoIterator<Item = f64>) -> Frame {
-        let base = values
-            .into_iter()
-            .filter(|&x| x != 0.0)
-            .map(|x| decompose(x).2)
-            .min()
-            .unwrap_or(0);
+        let base = values.into_iter().filter(|&x| x != 0.0).map(|x| decompose(x).2).min().unwrap_or(0);
         Frame { base }
     }
 
