@@ -282,3 +282,132 @@ fn first_hit_still_finds_a_part_inside_another() {
         assert_eq!(first["summary"]["contained"], "b_in_a", "{args:?}");
     }
 }
+
+/// A mesh of one triangle.
+fn triangle(t: [[f64; 3]; 3]) -> Mesh {
+    Mesh {
+        positions: t.iter().map(|p| DVec3::from_array(*p)).collect(),
+        triangles: vec![[0, 1, 2]],
+        tri_object: vec![0],
+        objects: vec![Object { name: "t".into(), ..Default::default() }],
+    }
+}
+
+fn with(clearance: f64, touch: f64) -> Settings {
+    let mut s = Settings::default();
+    s.tolerances.clearance = clearance;
+    s.tolerances.touch = touch;
+    s
+}
+
+/// Two grid boxes 0.25 apart (faces x = 1 and x = 1.25) whose other coordinates are not short
+/// binary fractions, at several tessellations: the minimum distance reads exactly 0.25, a
+/// clearance of 0.25 is not violated (the gap is not less than it), one ulp more is, and a touch
+/// tolerance of 0.25 counts the gap as touching.
+#[test]
+fn a_quarter_gap_reads_a_quarter_and_meets_the_thresholds_exactly_at_every_tessellation() {
+    for (na, nb) in [(1, 1), (3, 5), (7, 3), (6, 11)] {
+        for reversed in [false, true] {
+            let a = grid_box([0.1, 0.1, 0.3], [1.0, 0.7, 0.9], na, reversed);
+            let b = grid_box([1.25, 0.2, 0.35], [2.1, 0.65, 1.3], nb, !reversed);
+            let at = |c: f64, t: f64| check(&a, &b, &with(c, t));
+            let plain = at(0.0, 0.0);
+            assert_eq!(plain.closest.unwrap().distance, 0.25, "{na}x{nb}");
+            let edge = at(0.25, 0.0);
+            assert_eq!(edge.verdict, Verdict::Clear, "{na}x{nb}: 0.25 is not less than 0.25");
+            let over = at(0.25f64.next_up(), 0.0);
+            assert_eq!(over.verdict, Verdict::Clearance, "{na}x{nb}");
+            assert!(over.counts.clearance > 0);
+            assert_eq!(over.closest.unwrap().distance, 0.25);
+            let touch = at(0.0, 0.25);
+            assert_eq!(touch.verdict, Verdict::Touching, "{na}x{nb}");
+            assert_eq!(at(0.0, 0.25f64.next_down()).verdict, Verdict::Clear, "{na}x{nb}");
+        }
+    }
+}
+
+/// Random triangle pairs whose exact distance is known: one triangle in the plane z = 0, the
+/// other at height h above it, overlapping in projection (distance h: vertex–face), or with a
+/// top edge and a bottom edge crossing in projection (edge–edge). Coordinates are random f64,
+/// so the closed form rounds; the decisions at h and its neighbours must be exact, and the
+/// reported distance must be h.
+#[test]
+fn threshold_decisions_on_random_pairs_match_the_exact_distance() {
+    let mut s = 0x9e37_79b9_7f4a_7c15u64;
+    let mut rnd = move || {
+        s ^= s << 13;
+        s ^= s >> 7;
+        s ^= s << 17;
+        (s >> 11) as f64 / (1u64 << 53) as f64
+    };
+    for case in 0..300 {
+        let h = 0.01 + rnd() * 3.0;
+        let (x0, y0) = (rnd() * 10.0 - 5.0, rnd() * 10.0 - 5.0);
+        let (a, b) = if case % 2 == 0 {
+            // Face to face: b's triangle inside a's projection, tilted upwards.
+            let a = [[x0 - 2.0, y0 - 2.0, 0.0], [x0 + 3.0, y0 - 1.7, 0.0], [x0 + 0.2, y0 + 3.1, 0.0]];
+            let b = [[x0, y0, h], [x0 + 0.5 * rnd(), y0 + 0.1, h + rnd()], [x0 + 0.1, y0 + 0.4, h + rnd()]];
+            (a, b)
+        } else {
+            // Edge over edge: a's top edge along x at z = 0, b's bottom edge along y at z = h.
+            let a = [[x0 - 1.0 - rnd(), y0, 0.0], [x0 + 1.0 + rnd(), y0, 0.0], [x0, y0 + rnd(), -1.0]];
+            let b = [[x0, y0 - 1.0 - rnd(), h], [x0, y0 + 1.0 + rnd(), h], [x0 + rnd(), y0, h + 1.0]];
+            (a, b)
+        };
+        let (ma, mb) = (triangle(a), triangle(b));
+        for (limit, inside_clearance, inside_touch) in
+            [(h, false, true), (h.next_up(), true, true), (h.next_down(), false, false)]
+        {
+            let c = check(&ma, &mb, &with(limit, 0.0));
+            assert_eq!(
+                c.verdict == Verdict::Clearance,
+                inside_clearance,
+                "case {case}: h {h:?}, clearance {limit:?}"
+            );
+            let t = check(&ma, &mb, &with(0.0, limit));
+            assert_eq!(t.verdict == Verdict::Touching, inside_touch, "case {case}: h {h:?}, touch {limit:?}");
+        }
+        assert_eq!(check(&ma, &mb, &Settings::default()).closest.unwrap().distance, h, "case {case}");
+    }
+}
+
+/// A glTF whose node places a triangle by translation `x`, written as given.
+fn placed_triangle_gltf(x: &str) -> String {
+    use base64::Engine;
+    let bytes: Vec<u8> =
+        [0f32, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0, 0.0].iter().flat_map(|v| v.to_le_bytes()).collect();
+    let data = base64::engine::general_purpose::STANDARD.encode(&bytes);
+    format!(
+        r#"{{"asset": {{"version": "2.0"}}, "scene": 0, "scenes": [{{"nodes": [0]}}],
+  "nodes": [{{"mesh": 0, "translation": [{x}, 0.5, {x}]}}],
+  "meshes": [{{"primitives": [{{"attributes": {{"POSITION": 0}}}}]}}],
+  "accessors": [{{"bufferView": 0, "componentType": 5126, "count": 3, "type": "VEC3",
+                 "min": [0, 0, 0], "max": [1, 1, 0]}}],
+  "bufferViews": [{{"buffer": 0, "byteLength": 36}}],
+  "buffers": [{{"byteLength": 36, "uri": "data:application/octet-stream;base64,{data}"}}]}}"#
+    )
+}
+
+/// Node transforms are read correctly rounded: the shortest literal of a double and a
+/// 24-digit literal of the same double place the geometry identically, at that double (the
+/// shortest literal below is one the default serde_json parser reads 1 ulp off).
+#[test]
+fn gltf_translations_are_read_correctly_rounded() {
+    let dir = tempfile::tempdir().unwrap();
+    for x in [54.190120697021484f64, 56.682770684255644, 59.56577268096566] {
+        let long = format!("{x:.22}");
+        assert_eq!(long.parse::<f64>().unwrap(), x);
+        let mut placed = Vec::new();
+        for (k, lit) in [format!("{x:?}"), long].iter().enumerate() {
+            let p = dir.path().join(format!("t{k}.gltf"));
+            std::fs::write(&p, placed_triangle_gltf(lit)).unwrap();
+            let (loaded, _) = meshclash::load::load_path(&p).unwrap();
+            placed.push(
+                loaded.mesh.positions.iter().map(|p| p.to_array().map(f64::to_bits)).collect::<Vec<_>>(),
+            );
+        }
+        assert_eq!(placed[0], placed[1], "{x:?}");
+        assert_eq!(f64::from_bits(placed[0][0][0]), x);
+        assert_eq!(f64::from_bits(placed[0][0][2]), x);
+    }
+}

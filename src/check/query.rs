@@ -14,6 +14,7 @@ use crate::geom::predicates::{self, Tolerances};
 use crate::geom::{Aabb, DVec3};
 use crate::load::{self, Format};
 use crate::narrow::distance::triangle_distance;
+use crate::narrow::exact_distance::exact_distance_sq;
 use crate::narrow::tri_tri::{self, Contact, Shape};
 use crate::scene::mesh::{Mesh, TriMesh};
 use glam::DMat4;
@@ -652,9 +653,13 @@ fn classify_pair(
         return None;
     }
     let d = triangle_distance(ti, tj);
-    let kind = if tol.is_touch(d.distance) {
+    // The exact distance, computed only for a pair near a tolerance.
+    let exact = std::cell::OnceCell::new();
+    let order = |limit: f64| exact.get_or_init(|| exact_distance_sq(ti, tj)).cmp_distance(limit);
+    let scale = Aabb::of_triangle(ti).max_abs().max(Aabb::of_triangle(tj).max_abs());
+    let kind = if tol.touch > 0.0 && Tolerances::within(d.distance, tol.touch, true, scale, order) {
         PairKind::Touching
-    } else if tol.is_clearance(d.distance) {
+    } else if Tolerances::within(d.distance, tol.clearance, false, scale, order) {
         PairKind::Clearance
     } else {
         return None;
@@ -664,7 +669,7 @@ fn classify_pair(
         b: j,
         kind,
         contact: None,
-        distance: d.distance,
+        distance: exact.get().map_or(d.distance, |e| e.rounded(d.distance)),
         segment: Some([d.on_a, d.on_b]),
     })
 }
@@ -828,7 +833,10 @@ where
         },
         shared_best,
     )?;
-    Some(Closest { distance: best.distance, a: (best.key.0, best.data.0), b: (best.key.1, best.data.1) })
+    // The reported distance: the exact distance of the pair found, correctly rounded.
+    let (i, j) = best.key;
+    let distance = exact_distance_sq(&a.triangle(i), &b.triangle(j)).rounded(best.distance);
+    Some(Closest { distance, a: (i, best.data.0), b: (j, best.data.1) })
 }
 
 /// A triangle with what the closest-pair search's triangle-pair bounds read of it.
