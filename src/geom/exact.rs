@@ -295,7 +295,8 @@ mod tests {
             s ^= s >> 7;
             s ^= s << 17;
             // Nearly coplanar points on a coarse grid with tiny offsets: signs are delicate.
-            ((s % 17) as f64 - 8.0) * 0.5 + if s % 5 == 0 { ((s >> 20) % 3) as f64 * 1e-17 } else { 0.0 }
+            ((s % 17) as f64 - 8.0) * 0.5
+                + if s.is_multiple_of(5) { ((s >> 20) % 3) as f64 * 1e-17 } else { 0.0 }
         };
         for _ in 0..2000 {
             let p: Vec<DVec3> = (0..4).map(|_| DVec3::new(rnd(), rnd(), rnd())).collect();

@@ -189,7 +189,7 @@ mod tests {
     #[test]
     fn quarter_gaps_are_exact_and_round_to_a_quarter() {
         let a = [DVec3::new(0.0, 0.0, 0.0), DVec3::new(1.0, 0.0, 0.0), DVec3::new(0.0, 1.0, 0.0)];
-        for (shift, tilt) in [(0.25, 0.0), (0.25, 0.3), (0.25, -0.7)] {
+        for (shift, tilt) in [(0.25f64, 0.0f64), (0.25, 0.3), (0.25, -0.7)] {
             let b = [
                 DVec3::new(0.1, 0.1, shift),
                 DVec3::new(0.9, 0.0, shift + tilt.max(0.0)),
