@@ -1063,7 +1063,7 @@ pub fn group_by_part(parts: &[Part], a: &Mesh, b: &Mesh, r: &ClashResult) -> Vec
         .map(|mut e| {
             if let Some(c) = e.closest.as_mut().filter(|c| c.distance > 0.0) {
                 let (ta, tb) = (crate::bvh::triangle(a, c.a.0), crate::bvh::triangle(b, c.b.0));
-                c.distance = crate::narrow::exact_distance::exact_distance_sq(&ta, &tb).rounded(c.distance);
+                c.distance = crate::narrow::exact_distance::exact_distance_sq(&ta, &tb).rounded();
                 e.min_distance = Some(c.distance);
             }
             e

@@ -669,7 +669,7 @@ fn classify_pair(
         b: j,
         kind,
         contact: None,
-        distance: exact.get().map_or(d.distance, |e| e.rounded(d.distance)),
+        distance: exact.get().map_or(d.distance, |e| e.rounded()),
         segment: Some([d.on_a, d.on_b]),
     })
 }
@@ -835,7 +835,7 @@ where
     )?;
     // The reported distance: the exact distance of the pair found, correctly rounded.
     let (i, j) = best.key;
-    let distance = exact_distance_sq(&a.triangle(i), &b.triangle(j)).rounded(best.distance);
+    let distance = exact_distance_sq(&a.triangle(i), &b.triangle(j)).rounded();
     Some(Closest { distance, a: (i, best.data.0), b: (j, best.data.1) })
 }
 

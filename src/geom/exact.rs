@@ -133,6 +133,15 @@ impl Int {
         Int::new(self.neg != o.neg, mul_mag(&self.mag, &o.mag))
     }
 
+    /// `(m, e)` with `self ≈ m · 2^e`, `m` the leading 65 to 96 bits as an f64 (a relative
+    /// error of about one f64 rounding; exactly 0 for 0): an estimate that never overflows.
+    pub fn approx(&self) -> (f64, i64) {
+        let n = self.mag.len();
+        let top = self.mag.iter().rev().take(3).fold(0.0, |acc, &l| acc * 4_294_967_296.0 + l as f64);
+        let m = if self.neg { -top } else { top };
+        (m, 32 * n.saturating_sub(3) as i64)
+    }
+
     /// Numeric order.
     pub fn cmp_value(&self, o: &Int) -> Ordering {
         match (self.neg, o.neg) {

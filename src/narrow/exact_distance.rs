@@ -56,16 +56,26 @@ impl ExactSq {
         self.cmp_square(&m, e)
     }
 
-    /// The distance, correctly rounded to f64 (nearest, ties to even), starting the search
-    /// from an estimate (any non-negative f64 near it).
-    pub fn rounded(&self, estimate: f64) -> f64 {
+    /// The distance, correctly rounded to f64 (nearest, ties to even).
+    pub fn rounded(&self) -> f64 {
         if self.num.signum() == 0 {
             return 0.0;
         }
-        let mut r = estimate.max(f64::from_bits(1));
-        if !r.is_finite() {
-            r = f64::MAX;
+        // An estimate within a few ulps: sqrt(num/den) · 2^base from the leading bits.
+        let ((nm, ne), (dm, de)) = (self.num.approx(), self.den.approx());
+        let mut e = ne - de + 2 * self.base as i64;
+        let mut ratio = nm / dm;
+        if e % 2 != 0 {
+            ratio *= 2.0;
+            e -= 1;
         }
+        let half = (e / 2).clamp(-2000, 2000) as i32;
+        // 2^half in two steps, so neither factor overflows before the product settles.
+        let mut r = ratio.sqrt() * 2f64.powi(half / 2) * 2f64.powi(half - half / 2);
+        if r.is_nan() || r <= 0.0 {
+            r = f64::from_bits(1);
+        }
+        r = r.min(f64::MAX);
         // The midpoint of two adjacent floats, exact as an integer times a power of two.
         let mid = |x: f64, y: f64| {
             let f = Frame::of([x, y]);
@@ -198,14 +208,13 @@ mod tests {
             let e = exact_distance_sq(&a, &b);
             assert_eq!(e.cmp_distance(0.25), Ordering::Equal);
             assert_eq!(e.cmp_distance(0.25f64.next_down()), Ordering::Greater);
-            assert_eq!(e.rounded(triangle_distance(&a, &b).distance), 0.25);
-            assert_eq!(e.rounded(0.3), 0.25);
+            assert_eq!(e.rounded(), 0.25);
         }
         // Edge to edge, skew: distance 1/sqrt(2)·... checked against the f64 value.
         let c = [DVec3::new(0.5, -1.0, 1.0), DVec3::new(0.5, 1.0, 1.0), DVec3::new(0.5, 0.0, 3.0)];
         let d = [DVec3::new(-1.0, 0.2, 2.0), DVec3::new(1.0, 0.2, 2.0), DVec3::new(0.0, 0.2, 5.0)];
         let e = exact_distance_sq(&c, &d);
         let f = triangle_distance(&c, &d).distance;
-        assert!((e.rounded(f) - f).abs() <= 4.0 * f64::EPSILON * f.max(1.0), "{} {f}", e.rounded(f));
+        assert!((e.rounded() - f).abs() <= 4.0 * f64::EPSILON * f.max(1.0), "{} {f}", e.rounded());
     }
 }
