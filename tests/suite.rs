@@ -24,6 +24,8 @@ mod cli_messages;
 mod cli_subcommands;
 #[path = "contract.rs"]
 mod contract;
+#[path = "exactness.rs"]
+mod exactness;
 #[path = "extremes.rs"]
 mod extremes;
 #[path = "fcl_reference.rs"]

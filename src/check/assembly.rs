@@ -436,7 +436,7 @@ pub fn check_parts_kept(
         .map(|&(a, b)| {
             let (va, vb, ta, tb) = (view(a), view(b), tree(a), tree(b));
             let mut phase = pair_walk(&va, &ta, &vb, &tb, settings);
-            let needs = phase.needs_topology(&va, &ta, &vb, &tb, settings);
+            let needs = phase.needs_topology(&va, &ta, &vb, &tb);
             if settings.detail == Detail::Parts && !needs {
                 phase.forget_pairs();
             }
@@ -461,7 +461,7 @@ pub fn check_parts_kept(
             let topo =
                 needs.then(|| (topology[a].as_ref().expect("wanted"), topology[b].as_ref().expect("wanted")));
             let pending = phase.closest_pending();
-            let mut r = phase.finish(&view(a), &tree(a), &view(b), &tree(b), topo, settings);
+            let mut r = phase.finish(&view(a), &tree(a), &view(b), &tree(b), topo);
             r.closed = [topology[a].as_ref().map(|t| t.closed), topology[b].as_ref().map(|t| t.closed)];
             r.timings = Default::default();
             (r, pending)
@@ -996,7 +996,7 @@ fn per_part_containment(
 ) {
     let side = |input: u8| (0..parts.len()).filter(|&i| parts[i].input == input).collect::<Vec<_>>();
     let (sa, sb) = (side(0), side(1));
-    if (sa.len() <= 1 && sb.len() <= 1) || result.counts.crossing > 0 || settings.first_hit {
+    if (sa.len() <= 1 && sb.len() <= 1) || result.counts.crossing > 0 {
         return;
     }
     let ar = check_parts([a, b], parts.to_vec(), &sa, &sb, Pairing::Cross, settings);
@@ -1058,5 +1058,15 @@ pub fn group_by_part(parts: &[Part], a: &Mesh, b: &Mesh, r: &ClashResult) -> Vec
         }
         e.min_distance = e.closest.map(|c| c.distance);
     }
-    by.into_values().collect()
+    // A positive minimum is reported as the exact distance of its pair, correctly rounded.
+    by.into_values()
+        .map(|mut e| {
+            if let Some(c) = e.closest.as_mut().filter(|c| c.distance > 0.0) {
+                let (ta, tb) = (crate::bvh::triangle(a, c.a.0), crate::bvh::triangle(b, c.b.0));
+                c.distance = crate::narrow::exact_distance::exact_distance_sq(&ta, &tb).rounded();
+                e.min_distance = Some(c.distance);
+            }
+            e
+        })
+        .collect()
 }

@@ -16,9 +16,10 @@
 //! entirely inside or entirely outside the other, so one vertex per component decides.
 
 use crate::bvh::traverse::Tree;
+use crate::geom::exact;
 use crate::geom::predicates as pr;
 use crate::geom::{Aabb, DVec3};
-use crate::narrow::tri_tri::Shape;
+use crate::narrow::tri_tri::{self, Contact, Shape};
 use crate::scene::mesh::TriMesh;
 use std::collections::HashMap;
 
@@ -228,18 +229,27 @@ pub enum Inside {
 
 /// Is `p` inside the closed mesh `m` (with tree `t`)? `p` must not lie on `m`'s surface.
 pub fn point_in_closed_mesh<M: TriMesh + ?Sized, T: Tree + ?Sized>(p: DVec3, m: &M, t: &T) -> Inside {
-    let bounds = t.root_box();
-    if !bounds.contains(&Aabb { min: p, max: p }) {
+    if !t.root_box().contains(&Aabb { min: p, max: p }) {
         return Inside::No;
     }
-    // Long enough to leave the box from anywhere inside it along any tried direction.
-    let reach = bounds.extent().length() * 2.0 + 1.0;
+    parity(&p, Aabb { min: p, max: p }, m, t)
+}
+
+/// The parity test of [`point_in_closed_mesh`] from a ray start `p` that lies in `near` (a
+/// box the segments' boxes are built from, exact for an f64 point; the triangle's box for a
+/// [`Weighted`] point), `p` not on `m`'s surface.
+fn parity<P: RayStart, M: TriMesh + ?Sized, T: Tree + ?Sized>(p: &P, near: Aabb, m: &M, t: &T) -> Inside {
+    let bounds = t.root_box();
+    let from = near.center();
+    // Long enough to leave the box from anywhere inside (or near) it along any tried direction.
+    let reach = (bounds.extent().length() + (from - bounds.center()).length()) * 2.0 + 1.0;
     'dir: for d in DIRECTIONS {
-        let q = p + DVec3::from(d) * reach;
+        let q = from + DVec3::from(d) * reach;
+        let seg = near.grow(q);
         let mut crossings = 0usize;
-        let degenerate = crate::bvh::traverse::any_on_segment(t, p, q, |tri| {
+        let mut visit = |tri: u32| {
             let [a, b, c] = m.triangle(tri);
-            match segment_crosses(p, q, a, b, c) {
+            match segment_crosses(p, &seg, q, a, b, c) {
                 Crossing::No => false,
                 Crossing::Yes => {
                     crossings += 1;
@@ -247,7 +257,12 @@ pub fn point_in_closed_mesh<M: TriMesh + ?Sized, T: Tree + ?Sized>(p: DVec3, m: 
                 }
                 Crossing::Degenerate => true,
             }
-        });
+        };
+        let degenerate = if near.min == near.max {
+            crate::bvh::traverse::any_on_segment(t, near.min, q, visit)
+        } else {
+            crate::bvh::traverse::any_in_box(t, &seg, &mut visit)
+        };
         if degenerate {
             continue 'dir;
         }
@@ -302,17 +317,33 @@ enum Crossing {
     Degenerate,
 }
 
-fn segment_crosses(p: DVec3, q: DVec3, a: DVec3, b: DVec3, c: DVec3) -> Crossing {
+/// The start of a parity ray: exact signs of the orientations that involve it.
+trait RayStart {
+    /// Sign of `orient3d(a, b, c, self)`.
+    fn side(&self, a: DVec3, b: DVec3, c: DVec3) -> pr::Sign;
+    /// Sign of `orient3d(self, q, a, b)`.
+    fn turn(&self, q: DVec3, a: DVec3, b: DVec3) -> pr::Sign;
+}
+
+impl RayStart for DVec3 {
+    fn side(&self, a: DVec3, b: DVec3, c: DVec3) -> pr::Sign {
+        pr::orient3d(a, b, c, *self)
+    }
+    fn turn(&self, q: DVec3, a: DVec3, b: DVec3) -> pr::Sign {
+        pr::orient3d(*self, q, a, b)
+    }
+}
+
+/// The segment from `p` to `q` (whose box is `seg`) against triangle `abc`.
+fn segment_crosses<P: RayStart>(p: &P, seg: &Aabb, q: DVec3, a: DVec3, b: DVec3, c: DVec3) -> Crossing {
     if pr::collinear(a, b, c) {
         return Crossing::No; // zero area: not part of the surface a ray can cross
     }
-    let sp = pr::orient3d(a, b, c, p);
+    let sp = p.side(a, b, c);
     let sq = pr::orient3d(a, b, c, q);
     if sp == 0 && sq == 0 {
         // The ray lies in the triangle's plane: it may graze it; do not count, retry.
-        let box_ = Aabb::of_triangle(&[a, b, c]);
-        let seg = Aabb { min: p.min(q), max: p.max(q) };
-        return if box_.overlaps(&seg) { Crossing::Degenerate } else { Crossing::No };
+        return if Aabb::of_triangle(&[a, b, c]).overlaps(seg) { Crossing::Degenerate } else { Crossing::No };
     }
     if sp * sq > 0 {
         return Crossing::No;
@@ -322,13 +353,55 @@ fn segment_crosses(p: DVec3, q: DVec3, a: DVec3, b: DVec3, c: DVec3) -> Crossing
     if sp == 0 || sq == 0 {
         return Crossing::No;
     }
-    let s = [pr::orient3d(p, q, a, b), pr::orient3d(p, q, b, c), pr::orient3d(p, q, c, a)];
+    let s = [p.turn(q, a, b), p.turn(q, b, c), p.turn(q, c, a)];
     if s.iter().all(|&v| v > 0) || s.iter().all(|&v| v < 0) {
         Crossing::Yes
     } else if s.iter().all(|&v| v >= 0) || s.iter().all(|&v| v <= 0) {
         Crossing::Degenerate
     } else {
         Crossing::No
+    }
+}
+
+/// A point of a proper triangle `t` given by positive integer barycentric weights,
+/// `Σ w_k t_k / Σ w_k`: not representable in f64 in general, so every sign that involves it is
+/// the sign of the weighted sum of the exact orientation values of the triangle's vertices
+/// (orientation determinants are affine in each point, and the weights sum to a positive
+/// number).
+#[derive(Debug, Clone, Copy)]
+struct Weighted {
+    t: [DVec3; 3],
+    w: [i64; 3],
+}
+
+impl Weighted {
+    fn sum(&self, others: &[DVec3], value: impl Fn(&exact::Frame, DVec3) -> exact::Int) -> pr::Sign {
+        let f = exact::Frame::of_points(self.t.iter().chain(others));
+        exact::weighted_sum((0..3).map(|k| (self.w[k], value(&f, self.t[k])))).signum()
+    }
+
+    /// Sign of `orient2d(a, b, self)` on projection `axis`.
+    fn orient2d(&self, a: DVec3, b: DVec3, axis: usize) -> pr::Sign {
+        self.sum(&[a, b], |f, x| exact::orient2d(f, a, b, x, axis))
+    }
+
+    /// Exactly on the closed proper triangle `g`?
+    fn on_triangle(&self, g: &[DVec3; 3]) -> bool {
+        let Some(k) = pr::projection_axis(g[0], g[1], g[2]) else { return false };
+        if self.side(g[0], g[1], g[2]) != 0 {
+            return false;
+        }
+        let sigma = pr::orient2d(g[0], g[1], g[2], k);
+        (0..3).all(|i| self.orient2d(g[i], g[(i + 1) % 3], k) * sigma >= 0)
+    }
+}
+
+impl RayStart for Weighted {
+    fn side(&self, a: DVec3, b: DVec3, c: DVec3) -> pr::Sign {
+        self.sum(&[a, b, c], |f, x| exact::orient3d(f, a, b, c, x))
+    }
+    fn turn(&self, q: DVec3, a: DVec3, b: DVec3) -> pr::Sign {
+        self.sum(&[q, a, b], |f, x| exact::orient3d(f, x, q, a, b))
     }
 }
 
@@ -472,6 +545,234 @@ where
         (OneWay::Undecided(e), _) | (_, OneWay::Undecided(e)) => Containment::Undecided(e),
         _ => Containment::None,
     }
+}
+
+/// Does proper triangle `g` (not coplanar with proper triangle `t`, meeting it) lie on one side
+/// of `t`'s plane and meet the *relative interior* of `t`? Then `Some(side)`: the sign of
+/// `orient3d(t, ·)` at `g`'s vertices off the plane. Exact: the part of `g` in the plane (a
+/// vertex or an edge) is tested against the open triangle by separating lines (`t`'s edge
+/// lines and the edge's own line), all 2D orientation signs on one projection.
+fn touches_interior_from(t: &[DVec3; 3], g: &[DVec3; 3]) -> Option<pr::Sign> {
+    let s = g.map(|x| pr::orient3d(t[0], t[1], t[2], x));
+    let side = if s.iter().all(|&v| v >= 0) {
+        1
+    } else if s.iter().all(|&v| v <= 0) {
+        -1
+    } else {
+        return None; // `g` crosses the plane: the contact lies on `t`'s boundary
+    };
+    let on: Vec<DVec3> = (0..3).filter(|&k| s[k] == 0).map(|k| g[k]).collect();
+    if on.is_empty() || on.len() == 3 {
+        return None;
+    }
+    let k = pr::projection_axis(t[0], t[1], t[2])?;
+    let sigma = pr::orient2d(t[0], t[1], t[2], k);
+    let edge_separates =
+        (0..3).any(|i| on.iter().all(|&x| pr::orient2d(t[i], t[(i + 1) % 3], x, k) * sigma <= 0));
+    let line_separates = on.len() == 2 && {
+        let o = t.map(|x| pr::orient2d(on[0], on[1], x, k));
+        o.iter().all(|&v| v >= 0) || o.iter().all(|&v| v <= 0)
+    };
+    (!edge_separates && !line_separates).then_some(side)
+}
+
+/// One side of [`decide_touching`]: per component of `p`, whether some point of its surface off
+/// `q`'s surface lies inside `q`, and whether some lies outside. `partners[t]`: the triangles
+/// of `q` that share a point with triangle `t` of `p`; `covered[t]`: `t` has a face-to-face
+/// contact with opposite interiors (its points off `q` are then outside: see
+/// [`decide_touching`]).
+fn surface_states<P, Q, TQ>(
+    p: &P,
+    ptopo: &Topology,
+    q: &Q,
+    tq: &TQ,
+    partners: &[Vec<u32>],
+    covered: &[bool],
+    name: &str,
+) -> Result<Vec<(bool, bool)>, String>
+where
+    P: TriMesh + ?Sized,
+    Q: TriMesh + ?Sized,
+    TQ: Tree + ?Sized,
+{
+    use crate::scene::bodies::{find, union};
+    let n = p.triangle_count();
+    let proper: Vec<bool> = (0..n).map(|t| !Shape::of(&p.triangle(t as u32)).is_degenerate()).collect();
+    // Proper partners only: zero-area triangles are not part of the surface a ray crosses.
+    let partners: Vec<Vec<[DVec3; 3]>> = partners
+        .iter()
+        .map(|g| g.iter().map(|&g| q.triangle(g)).filter(|g| !Shape::of(g).is_degenerate()).collect())
+        .collect();
+    // Triangles that meet no triangle of `q` are off its surface; any two of them that share a
+    // vertex share its status (the vertex is off the surface). One test per such class.
+    let distinct = ptopo.merged.iter().max().map_or(0, |&m| m as usize + 1);
+    let mut parent: Vec<u32> = (0..distinct as u32).collect();
+    for t in (0..n).filter(|&t| proper[t] && partners[t].is_empty()) {
+        let v = p.indices(t as u32).map(|i| ptopo.merged[i as usize]);
+        union(&mut parent, v[0], v[1]);
+        union(&mut parent, v[1], v[2]);
+    }
+    let mut class_done = vec![false; distinct];
+    let mut by_vertex: HashMap<u32, Inside> = HashMap::new();
+    let mut states = vec![(false, false); ptopo.component_seeds.len()];
+    for t in (0..n).filter(|&t| proper[t]) {
+        let idx = p.indices(t as u32);
+        let tri = p.triangle(t as u32);
+        let status = if partners[t].is_empty() {
+            let root = find(&mut parent, ptopo.merged[idx[0] as usize]) as usize;
+            if std::mem::replace(&mut class_done[root], true) {
+                continue;
+            }
+            *by_vertex
+                .entry(ptopo.merged[idx[0] as usize])
+                .or_insert_with(|| point_in_closed_mesh(tri[0], q, tq))
+        } else if covered[t] {
+            continue;
+        } else {
+            let on_q = |x: DVec3| partners[t].iter().any(|g| tri_tri::classify(&[x, x, x], g).is_some());
+            match (0..3).find(|&k| !on_q(tri[k])) {
+                Some(k) => *by_vertex
+                    .entry(ptopo.merged[idx[k] as usize])
+                    .or_insert_with(|| point_in_closed_mesh(tri[k], q, tq)),
+                None => {
+                    // Every vertex lies on `q`. Where `q`'s surface meets the triangle's interior
+                    // it does so in segments and points (no face-to-face contact here), and no
+                    // line holds three points of a parabola: of 2m + 1 points on one, inside
+                    // the triangle, one is off the m partners' contacts.
+                    let m = partners[t].len() as i64;
+                    let steps = 2 * m + 2;
+                    let point = (1..steps).map(|i| Weighted {
+                        t: tri,
+                        w: [(2 * steps - i) * (steps - i), 2 * steps * i, i * (steps - i)],
+                    });
+                    let Some(w) = point.clone().find(|w| !partners[t].iter().any(|g| w.on_triangle(g)))
+                    else {
+                        return Err(format!("no point of a triangle of {name} found off the other surface"));
+                    };
+                    let near = Aabb::of_triangle(&tri);
+                    if !tq.root_box().overlaps(&near) {
+                        Inside::No
+                    } else {
+                        parity(&w, near, q, tq)
+                    }
+                }
+            }
+        };
+        let c = ptopo.component_of[idx[0] as usize] as usize;
+        match status {
+            Inside::Yes => states[c].0 = true,
+            Inside::No => states[c].1 = true,
+            Inside::Undecided => {
+                return Err(format!("every ray from a point of a triangle of {name} met an edge exactly"))
+            }
+        }
+    }
+    Ok(states)
+}
+
+/// Containment of two closed parts whose surfaces meet but never cross (`contacts`: every pair
+/// of triangles that shares a point, as (triangle of `a`, triangle of `b`, contact)), decided
+/// exactly and independently of triangle order: do the interiors overlap?
+///
+/// They do iff (1) a face-to-face contact has both interiors on the same side
+/// ([`coplanar_overlap`]), or (2) a triangle of one part meets the relative interior of a
+/// triangle of the other from that triangle's inner side (points of it near the contact are
+/// then inside the other solid), or (3) a point of one surface off the other lies strictly
+/// inside it. When no pair crosses and (2) does not hold for triangle `t`, all points of `t`'s
+/// relative interior off the other surface lie on one side of it: a path between two of them,
+/// pushed slightly to the inner side of `t`, meets no triangle of the other part (one would
+/// cross `t` or touch its interior from that side). So one point per triangle decides (3): a
+/// vertex off the other surface, or an exact interior point found by [`Weighted`]; a triangle
+/// that meets no other triangle shares its status with its neighbours, so one test per class of
+/// such triangles. A triangle with a face-to-face contact of opposite interiors needs none: at
+/// the boundary of the shared area the other surface turns away to the outer side (the inner
+/// side is (2)), so its points off the other surface are outside. Conversely, if the interiors
+/// overlap and no surface point of either lies inside the other, the overlap is a union of
+/// components of both interiors: coinciding solids, which (1) finds.
+///
+/// `None` when an orientation is needed and cannot be computed (or a part is open): the caller
+/// keeps the one-vertex-per-component answer of [`decide`].
+#[allow(clippy::too_many_arguments)]
+pub fn decide_touching<A, TA, B, TB>(
+    a: &A,
+    ta: &TA,
+    topo_a: &Topology,
+    b: &B,
+    tb: &TB,
+    topo_b: &Topology,
+    contacts: &[(u32, u32, Contact)],
+) -> Option<Containment>
+where
+    A: TriMesh + ?Sized,
+    TA: Tree + ?Sized,
+    B: TriMesh + ?Sized,
+    TB: Tree + ?Sized,
+{
+    if !topo_a.closed || !topo_b.closed {
+        return None;
+    }
+    let proper = |t: &[DVec3; 3]| !Shape::of(t).is_degenerate();
+    // (2)'s candidates: (triangle, side its partner lies on), each way.
+    let (mut into_a, mut into_b) = (Vec::new(), Vec::new());
+    let mut coplanar = false;
+    for &(i, j, c) in contacts {
+        match c {
+            Contact::CoplanarArea => coplanar = true,
+            Contact::CoplanarBoundary => {}
+            Contact::Point | Contact::Segment => {
+                let (ti, tj) = (a.triangle(i), b.triangle(j));
+                if proper(&ti) && proper(&tj) {
+                    into_a.extend(touches_interior_from(&ti, &tj).map(|s| (i, s)));
+                    into_b.extend(touches_interior_from(&tj, &ti).map(|s| (j, s)));
+                }
+            }
+        }
+    }
+    let (mut covered_a, mut covered_b) = (vec![false; a.triangle_count()], vec![false; b.triangle_count()]);
+    if coplanar || !into_a.is_empty() || !into_b.is_empty() {
+        let (oa, ob) = rayon::join(|| outward(a, topo_a), || outward(b, topo_b));
+        let (oa, ob) = (oa?, ob?);
+        for &(i, j, _) in contacts.iter().filter(|x| x.2 == Contact::CoplanarArea) {
+            if coplanar_overlap(&a.triangle(i), oa[i as usize], &b.triangle(j), ob[j as usize]) {
+                return Some(Containment::VolumesOverlap);
+            }
+            covered_a[i as usize] = true;
+            covered_b[j as usize] = true;
+        }
+        // The inner side of a triangle is opposite its outward normal: orient3d sign times
+        // the outward flag is negative there.
+        let inward = |v: &[(u32, pr::Sign)], o: &[i8]| v.iter().any(|&(t, s)| s * o[t as usize] < 0);
+        if inward(&into_a, &oa) || inward(&into_b, &ob) {
+            return Some(Containment::VolumesOverlap);
+        }
+    }
+    let mut partners_a = vec![Vec::new(); a.triangle_count()];
+    let mut partners_b = vec![Vec::new(); b.triangle_count()];
+    for &(i, j, _) in contacts {
+        partners_a[i as usize].push(j);
+        partners_b[j as usize].push(i);
+    }
+    let (sa, sb) = rayon::join(
+        || surface_states(a, topo_a, b, tb, &partners_a, &covered_a, "a"),
+        || surface_states(b, topo_b, a, ta, &partners_b, &covered_b, "b"),
+    );
+    let (sa, sb) = match (sa, sb) {
+        (Ok(x), Ok(y)) => (x, y),
+        (Err(e), _) | (_, Err(e)) => return Some(Containment::Undecided(e)),
+    };
+    // A component with points both inside and outside the other: the surfaces pass through
+    // each other along shared edges.
+    if sa.iter().chain(&sb).any(|&(i, o)| i && o) {
+        return Some(Containment::VolumesOverlap);
+    }
+    let inside = |s: &[(bool, bool)]| (s.iter().filter(|x| x.0).count(), s.len());
+    Some(match (inside(&sa), inside(&sb)) {
+        ((i, n), _) if i > 0 && i == n => Containment::AInB,
+        (_, (i, n)) if i > 0 && i == n => Containment::BInA,
+        ((i, _), _) if i > 0 => Containment::APartlyInB,
+        (_, (i, _)) if i > 0 => Containment::BPartlyInA,
+        _ => Containment::None,
+    })
 }
 
 #[cfg(test)]

@@ -14,6 +14,7 @@ use crate::geom::predicates::{self, Tolerances};
 use crate::geom::{Aabb, DVec3};
 use crate::load::{self, Format};
 use crate::narrow::distance::triangle_distance;
+use crate::narrow::exact_distance::exact_distance_sq;
 use crate::narrow::tri_tri::{self, Contact, Shape};
 use crate::scene::mesh::{Mesh, TriMesh};
 use glam::DMat4;
@@ -455,13 +456,13 @@ where
     TB: Tree + ?Sized,
 {
     let phase = pair_phase(a, ta, b, tb, settings);
-    let mut r = if phase.needs_topology(a, ta, b, tb, settings) {
+    let mut r = if phase.needs_topology(a, ta, b, tb) {
         let (topo_a, topo_b) = rayon::join(|| containment::topology(a), || containment::topology(b));
-        let mut r = phase.finish(a, ta, b, tb, Some((&topo_a, &topo_b)), settings);
+        let mut r = phase.finish(a, ta, b, tb, Some((&topo_a, &topo_b)));
         r.closed = [Some(topo_a.closed), Some(topo_b.closed)];
         r
     } else {
-        phase.finish(a, ta, b, tb, None, settings)
+        phase.finish(a, ta, b, tb, None)
     };
     r.trees = [ta.stats(), tb.stats()];
     r
@@ -533,7 +534,7 @@ impl PairPhase {
     /// Does the verdict need both sides' topology? Only when no pair crosses (and the search
     /// was not cut short), and either box meets the other's vertices (nesting is possible) or
     /// faces touch (volumes may overlap).
-    pub fn needs_topology<A, TA, B, TB>(&self, a: &A, ta: &TA, b: &B, tb: &TB, settings: &Settings) -> bool
+    pub fn needs_topology<A, TA, B, TB>(&self, a: &A, ta: &TA, b: &B, tb: &TB) -> bool
     where
         A: TriMesh + ?Sized,
         TA: Tree + ?Sized,
@@ -541,7 +542,6 @@ impl PairPhase {
         TB: Tree + ?Sized,
     {
         self.counts.crossing == 0
-            && !settings.first_hit
             && (self.pairs.iter().any(|p| p.contact == Some(Contact::CoplanarArea))
                 || containment::may_nest(a, ta, b, tb))
     }
@@ -555,7 +555,6 @@ impl PairPhase {
         b: &B,
         tb: &TB,
         topo: Option<(&containment::Topology, &containment::Topology)>,
-        settings: &Settings,
     ) -> ClashResult
     where
         A: TriMesh + ?Sized,
@@ -565,13 +564,18 @@ impl PairPhase {
     {
         let PairPhase { pairs, counts, closest, started, .. } = self;
         let containment = match topo {
-            _ if counts.crossing > 0 || settings.first_hit => Containment::None,
+            _ if counts.crossing > 0 => Containment::None,
             None => Containment::None, // no nesting possible and no faces touch
             Some((ta_, tb_)) => {
-                if volumes_overlap(a, ta_, b, tb_, &pairs) {
-                    Containment::VolumesOverlap
-                } else {
-                    containment::decide(a, ta, ta_, b, tb, tb_)
+                let contacts: Vec<_> =
+                    pairs.iter().filter_map(|p| p.contact.map(|c| (p.a, p.b, c))).collect();
+                let touching = (!contacts.is_empty())
+                    .then(|| containment::decide_touching(a, ta, ta_, b, tb, tb_, &contacts))
+                    .flatten();
+                match touching {
+                    Some(c) => c,
+                    None if volumes_overlap(a, ta_, b, tb_, &pairs) => Containment::VolumesOverlap,
+                    None => containment::decide(a, ta, ta_, b, tb, tb_),
                 }
             }
         };
@@ -649,9 +653,13 @@ fn classify_pair(
         return None;
     }
     let d = triangle_distance(ti, tj);
-    let kind = if tol.is_touch(d.distance) {
+    // The exact distance, computed only for a pair near a tolerance.
+    let exact = std::cell::OnceCell::new();
+    let order = |limit: f64| exact.get_or_init(|| exact_distance_sq(ti, tj)).cmp_distance(limit);
+    let scale = Aabb::of_triangle(ti).max_abs().max(Aabb::of_triangle(tj).max_abs());
+    let kind = if tol.touch > 0.0 && Tolerances::within(d.distance, tol.touch, true, scale, order) {
         PairKind::Touching
-    } else if tol.is_clearance(d.distance) {
+    } else if Tolerances::within(d.distance, tol.clearance, false, scale, order) {
         PairKind::Clearance
     } else {
         return None;
@@ -661,7 +669,7 @@ fn classify_pair(
         b: j,
         kind,
         contact: None,
-        distance: d.distance,
+        distance: exact.get().map_or(d.distance, |e| e.rounded()),
         segment: Some([d.on_a, d.on_b]),
     })
 }
@@ -825,7 +833,10 @@ where
         },
         shared_best,
     )?;
-    Some(Closest { distance: best.distance, a: (best.key.0, best.data.0), b: (best.key.1, best.data.1) })
+    // The reported distance: the exact distance of the pair found, correctly rounded.
+    let (i, j) = best.key;
+    let distance = exact_distance_sq(&a.triangle(i), &b.triangle(j)).rounded();
+    Some(Closest { distance, a: (i, best.data.0), b: (j, best.data.1) })
 }
 
 /// A triangle with what the closest-pair search's triangle-pair bounds read of it.

@@ -1,6 +1,7 @@
 //! Geometry primitives: f64 vectors (glam's `DVec3`), axis-aligned boxes, and — in
 //! [`predicates`] — the one module that holds every exact predicate and every tolerance.
 
+pub mod exact;
 pub mod predicates;
 
 pub use glam::DVec3;

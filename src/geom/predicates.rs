@@ -585,16 +585,30 @@ pub const ORIENTED_BOUND_ROUNDING_ULPS: f64 = 64.0;
 /// the exact segment–triangle test.
 pub const SEGMENT_BOX_ROUNDING_ULPS: f64 = 8.0;
 
+/// Half-width of the band around a tolerance inside which a pair's f64 closed-form distance
+/// does not decide `distance <= touch` or `distance < clearance`, for triangles (and tolerance)
+/// at most `scale` in magnitude: the exact distance decides there
+/// ([`crate::narrow::exact_distance`]). `THRESHOLD_FILTER_ULPS` ulps of `scale`.
+pub fn threshold_filter_margin(scale: f64) -> f64 {
+    THRESHOLD_FILTER_ULPS * f64::EPSILON * scale
+}
+
+/// See [`threshold_filter_margin`]: 64 times the bound on the closed forms' rounding
+/// ([`DISTANCE_ROUNDING_ULPS`]), so the f64 value decides only where it cannot be on the wrong
+/// side. The band is a filter, not a tolerance: inside it the exact comparison answers.
+pub const THRESHOLD_FILTER_ULPS: f64 = 64.0 * DISTANCE_ROUNDING_ULPS;
+
 /// User tolerances, all in model units (absolute), all zero by default.
 ///
-/// * `touch`: a pair of triangles that do not share a point but whose f64 closed-form distance
-///   is `<= touch` counts as touching (contact `within_tolerance`). With `touch == 0` touching is
-///   decided exactly and no distance is consulted.
+/// * `touch`: a pair of triangles that do not share a point but whose distance is `<= touch`
+///   counts as touching (contact `within_tolerance`). With `touch == 0` touching is decided
+///   exactly and no distance is consulted.
 /// * `clearance`: a pair that does not touch and whose distance is `< clearance` is reported as
 ///   a clearance finding.
 ///
-/// Distances are computed in f64 closed form (not exactly): a pair whose distance is within a
-/// few ulps of a tolerance may fall on either side. Exact contacts never depend on them.
+/// Both comparisons are exact ([`Tolerances::within`]): the f64 closed-form distance decides
+/// when it is farther than [`threshold_filter_margin`] from the tolerance, the exact rational
+/// distance otherwise.
 #[derive(Debug, Clone, Copy, PartialEq, Default)]
 pub struct Tolerances {
     /// Pairs within this distance count as touching.
@@ -619,20 +633,46 @@ impl Tolerances {
         if m == 0.0 {
             a.overlaps(b)
         } else {
-            a.distance_sq(b) <= m * m
+            // Widened by the threshold band: the exact comparisons decide the pairs inside it.
+            let reach = m + threshold_filter_margin(a.max_abs().max(b.max_abs()).max(m));
+            a.distance_sq(b) <= reach * reach
         }
     }
 
     /// Does a pair at (f64) distance `d`, which does not touch exactly, count as touching?
+    /// The f64 comparison alone (see [`Tolerances::within`] for the exact one).
     #[inline]
     pub fn is_touch(&self, d: f64) -> bool {
         self.touch > 0.0 && d <= self.touch
     }
 
-    /// Is a non-touching pair at distance `d` a clearance finding?
+    /// Is a non-touching pair at distance `d` a clearance finding? The f64 comparison alone.
     #[inline]
     pub fn is_clearance(&self, d: f64) -> bool {
         d < self.clearance
+    }
+
+    /// Exactly: is the distance of a pair within `limit` (`<=` when `inclusive`, else `<`)?
+    /// `d` is its f64 closed-form distance, `scale` the largest coordinate magnitude of the two
+    /// triangles; `exact` gives the order of the exact distance against a value, and is called
+    /// only when `d` lies within [`threshold_filter_margin`] of `limit`.
+    #[inline]
+    pub fn within(
+        d: f64,
+        limit: f64,
+        inclusive: bool,
+        scale: f64,
+        exact: impl FnOnce(f64) -> std::cmp::Ordering,
+    ) -> bool {
+        let band = threshold_filter_margin(scale.max(limit));
+        if d < limit - band {
+            true
+        } else if d > limit + band {
+            false
+        } else {
+            let o = exact(limit);
+            o.is_lt() || (inclusive && o.is_eq())
+        }
     }
 }
 

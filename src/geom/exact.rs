@@ -1,0 +1,319 @@
+//! Exact integer arithmetic for the few decisions that need an exact *value* rather than the
+//! sign of one determinant: sums of several orientation determinants (the side of a point given
+//! by rational barycentric weights), and squared distances compared with a threshold.
+//!
+//! Every finite f64 is an odd integer times a power of two, so the coordinates of one
+//! computation, all written as integers times `2^base` where `base` is the lowest set bit
+//! exponent among them ([`Frame`]), turn every polynomial in them into an integer polynomial,
+//! evaluated here without rounding ([`Int`]: sign and magnitude in 32-bit limbs, schoolbook
+//! products). Used only where the f64 filters of [`crate::geom::predicates`] cannot decide, so
+//! the cost of arbitrary precision is paid on borderline cases alone.
+
+use crate::geom::DVec3;
+use std::cmp::Ordering;
+
+/// A signed integer of any size. Normalized: no high zero limbs, and zero is never negative.
+#[derive(Clone, Debug, PartialEq, Eq, Default)]
+pub struct Int {
+    neg: bool,
+    mag: Vec<u32>,
+}
+
+fn trim(mut m: Vec<u32>) -> Vec<u32> {
+    while m.last() == Some(&0) {
+        m.pop();
+    }
+    m
+}
+
+fn cmp_mag(a: &[u32], b: &[u32]) -> Ordering {
+    a.len().cmp(&b.len()).then_with(|| a.iter().rev().cmp(b.iter().rev()))
+}
+
+fn add_mag(a: &[u32], b: &[u32]) -> Vec<u32> {
+    let (long, short) = if a.len() >= b.len() { (a, b) } else { (b, a) };
+    let mut out = Vec::with_capacity(long.len() + 1);
+    let mut carry = 0u64;
+    for (i, &x) in long.iter().enumerate() {
+        let s = x as u64 + *short.get(i).unwrap_or(&0) as u64 + carry;
+        out.push(s as u32);
+        carry = s >> 32;
+    }
+    if carry > 0 {
+        out.push(carry as u32);
+    }
+    out
+}
+
+/// `a - b` for `|a| >= |b|`.
+fn sub_mag(a: &[u32], b: &[u32]) -> Vec<u32> {
+    let mut out = Vec::with_capacity(a.len());
+    let mut borrow = 0i64;
+    for (i, &x) in a.iter().enumerate() {
+        let mut d = x as i64 - *b.get(i).unwrap_or(&0) as i64 - borrow;
+        borrow = (d < 0) as i64;
+        d += borrow << 32;
+        out.push(d as u32);
+    }
+    trim(out)
+}
+
+fn mul_mag(a: &[u32], b: &[u32]) -> Vec<u32> {
+    if a.is_empty() || b.is_empty() {
+        return Vec::new();
+    }
+    let mut out = vec![0u32; a.len() + b.len()];
+    for (i, &x) in a.iter().enumerate() {
+        let mut carry = 0u64;
+        for (j, &y) in b.iter().enumerate() {
+            let t = x as u64 * y as u64 + out[i + j] as u64 + carry;
+            out[i + j] = t as u32;
+            carry = t >> 32;
+        }
+        out[i + b.len()] = carry as u32;
+    }
+    trim(out)
+}
+
+impl Int {
+    fn new(neg: bool, mag: Vec<u32>) -> Int {
+        let mag = trim(mag);
+        Int { neg: neg && !mag.is_empty(), mag }
+    }
+
+    /// The integer `v`.
+    pub fn from_i64(v: i64) -> Int {
+        let m = v.unsigned_abs();
+        Int::new(v < 0, vec![m as u32, (m >> 32) as u32])
+    }
+
+    /// `m · 2^shift` for a non-negative `shift`.
+    fn from_parts(neg: bool, m: u64, shift: u32) -> Int {
+        let (limbs, bits) = ((shift / 32) as usize, shift % 32);
+        let wide = (m as u128) << bits;
+        let mut mag = vec![0u32; limbs];
+        mag.extend([wide as u32, (wide >> 32) as u32, (wide >> 64) as u32]);
+        Int::new(neg, mag)
+    }
+
+    /// -1, 0 or 1.
+    pub fn signum(&self) -> i8 {
+        if self.mag.is_empty() {
+            0
+        } else if self.neg {
+            -1
+        } else {
+            1
+        }
+    }
+
+    /// `self + o`.
+    pub fn add(&self, o: &Int) -> Int {
+        if self.neg == o.neg {
+            return Int::new(self.neg, add_mag(&self.mag, &o.mag));
+        }
+        match cmp_mag(&self.mag, &o.mag) {
+            Ordering::Less => Int::new(o.neg, sub_mag(&o.mag, &self.mag)),
+            _ => Int::new(self.neg, sub_mag(&self.mag, &o.mag)),
+        }
+    }
+
+    /// `-self`.
+    pub fn neg(&self) -> Int {
+        Int::new(!self.neg, self.mag.clone())
+    }
+
+    /// `self - o`.
+    pub fn sub(&self, o: &Int) -> Int {
+        self.add(&o.neg())
+    }
+
+    /// `self · o`.
+    pub fn mul(&self, o: &Int) -> Int {
+        Int::new(self.neg != o.neg, mul_mag(&self.mag, &o.mag))
+    }
+
+    /// `(m, e)` with `self ≈ m · 2^e`, `m` the leading 65 to 96 bits as an f64 (a relative
+    /// error of about one f64 rounding; exactly 0 for 0): an estimate that never overflows.
+    pub fn approx(&self) -> (f64, i64) {
+        let n = self.mag.len();
+        let top = self.mag.iter().rev().take(3).fold(0.0, |acc, &l| acc * 4_294_967_296.0 + l as f64);
+        let m = if self.neg { -top } else { top };
+        (m, 32 * n.saturating_sub(3) as i64)
+    }
+
+    /// Numeric order.
+    pub fn cmp_value(&self, o: &Int) -> Ordering {
+        match (self.neg, o.neg) {
+            (false, true) => Ordering::Greater,
+            (true, false) => Ordering::Less,
+            (false, false) => cmp_mag(&self.mag, &o.mag),
+            (true, true) => cmp_mag(&o.mag, &self.mag),
+        }
+    }
+}
+
+/// `x = m · 2^e` with `m` odd (or 0): `(negative, m, e)`.
+fn decompose(x: f64) -> (bool, u64, i32) {
+    let bits = x.to_bits();
+    let (neg, exp, frac) = (bits >> 63 == 1, ((bits >> 52) & 0x7ff) as i32, bits & ((1 << 52) - 1));
+    let (m, e) = if exp == 0 { (frac, -1074) } else { (frac | 1 << 52, exp - 1075) };
+    if m == 0 {
+        return (false, 0, 0);
+    }
+    let tz = m.trailing_zeros();
+    (neg, m >> tz, e + tz as i32)
+}
+
+/// A common scale for the coordinates of one exact computation: every value is read as the
+/// integer `x / 2^base`, where `2^base` is the lowest set bit among the values the frame was
+/// made for (so every product of `k` of them is exact at scale `2^(k·base)`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct Frame {
+    base: i32,
+}
+
+impl Frame {
+    /// The frame of a set of finite values.
+    pub fn of(values: impl IntoIterator<Item = f64>) -> Frame {
+        let base = values.into_iter().filter(|&x| x != 0.0).map(|x| decompose(x).2).min().unwrap_or(0);
+        Frame { base }
+    }
+
+    /// The frame of a set of points.
+    pub fn of_points<'a>(points: impl IntoIterator<Item = &'a DVec3>) -> Frame {
+        Frame::of(points.into_iter().flat_map(|p| p.to_array()))
+    }
+
+    /// The power of two every value is a multiple of.
+    pub fn base(&self) -> i32 {
+        self.base
+    }
+
+    /// `x / 2^base`, exactly (`x` must be a value the frame was made for, or a multiple of
+    /// `2^base`).
+    pub fn int(&self, x: f64) -> Int {
+        let (neg, m, e) = decompose(x);
+        if m == 0 {
+            return Int::default();
+        }
+        debug_assert!(e >= self.base, "value below the frame");
+        Int::from_parts(neg, m, (e - self.base) as u32)
+    }
+
+    /// A point's coordinates as integers.
+    pub fn point(&self, p: DVec3) -> [Int; 3] {
+        p.to_array().map(|x| self.int(x))
+    }
+}
+
+/// `u - v` per coordinate.
+pub fn diff(u: &[Int; 3], v: &[Int; 3]) -> [Int; 3] {
+    [u[0].sub(&v[0]), u[1].sub(&v[1]), u[2].sub(&v[2])]
+}
+
+/// `u · v`.
+pub fn dot(u: &[Int; 3], v: &[Int; 3]) -> Int {
+    u[0].mul(&v[0]).add(&u[1].mul(&v[1])).add(&u[2].mul(&v[2]))
+}
+
+/// `u × v`.
+pub fn cross(u: &[Int; 3], v: &[Int; 3]) -> [Int; 3] {
+    [
+        u[1].mul(&v[2]).sub(&u[2].mul(&v[1])),
+        u[2].mul(&v[0]).sub(&u[0].mul(&v[2])),
+        u[0].mul(&v[1]).sub(&u[1].mul(&v[0])),
+    ]
+}
+
+/// The exact value of `((b - a) × (c - a)) · (d - a)` at the frame's scale (times
+/// `2^(-3·base)`); its sign is [`crate::geom::predicates::orient3d`]'s.
+pub fn orient3d(f: &Frame, a: DVec3, b: DVec3, c: DVec3, d: DVec3) -> Int {
+    let pa = f.point(a);
+    let (u, v, w) = (diff(&f.point(b), &pa), diff(&f.point(c), &pa), diff(&f.point(d), &pa));
+    dot(&cross(&u, &v), &w)
+}
+
+/// The exact value of component `axis` of `(b - a) × (c - a)` at the frame's scale (times
+/// `2^(-2·base)`); its sign is [`crate::geom::predicates::orient2d`]'s.
+pub fn orient2d(f: &Frame, a: DVec3, b: DVec3, c: DVec3, axis: usize) -> Int {
+    let pa = f.point(a);
+    let (u, v) = (diff(&f.point(b), &pa), diff(&f.point(c), &pa));
+    let (i, j) = ((axis + 1) % 3, (axis + 2) % 3);
+    u[i].mul(&v[j]).sub(&u[j].mul(&v[i]))
+}
+
+/// `Σ w_k · x_k` for small integer weights.
+pub fn weighted_sum(terms: impl IntoIterator<Item = (i64, Int)>) -> Int {
+    terms.into_iter().fold(Int::default(), |s, (w, x)| s.add(&Int::from_i64(w).mul(&x)))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::geom::predicates as pr;
+
+    fn to_i128(x: &Int) -> i128 {
+        let mut v: i128 = 0;
+        for &l in x.mag.iter().rev() {
+            v = (v << 32) | l as i128;
+        }
+        if x.neg {
+            -v
+        } else {
+            v
+        }
+    }
+
+    #[test]
+    fn integer_operations_agree_with_i128() {
+        let vals = [0i64, 1, -1, 7, -123_456_789, i64::MAX, i64::MIN + 1, 1 << 40, -(1 << 33) + 5];
+        for &a in &vals {
+            for &b in &vals {
+                let (x, y) = (Int::from_i64(a), Int::from_i64(b));
+                let (a, b) = (a as i128, b as i128);
+                assert_eq!(to_i128(&x.add(&y)), a + b);
+                assert_eq!(to_i128(&x.sub(&y)), a - b);
+                if let Some(p) = a.checked_mul(b) {
+                    assert_eq!(to_i128(&x.mul(&y)), p);
+                }
+                assert_eq!(x.cmp_value(&y), a.cmp(&b));
+                assert_eq!(x.signum() as i128, a.signum());
+            }
+        }
+    }
+
+    #[test]
+    fn frame_values_are_exact_multiples() {
+        let f = Frame::of([0.75, 3.0, -2.5, 0.0, 1e6]);
+        assert_eq!(f.base(), -2);
+        for x in [0.75, 3.0, -2.5, 0.0, 1e6] {
+            assert_eq!(to_i128(&f.int(x)) as f64 * 0.25, x);
+        }
+        // Subnormal and huge values in one frame: 2^-1074 is the unit.
+        let g = Frame::of([f64::from_bits(1), 1.0]);
+        assert_eq!(g.base(), -1074);
+        assert_eq!(g.int(1.0).mag.len(), 34); // 2^1074 needs 1075 bits
+    }
+
+    #[test]
+    fn orientation_values_have_the_predicate_signs() {
+        let mut s = 0x2545_f491_4f6c_dd1du64;
+        let mut rnd = || {
+            s ^= s << 13;
+            s ^= s >> 7;
+            s ^= s << 17;
+            // Nearly coplanar points on a coarse grid with tiny offsets: signs are delicate.
+            ((s % 17) as f64 - 8.0) * 0.5
+                + if s.is_multiple_of(5) { ((s >> 20) % 3) as f64 * 1e-17 } else { 0.0 }
+        };
+        for _ in 0..2000 {
+            let p: Vec<DVec3> = (0..4).map(|_| DVec3::new(rnd(), rnd(), rnd())).collect();
+            let f = Frame::of_points(&p);
+            assert_eq!(orient3d(&f, p[0], p[1], p[2], p[3]).signum(), pr::orient3d(p[0], p[1], p[2], p[3]));
+            for k in 0..3 {
+                assert_eq!(orient2d(&f, p[0], p[1], p[2], k).signum(), pr::orient2d(p[0], p[1], p[2], k));
+            }
+        }
+    }
+}
