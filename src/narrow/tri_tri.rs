@@ -110,24 +110,22 @@ impl Shape {
 /// for bit (points included).
 pub fn classify(a: &[DVec3; 3], b: &[DVec3; 3]) -> Option<Hit> {
     let fb = PlaneFilter::new(b);
-    // A proper `b` with all of `a` strictly on one side of its plane: apart, whatever shape `a`
-    // has (a segment or point of `a` is then strictly on that side too).
-    if fb.proper() && apart(&fb, a) {
-        return None;
-    }
-    let fa = PlaneFilter::new(a);
-    if fa.proper() && fb.proper() {
-        // Both proven non-collinear: `Shape::of` would return `Tri` for both.
-        return Classifier::<Exact>::tri_tri_filtered(a, &fa, b, &fb);
+    if fb.proper() {
+        // The filter's sides of `a`'s vertices against `b`'s plane, computed once: all strictly
+        // on one side means apart, whatever shape `a` has (a segment or point of `a` is then
+        // strictly on that side too).
+        let s = a.map(|p| fb.side(p));
+        if s == [Some(1); 3] || s == [Some(-1); 3] {
+            return None;
+        }
+        let fa = PlaneFilter::new(a);
+        if fa.proper() {
+            // Both proven non-collinear: `Shape::of` would return `Tri` for both.
+            let sa = Classifier::<Exact>::settle(s, b, a);
+            return Classifier::<Exact>::tri_tri_from(a, b, sa, || Classifier::<Exact>::sides_all(&fa, a, b));
+        }
     }
     Classifier::<Exact>::classify_shapes(&Shape::of(a), &Shape::of(b))
-}
-
-/// True if the filter proves all of `pts` strictly on one side of its plane.
-#[inline]
-fn apart(f: &PlaneFilter, pts: &[DVec3; 3]) -> bool {
-    let s = pts.map(|p| f.side(p));
-    s == [Some(1); 3] || s == [Some(-1); 3]
 }
 
 /// As [`classify`], for already classified shapes.
@@ -248,7 +246,14 @@ impl<K: Kernel> Classifier<K> {
         if s == [Some(1); 3] || s == [Some(-1); 3] {
             return None;
         }
-        Some([0, 1, 2].map(|i| s[i].unwrap_or_else(|| pr::orient3d_undecided(t[0], t[1], t[2], pts[i]))))
+        Some(Self::settle(s, t, pts))
+    }
+
+    /// The exact signs of `pts` against the plane of `t`: the filter's `s` where it decided,
+    /// the exact stages elsewhere.
+    #[inline]
+    fn settle(s: [Option<Sign>; 3], t: &[DVec3; 3], pts: &[DVec3; 3]) -> [Sign; 3] {
+        [0, 1, 2].map(|i| s[i].unwrap_or_else(|| pr::orient3d_undecided(t[0], t[1], t[2], pts[i])))
     }
 
     /// As [`Self::sides`], always returning the signs.
