@@ -543,7 +543,12 @@ fn run_peers(python: &Path, dir: &Path, cases: &[&str]) -> Result<Vec<Peer>> {
         .output()
         .map_err(|e| usage(format!("--peers {}: cannot run: {e}", python.display())))?;
     if !out.status.success() {
-        return Err(usage(format!("--peers {}: {} exited with {}", python.display(), script.display(), out.status)));
+        return Err(usage(format!(
+            "--peers {}: {} exited with {}",
+            python.display(),
+            script.display(),
+            out.status
+        )));
     }
     let run: PeerRun = serde_json::from_slice(&out.stdout)
         .map_err(|e| usage(format!("--peers {}: unexpected output: {e}", python.display())))?;

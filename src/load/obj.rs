@@ -441,7 +441,16 @@ mod chunked {
     }
 
     fn chunk(bytes: &[u8]) -> Option<Chunk> {
-        let mut c = Chunk::default();
+        // Capacity for the most vertices and plain triangles the chunk can hold (a statement
+        // takes at least 8 bytes), so the vectors never move while growing: reserved but
+        // untouched pages cost nothing.
+        let most = bytes.len() / 8 + 1;
+        let mut c = Chunk {
+            positions: Vec::with_capacity(most),
+            triangles: Vec::with_capacity(most),
+            names_before: Vec::with_capacity(most),
+            ..Chunk::default()
+        };
         let mut face: Vec<i64> = Vec::new();
         let mut start = 0;
         let ends = memchr::memchr_iter(b'\n', bytes).chain(std::iter::once(bytes.len()));

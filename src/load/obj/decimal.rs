@@ -64,35 +64,14 @@ pub(super) fn parse(t: &[u8]) -> Option<f64> {
     let mut i = 0;
     let mut w: u64 = 0;
     let mut significant: u32 = 0;
-    let mut mantissa_digits = 0usize;
     // Integer part.
-    while let Some(&c) = rest.get(i) {
-        let d = c.wrapping_sub(b'0');
-        if d > 9 {
-            break;
-        }
-        if w != 0 || d != 0 {
-            significant += 1;
-            w = w.wrapping_mul(10).wrapping_add(d as u64);
-        }
-        i += 1;
-    }
-    mantissa_digits += i;
+    digits(rest, &mut i, &mut w, &mut significant);
+    let mut mantissa_digits = i;
     let mut exponent: i64 = 0;
     if rest.get(i) == Some(&b'.') {
         i += 1;
         let start = i;
-        while let Some(&c) = rest.get(i) {
-            let d = c.wrapping_sub(b'0');
-            if d > 9 {
-                break;
-            }
-            if w != 0 || d != 0 {
-                significant += 1;
-                w = w.wrapping_mul(10).wrapping_add(d as u64);
-            }
-            i += 1;
-        }
+        digits(rest, &mut i, &mut w, &mut significant);
         mantissa_digits += i - start;
         exponent = -((i - start) as i64);
     }
@@ -133,6 +112,55 @@ pub(super) fn parse(t: &[u8]) -> Option<f64> {
     }
     let magnitude = if w == 0 { 0.0 } else { scale(w, exponent)? };
     Some(if negative { -magnitude } else { magnitude })
+}
+
+/// Reads the run of ASCII digits of `t` from `*i` into `w` (`w · 10 + d` per digit; wrapping,
+/// so only meaningful while `significant` ≤ [`MAX_DIGITS`]), counting the digits from the first
+/// non-zero one on in `significant`. Eight digits at a time where eight are there.
+#[inline(always)]
+fn digits(t: &[u8], i: &mut usize, w: &mut u64, significant: &mut u32) {
+    while let Some(eight) = t.get(*i..*i + 8) {
+        let Some(v) = eight_digits(u64::from_le_bytes(eight.try_into().expect("8 bytes"))) else {
+            break;
+        };
+        if *w != 0 {
+            *significant += 8;
+        } else if v != 0 {
+            // Digits of `v` (its leading zeros are leading zeros of the number).
+            *significant += v.ilog10() + 1;
+        }
+        *w = w.wrapping_mul(100_000_000).wrapping_add(v as u64);
+        *i += 8;
+    }
+    while let Some(&c) = t.get(*i) {
+        let d = c.wrapping_sub(b'0');
+        if d > 9 {
+            break;
+        }
+        if *w != 0 || d != 0 {
+            *significant += 1;
+            *w = w.wrapping_mul(10).wrapping_add(d as u64);
+        }
+        *i += 1;
+    }
+}
+
+/// The value of eight ASCII digits (the first in the lowest byte), or `None` if one of the
+/// bytes is not a digit.
+#[inline(always)]
+fn eight_digits(chunk: u64) -> Option<u32> {
+    let low = chunk.wrapping_sub(0x3030_3030_3030_3030); // byte - '0'
+    let high = chunk.wrapping_add(0x4646_4646_4646_4646); // byte + ('\x7f' - '9')
+                                                          // A byte below '0' borrows or wraps into its top bit; one above '9' carries into it; so
+                                                          // does any byte with its own top bit set.
+    if (low | high | chunk) & 0x8080_8080_8080_8080 != 0 {
+        return None;
+    }
+    // Pairs, then quadruples, then the eight: each step joins neighbouring fields (the first
+    // digit is the most significant).
+    let pairs = (low * 10 + (low >> 8)) & 0x00ff_00ff_00ff_00ff;
+    let quads = (pairs * 100 + (pairs >> 16)) & 0x0000_ffff_0000_ffff;
+    Some(((quads * 10_000 + (quads >> 32)) & 0xffff_ffff) as u32)
 }
 
 /// `w · 10^e` correctly rounded (`w > 0`), when one of the exact routes of the module doc
@@ -188,6 +216,26 @@ mod tests {
         }
         fn below(&mut self, n: u64) -> u64 {
             self.next() % n
+        }
+    }
+
+    #[test]
+    fn eight_digits_reads_digits_and_refuses_everything_else() {
+        let mut rng = Rng(0x8888_1234_5678_9abc);
+        for _ in 0..200_000 {
+            let mut b = [0u8; 8];
+            for x in &mut b {
+                *x = if rng.below(4) == 0 { rng.next() as u8 } else { b'0' + rng.below(10) as u8 };
+            }
+            let want = std::str::from_utf8(&b)
+                .ok()
+                .filter(|s| s.bytes().all(|c| c.is_ascii_digit()))
+                .map(|s| s.parse::<u32>().unwrap());
+            assert_eq!(super::eight_digits(u64::from_le_bytes(b)), want, "{b:?}");
+        }
+        for s in [b"00000000", b"99999999", b"12345678", b"0000000/", b":0000000", b"1234567\xff"] {
+            let want = std::str::from_utf8(s).ok().and_then(|s| s.parse::<u32>().ok());
+            assert_eq!(super::eight_digits(u64::from_le_bytes(*s)), want);
         }
     }
 
