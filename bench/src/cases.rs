@@ -82,6 +82,11 @@ pub struct CasesArgs {
     /// Print JSON instead of tables.
     #[arg(long)]
     pub json: bool,
+    /// Also run the same-run peers of `bench/peers.py` (trueform, python-fcl: each only when
+    /// that Python can import it) with this Python interpreter, and check their answers
+    /// against meshclash's.
+    #[arg(long, value_name = "PYTHON")]
+    pub peers: Option<PathBuf>,
 }
 
 /// Every case name, in run order.
@@ -467,6 +472,116 @@ pub struct CaseResult {
     pub parry_f64: Option<Phases>,
     /// parry3d (f32).
     pub parry_f32: Option<Phases>,
+    /// Peers run by `bench/peers.py` (`--peers`).
+    pub peers: Vec<Peer>,
+}
+
+/// One peer of `bench/peers.py` on one case, ms, and whether its answers equal meshclash's.
+#[derive(Debug, Clone, Default, Serialize, serde::Deserialize)]
+pub struct Peer {
+    /// Tool and version.
+    pub tool: String,
+    /// Case name.
+    pub case: String,
+    /// Loading both files (the peer's reader).
+    #[serde(default)]
+    pub load_ms: f64,
+    /// Building both trees.
+    #[serde(default)]
+    pub build_ms: f64,
+    /// The yes/no intersection query.
+    #[serde(default)]
+    pub intersects_ms: f64,
+    /// Every intersecting triangle pair.
+    #[serde(default)]
+    pub pairs_ms: f64,
+    /// The distance query.
+    #[serde(default)]
+    pub distance_ms: f64,
+    /// Its answers.
+    #[serde(default)]
+    pub intersects: bool,
+    /// Intersecting pairs found.
+    #[serde(default)]
+    pub pairs: usize,
+    /// Distance found (0 when they meet).
+    #[serde(default)]
+    pub distance: f64,
+    /// The peer's error, if it failed.
+    pub error: Option<String>,
+    /// Filled in here: how its answers compare with meshclash's.
+    #[serde(default)]
+    pub check: String,
+}
+
+impl Peer {
+    /// load + build + pairs (the whole answer to "which pairs clash").
+    pub fn pairs_total(&self) -> f64 {
+        self.load_ms + self.build_ms + self.pairs_ms
+    }
+    /// load + build + distance.
+    pub fn distance_total(&self) -> f64 {
+        self.load_ms + self.build_ms + self.distance_ms
+    }
+}
+
+/// The JSON `bench/peers.py --json` prints.
+#[derive(serde::Deserialize)]
+struct PeerRun {
+    results: Vec<Peer>,
+}
+
+/// Runs `bench/peers.py` on `cases` with `python`; an interpreter that cannot be started or
+/// output that is not the expected JSON is an error naming the interpreter.
+fn run_peers(python: &Path, dir: &Path, cases: &[&str]) -> Result<Vec<Peer>> {
+    let script = Path::new(env!("CARGO_MANIFEST_DIR")).join("peers.py");
+    let out = std::process::Command::new(python)
+        .arg(&script)
+        .arg(dir)
+        .args(["--json", "--only", &cases.join(",")])
+        .stderr(std::process::Stdio::inherit())
+        .output()
+        .map_err(|e| usage(format!("--peers {}: cannot run: {e}", python.display())))?;
+    if !out.status.success() {
+        return Err(usage(format!(
+            "--peers {}: {} exited with {}",
+            python.display(),
+            script.display(),
+            out.status
+        )));
+    }
+    let run: PeerRun = serde_json::from_slice(&out.stdout)
+        .map_err(|e| usage(format!("--peers {}: unexpected output: {e}", python.display())))?;
+    Ok(run.results)
+}
+
+/// How a peer's answers compare with meshclash's (`verdict`, pairs, exact distance).
+fn judge(p: &Peer, verdict: &str, pairs: Option<usize>, distance: Option<f64>) -> String {
+    if let Some(e) = &p.error {
+        return format!("failed: {e}");
+    }
+    let meet = verdict == "clash" || verdict == "touching";
+    let mut out = Vec::new();
+    if p.intersects != meet {
+        out.push(format!("WRONG: intersects = {} (meshclash: {verdict})", p.intersects));
+    }
+    if let Some(n) = pairs.filter(|_| meet) {
+        if p.pairs != n {
+            out.push(format!("pairs {} vs {n}", p.pairs));
+        }
+    }
+    if let Some(d) = distance {
+        let err = (p.distance - d).abs();
+        // f32 input read exactly into f64: an f64 peer's distance agrees to ~1e-12 relative.
+        if err > 1e-9 * d.max(1.0) {
+            out.push(format!("distance off by {err:.2e}"));
+        }
+    }
+    if out.is_empty() {
+        "answers equal".into()
+    } else {
+        out.join("; ")
+    }
 }
 
 /// Everything one `cases` run measured.
@@ -542,6 +657,7 @@ fn run_case(name: &str, dir: &Path, args: &CasesArgs) -> Result<CaseResult> {
             },
             parry_f64: None,
             parry_f32: None,
+            peers: Vec::new(),
         });
     }
     let t = Instant::now();
@@ -594,6 +710,7 @@ fn run_case(name: &str, dir: &Path, args: &CasesArgs) -> Result<CaseResult> {
         meshclash,
         parry_f64: p64,
         parry_f32: p32,
+        peers: Vec::new(),
     })
 }
 
@@ -642,10 +759,18 @@ pub fn run_cases(args: &CasesArgs) -> Result<String> {
         .build()
         .map_err(|e| Error::bad_flag("threads", UsageProblem::Invalid(e.to_string())))?;
     let load0 = loadavg();
-    let results = pool.install(|| {
+    let mut results = pool.install(|| {
         rayon::broadcast(|_| ()); // start the workers outside the timed regions
         cases.iter().map(|c| run_case(c, &args.dir, args)).collect::<Result<Vec<_>>>()
     })?;
+    if let Some(python) = &args.peers {
+        for mut p in run_peers(python, &args.dir, &cases)? {
+            if let Some(c) = results.iter_mut().find(|c| c.name == p.case) {
+                p.check = judge(&p, &c.verdict, c.meshclash.pairs, c.meshclash.distance);
+                c.peers.push(p);
+            }
+        }
+    }
     let rep = CasesReport {
         cores: std::thread::available_parallelism().map_or(1, |n| n.get()),
         threads: pool.current_num_threads(),
@@ -687,9 +812,13 @@ pub fn render_cases(rep: &CasesReport) -> String {
             "\n### {} ({} + {} triangles, meshclash: {})\n\n",
             c.name, c.triangles[0], c.triangles[1], c.verdict
         ));
-        s.push_str("| tool | load ms | build ms | pairs ms | distance ms | pairs-only ms | pairs+distance ms | check ms | pairs | distance | note |\n");
+        s.push_str(
+            "| tool | load ms | build ms | pairs ms | distance ms | load+build+pairs ms | load+build+pairs+distance ms | check ms | pairs | distance | note |\n",
+        );
         s.push_str("|---|---|---|---|---|---|---|---|---|---|---|\n");
         let m = &c.meshclash;
+        // What the CLI does: load, then the whole check on lazily built trees.
+        let cli = m.check_ms.map(|c| m.load_ms + c);
         let mut row = |tool: &str, p: &Phases| {
             s.push_str(&format!(
                 "| {tool} | {} | {} | {} | {} | {} | {} | {} | {} | {} | {} |\n",
@@ -705,11 +834,40 @@ pub fn render_cases(rep: &CasesReport) -> String {
                 p.note.as_deref().unwrap_or("")
             ));
         };
-        row("meshclash", m);
+        if m.build_ms.is_some() {
+            row("meshclash, eager full trees (not what the CLI runs)", m);
+            let cli_only = Phases {
+                load_ms: m.load_ms,
+                check_ms: m.check_ms,
+                pairs: m.pairs,
+                distance: m.distance,
+                note: Some(format!("as the CLI: load + check = {} ms", cell(cli))),
+                ..Default::default()
+            };
+            row("meshclash (CLI path)", &cli_only);
+        } else {
+            row("meshclash", m);
+        }
         for (tool, p) in [("parry3d-f64", &c.parry_f64), ("parry3d f32", &c.parry_f32)] {
             if let Some(p) = p {
                 row(tool, p);
             }
+        }
+        for p in &c.peers {
+            s.push_str(&format!(
+                "| {} | {} | {} | {} | {} | {} | {} | intersects {} | {} | {:.9} | {} |\n",
+                p.tool,
+                cell(Some(p.load_ms)),
+                cell(Some(p.build_ms)),
+                cell(Some(p.pairs_ms)),
+                cell(Some(p.distance_ms)),
+                cell(Some(p.pairs_total())),
+                cell(Some(p.distance_total())),
+                cell(Some(p.intersects_ms)),
+                p.pairs,
+                p.distance,
+                p.check
+            ));
         }
         for (tool, p) in [("parry3d-f64", &c.parry_f64), ("parry3d f32", &c.parry_f32)] {
             if let Some(p) = p {
@@ -722,6 +880,25 @@ pub fn render_cases(rep: &CasesReport) -> String {
                     ratio(p.distance_total(), m.distance_total()),
                 ));
             }
+        }
+        // Against what the CLI runs: the peer's whole answer (load + build + pairs, and the
+        // distance too where meshclash finds the meshes apart) ÷ meshclash's load + check.
+        let clear = m.distance.is_some_and(|d| d > 0.0);
+        let mut whole: Vec<(String, Option<f64>)> = Vec::new();
+        for (tool, p) in [("parry3d-f64", &c.parry_f64), ("parry3d f32", &c.parry_f32)] {
+            if let Some(p) = p {
+                whole.push((tool.into(), if clear { p.distance_total() } else { p.pairs_total() }));
+            }
+        }
+        for p in c.peers.iter().filter(|p| p.error.is_none()) {
+            whole.push((p.tool.clone(), Some(if clear { p.distance_total() } else { p.pairs_total() })));
+        }
+        for (tool, t) in whole {
+            s.push_str(&format!(
+                "| {tool} ÷ meshclash CLI path | | | | | {} | | | | | load + {} ÷ load + check, same run |\n",
+                ratio(t, cli),
+                if clear { "build + pairs + distance" } else { "build + pairs" },
+            ));
         }
     }
     s

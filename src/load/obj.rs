@@ -19,6 +19,8 @@
 //! - Names and comments may hold any bytes (decoded lossily); a number that is not valid UTF-8
 //!   is an error `line N: not UTF-8 at byte B`.
 
+mod decimal;
+
 use std::borrow::Cow;
 use std::path::Path;
 
@@ -156,11 +158,7 @@ impl<'p> Parser<'p> {
             return Ok(());
         };
         match keyword {
-            b"v" => match std::str::from_utf8(text) {
-                // One UTF-8 check per line, not per coordinate (it was a fifth of the parse).
-                Ok(valid) => self.vertex(line, start, &mut tokens, Some(valid)),
-                Err(_) => self.vertex(line, start, &mut tokens, None),
-            },
+            b"v" => self.vertex(line, start, &mut tokens),
             b"f" | b"fo" => self.face(line, start, &mut tokens),
             b"o" | b"g" => {
                 let name = String::from_utf8_lossy(tokens.rest()).trim().to_string();
@@ -185,19 +183,19 @@ impl<'p> Parser<'p> {
         }
     }
 
-    /// `valid`: the whole line, when it is known to be UTF-8.
-    fn vertex(&mut self, line: usize, start: usize, tokens: &mut Tokens, valid: Option<&str>) -> Result<()> {
+    fn vertex(&mut self, line: usize, start: usize, tokens: &mut Tokens) -> Result<()> {
         let mut c = [0.0f64; 3];
         for (k, slot) in c.iter_mut().enumerate() {
             let Some((off, tok)) = tokens.next() else {
                 return Err(self.err(line, InputProblem::TooFewCoordinates { found: k }));
             };
-            // Tokens end at ASCII whitespace, so they are char boundaries of a valid line.
-            let s = match valid {
-                Some(text) => &text[off..off + tok.len()],
-                None => self.utf8(line, start + off, tok)?,
+            *slot = match decimal::parse(tok) {
+                Some(x) => x,
+                None => {
+                    let s = self.utf8(line, start + off, tok)?;
+                    s.parse::<f64>().map_err(|_| self.err(line, InputProblem::BadNumber(clip(s, 40))))?
+                }
             };
-            *slot = s.parse::<f64>().map_err(|_| self.err(line, InputProblem::BadNumber(clip(s, 40))))?;
         }
         let index = self.mesh.positions.len();
         if let Some(value) = NonFinite::first(c) {
@@ -443,7 +441,16 @@ mod chunked {
     }
 
     fn chunk(bytes: &[u8]) -> Option<Chunk> {
-        let mut c = Chunk::default();
+        // Capacity for the most vertices and plain triangles the chunk can hold (a statement
+        // takes at least 8 bytes), so the vectors never move while growing: reserved but
+        // untouched pages cost nothing.
+        let most = bytes.len() / 8 + 1;
+        let mut c = Chunk {
+            positions: Vec::with_capacity(most),
+            triangles: Vec::with_capacity(most),
+            names_before: Vec::with_capacity(most),
+            ..Chunk::default()
+        };
         let mut face: Vec<i64> = Vec::new();
         let mut start = 0;
         let ends = memchr::memchr_iter(b'\n', bytes).chain(std::iter::once(bytes.len()));
@@ -462,13 +469,13 @@ mod chunked {
             };
             match keyword {
                 b"v" => {
-                    // One UTF-8 check per line; tokens end at ASCII whitespace, so they are
-                    // char boundaries of it.
-                    let line = std::str::from_utf8(text).ok()?;
                     let mut p = [0.0f64; 3];
                     for slot in &mut p {
-                        let (off, tok) = tokens.next()?;
-                        *slot = line[off..off + tok.len()].parse::<f64>().ok()?;
+                        let (_, tok) = tokens.next()?;
+                        *slot = match super::decimal::parse(tok) {
+                            Some(x) => x,
+                            None => std::str::from_utf8(tok).ok()?.parse::<f64>().ok()?,
+                        };
                         if !slot.is_finite() {
                             return None;
                         }

@@ -20,6 +20,7 @@
 pub use crate::geom::predicates::Float;
 use crate::geom::predicates::{self as pr, Adaptive, Exact, Kernel, PlaneFilter, Sign};
 use crate::geom::DVec3;
+use std::cell::Cell;
 
 /// How two triangles meet.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord)]
@@ -110,24 +111,22 @@ impl Shape {
 /// for bit (points included).
 pub fn classify(a: &[DVec3; 3], b: &[DVec3; 3]) -> Option<Hit> {
     let fb = PlaneFilter::new(b);
-    // A proper `b` with all of `a` strictly on one side of its plane: apart, whatever shape `a`
-    // has (a segment or point of `a` is then strictly on that side too).
-    if fb.proper() && apart(&fb, a) {
-        return None;
-    }
-    let fa = PlaneFilter::new(a);
-    if fa.proper() && fb.proper() {
-        // Both proven non-collinear: `Shape::of` would return `Tri` for both.
-        return Classifier::<Exact>::tri_tri_filtered(a, &fa, b, &fb);
+    if fb.proper() {
+        // The filter's sides of `a`'s vertices against `b`'s plane, computed once: all strictly
+        // on one side means apart, whatever shape `a` has (a segment or point of `a` is then
+        // strictly on that side too).
+        let s = a.map(|p| fb.side(p));
+        if s == [Some(1); 3] || s == [Some(-1); 3] {
+            return None;
+        }
+        let fa = PlaneFilter::new(a);
+        if fa.proper() {
+            // Both proven non-collinear: `Shape::of` would return `Tri` for both.
+            let sa = Classifier::<Exact>::settle(s, b, a);
+            return Classifier::<Exact>::tri_tri_from(a, b, sa, || Classifier::<Exact>::sides_all(&fa, a, b));
+        }
     }
     Classifier::<Exact>::classify_shapes(&Shape::of(a), &Shape::of(b))
-}
-
-/// True if the filter proves all of `pts` strictly on one side of its plane.
-#[inline]
-fn apart(f: &PlaneFilter, pts: &[DVec3; 3]) -> bool {
-    let s = pts.map(|p| f.side(p));
-    s == [Some(1); 3] || s == [Some(-1); 3]
 }
 
 /// As [`classify`], for already classified shapes.
@@ -220,10 +219,11 @@ impl<K: Kernel> Classifier<K> {
     /// vertex `i` of `t` with respect to the other plane.
     fn end_point(t: &[DVec3; 3], d: impl Fn(usize) -> f64, e: End) -> DVec3 {
         let (p, q) = (t[e.apex], t[e.other]);
-        let (dp, dq) = (d(e.apex), d(e.other));
+        let dq = d(e.other);
         if dq == 0.0 {
             return q;
         }
+        let dp = d(e.apex);
         let u = dp / (dp - dq);
         p + (q - p) * u
     }
@@ -248,7 +248,14 @@ impl<K: Kernel> Classifier<K> {
         if s == [Some(1); 3] || s == [Some(-1); 3] {
             return None;
         }
-        Some([0, 1, 2].map(|i| s[i].unwrap_or_else(|| pr::orient3d_undecided(t[0], t[1], t[2], pts[i]))))
+        Some(Self::settle(s, t, pts))
+    }
+
+    /// The exact signs of `pts` against the plane of `t`: the filter's `s` where it decided,
+    /// the exact stages elsewhere.
+    #[inline]
+    fn settle(s: [Option<Sign>; 3], t: &[DVec3; 3], pts: &[DVec3; 3]) -> [Sign; 3] {
+        [0, 1, 2].map(|i| s[i].unwrap_or_else(|| pr::orient3d_undecided(t[0], t[1], t[2], pts[i])))
     }
 
     /// As [`Self::sides`], always returning the signs.
@@ -286,8 +293,10 @@ impl<K: Kernel> Classifier<K> {
         let positive = lo_a_hi_b < 0 && hi_a_lo_b > 0 && !ia.single && !ib.single;
         // The shared interval: max of the lows, min of the highs. The determinant values (for
         // placing the ends) only of the vertices used, with their exact signs already known.
-        let da = |i: usize| K::orient3d_value_signed(b[0], b[1], b[2], a[i], sa[i]);
-        let db = |i: usize| K::orient3d_value_signed(a[0], a[1], a[2], b[i], sb[i]);
+        // Each value at most once: both ends of one section share its apex.
+        let (memo_a, memo_b) = (Cell::new([None; 3]), Cell::new([None; 3]));
+        let da = |i: usize| memo(&memo_a, i, || K::orient3d_value_signed(b[0], b[1], b[2], a[i], sa[i]));
+        let db = |i: usize| memo(&memo_b, i, || K::orient3d_value_signed(a[0], a[1], a[2], b[i], sb[i]));
         let lo_cmp = Self::cmp_ends(a, &ia, ia.lo, b, &ib, ib.lo);
         let lo = if lo_cmp >= 0 { Self::end_point(a, da, ia.lo) } else { Self::end_point(b, db, ib.lo) };
         let segment = Some(if positive {
@@ -492,6 +501,15 @@ impl<K: Kernel> Classifier<K> {
         }
         Self::touch(Contact::Point, None)
     }
+}
+
+/// Slot `i` of `cache`, filled by `f` on first use.
+#[inline]
+fn memo(cache: &Cell<[Option<f64>; 3]>, i: usize, f: impl FnOnce() -> f64) -> f64 {
+    let mut c = cache.get();
+    let v = *c[i].get_or_insert_with(f);
+    cache.set(c);
+    v
 }
 
 /// An endpoint of a triangle's section by the other plane: the point where edge
