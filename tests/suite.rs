@@ -56,3 +56,7 @@ mod shard;
 mod tri_tri_oracle;
 #[path = "trust.rs"]
 mod trust;
+#[path = "never_lose.rs"]
+mod never_lose;
+#[path = "bcf_schema.rs"]
+mod bcf_schema;
