@@ -12,7 +12,8 @@ fn root() -> PathBuf {
 }
 
 fn xmllint() -> bool {
-    let ok = std::process::Command::new("xmllint").arg("--version").output().is_ok_and(|o| o.status.success());
+    let ok =
+        std::process::Command::new("xmllint").arg("--version").output().is_ok_and(|o| o.status.success());
     if !ok {
         eprintln!("skipping: xmllint not found (Debian package libxml2-utils)");
     }
@@ -150,7 +151,7 @@ fn text_summary_escapes_control_characters_in_names() {
     let out = Command::cargo_bin("meshclash")
         .unwrap()
         .args([&a, &b])
-        .args(["--format", "text", "--no-timings", "--color", "never"])
+        .args(["--format", "text", "--no-timings"])
         .output()
         .unwrap();
     assert_eq!(out.status.code(), Some(1), "{}", String::from_utf8_lossy(&out.stderr));

@@ -115,7 +115,8 @@ fn output_naming_a_gltf_external_buffer_or_image_is_refused() {
 fn two_outputs_naming_one_new_file_are_refused() {
     let d = two_meshes();
     for second in ["r.json", "./r.json"] {
-        let o = bin().current_dir(d.path()).args(["a.obj", "b.obj", "-o", "r.json", "--junit", second]).output();
+        let o =
+            bin().current_dir(d.path()).args(["a.obj", "b.obj", "-o", "r.json", "--junit", second]).output();
         let o = o.unwrap();
         let err = String::from_utf8_lossy(&o.stderr);
         assert_eq!(o.status.code(), Some(2), "{err}");

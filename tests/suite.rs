@@ -6,6 +6,8 @@
 mod assembly;
 #[path = "bcf.rs"]
 mod bcf;
+#[path = "bcf_schema.rs"]
+mod bcf_schema;
 #[path = "bench_cmd.rs"]
 mod bench_cmd;
 #[path = "bodies_penetration.rs"]
@@ -36,6 +38,8 @@ mod hostile;
 mod html;
 #[path = "layers.rs"]
 mod layers;
+#[path = "never_lose.rs"]
+mod never_lose;
 #[path = "obj_vs_tobj.rs"]
 mod obj_vs_tobj;
 #[path = "outputs.rs"]
@@ -56,7 +60,3 @@ mod shard;
 mod tri_tri_oracle;
 #[path = "trust.rs"]
 mod trust;
-#[path = "never_lose.rs"]
-mod never_lose;
-#[path = "bcf_schema.rs"]
-mod bcf_schema;

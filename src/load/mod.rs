@@ -185,13 +185,16 @@ fn gltf_json_of(path: &Path) -> Result<Vec<u8>> {
     let n = f.read(&mut head).map_err(|e| Error::in_file(path, unreadable(Reading::File, &e)))?;
     if n >= 4 && &head[..4] == b"glTF" {
         // Header (12 bytes), then the first chunk's length and type: JSON.
-        f.read_exact(&mut head[n.min(20)..]).map_err(|e| Error::in_file(path, unreadable(Reading::File, &e)))?;
+        f.read_exact(&mut head[n.min(20)..])
+            .map_err(|e| Error::in_file(path, unreadable(Reading::File, &e)))?;
         let len = u32::from_le_bytes([head[12], head[13], head[14], head[15]]) as u64;
         if &head[16..20] != b"JSON" || len > size {
             return Err(Error::in_file(path, InputProblem::Invalid("no JSON chunk".into())));
         }
         let mut json = Vec::with_capacity(len as usize);
-        f.take(len).read_to_end(&mut json).map_err(|e| Error::in_file(path, unreadable(Reading::File, &e)))?;
+        f.take(len)
+            .read_to_end(&mut json)
+            .map_err(|e| Error::in_file(path, unreadable(Reading::File, &e)))?;
         return Ok(json);
     }
     let mut json = head[..n].to_vec();
@@ -475,7 +478,8 @@ mod tests {
         assert_eq!(e.lines().count(), 1, "{e}");
         let e = read_small_file(dir.path(), Reading::Baseline, 1 << 20).unwrap_err().to_string();
         assert!(e.contains("not a regular file (a directory)"), "{e}");
-        let e = read_small_file(Path::new("/dev/zero"), Reading::ShardReport, 1 << 20).unwrap_err().to_string();
+        let e =
+            read_small_file(Path::new("/dev/zero"), Reading::ShardReport, 1 << 20).unwrap_err().to_string();
         assert!(e.contains("/dev/zero: not a regular file (a character device)"), "{e}");
         let big = dir.path().join("big.json");
         std::fs::write(&big, vec![b' '; 1001]).unwrap();
@@ -499,7 +503,8 @@ mod tests {
         let got = files_read(&d.join("m.gltf"));
         assert_eq!(got, [d.join("m.gltf"), d.join("geo a.bin"), d.join("tex.png")]);
         // A GLB: only its JSON chunk is read.
-        let mut chunk = br#"{"asset":{"version":"2.0"},"buffers":[{"uri":"ext.bin","byteLength":4}]}"#.to_vec();
+        let mut chunk =
+            br#"{"asset":{"version":"2.0"},"buffers":[{"uri":"ext.bin","byteLength":4}]}"#.to_vec();
         while chunk.len() % 4 != 0 {
             chunk.push(b' ');
         }

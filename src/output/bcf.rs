@@ -477,7 +477,10 @@ mod tests {
         let doc = String::from_utf8(x.bytes()).unwrap();
         let parsed = roxmltree::Document::parse(&doc).unwrap();
         let t = parsed.descendants().find(|n| n.has_tag_name("T")).unwrap().text().unwrap();
-        assert!(t.contains("\\u{1}") && t.contains('\u{10FFFF}') && t.contains("<&>"), "not escaped as expected");
+        assert!(
+            t.contains("\\u{1}") && t.contains('\u{10FFFF}') && t.contains("<=>") && t.contains("%&'("),
+            "not escaped as expected"
+        );
     }
 
     #[test]

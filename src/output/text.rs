@@ -89,7 +89,10 @@ pub fn shown(s: &str) -> std::borrow::Cow<'_, str> {
     if !s.chars().any(bad) {
         return s.into();
     }
-    s.chars().map(|c| if bad(c) { c.escape_unicode().to_string() } else { c.to_string() }).collect::<String>().into()
+    s.chars()
+        .map(|c| if bad(c) { c.escape_unicode().to_string() } else { c.to_string() })
+        .collect::<String>()
+        .into()
 }
 
 /// One line describing a pair: kind, triangles with their objects, contact, where.

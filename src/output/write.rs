@@ -238,7 +238,10 @@ pub fn check_outputs(outputs: &[Named], inputs: &[&Path]) -> Result<()> {
                     .map(|d| d.join(target.file_name().unwrap_or_default()));
                 if let Ok(key) = key {
                     if let Some((_, other)) = new.iter().find(|(k, _)| *k == key) {
-                        return Err(fail(OutputProblem::SameFile { flag: flag_(), other: other.to_string() }));
+                        return Err(fail(OutputProblem::SameFile {
+                            flag: flag_(),
+                            other: other.to_string(),
+                        }));
                     }
                     new.push((key, flag));
                 }
