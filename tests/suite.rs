@@ -38,6 +38,8 @@ mod hostile;
 mod html;
 #[path = "layers.rs"]
 mod layers;
+#[path = "memory_bounds.rs"]
+mod memory_bounds;
 #[path = "never_lose.rs"]
 mod never_lose;
 #[path = "obj_vs_tobj.rs"]

@@ -35,6 +35,22 @@ pub use obj::MAX_FACE_VERTICES;
 /// scene that cannot fit.
 pub const CHECK_BYTES_PER_TRIANGLE: u64 = 100;
 
+/// What a check needs per part of a glTF scene after instancing (a node instance or a GPU
+/// instance), whatever its triangles: its object (name, world matrix: ~190 bytes), the
+/// loader's instance record, and the check's per-part records, trees and lists. Measured as
+/// the growth of peak memory with the part count of one-triangle parts (`scene` on 250,000
+/// and 500,000 GPU instances of one triangle); an estimate, used only to refuse up front.
+pub const CHECK_BYTES_PER_PART: u64 = 400;
+
+/// The memory a glTF scene's check is estimated to need: 24 bytes per vertex (its world
+/// positions), [`CHECK_BYTES_PER_TRIANGLE`] per triangle and [`CHECK_BYTES_PER_PART`] per part.
+pub fn scene_estimate(vertices: u64, triangles: u64, parts: u64) -> u64 {
+    vertices
+        .saturating_mul(24)
+        .saturating_add(triangles.saturating_mul(CHECK_BYTES_PER_TRIANGLE))
+        .saturating_add(parts.saturating_mul(CHECK_BYTES_PER_PART))
+}
+
 /// The memory this process may still use, in bytes: the least of the machine's available
 /// memory (`MemAvailable`), the cgroup's limit less its usage, and the address-space limit
 /// (`ulimit -v`) less what is mapped. `None` where none of them can be read.
