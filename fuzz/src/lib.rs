@@ -240,11 +240,11 @@ pub fn self_fans(data: &[u8]) {
         let last = positions.len() as u32 - 1;
         let prev = if last > 2 { last - 1 } else { last };
         let t = match chunk[0] % 6 {
-            0 | 1 => [0, prev, last],             // a fan around vertex 0
-            2 => [1, 0, last],                    // a book on the edge 0-1
+            0 | 1 => [0, prev, last], // a fan around vertex 0
+            2 => [1, 0, last],        // a book on the edge 0-1
             3 => triangles.last().copied().unwrap_or([0, 1, last]).map(|v| v.min(last)), // a copy
-            4 => [last, last, last],              // a point
-            _ => [0, last, last],                 // a segment from vertex 0
+            4 => [last, last, last],  // a point
+            _ => [0, last, last],     // a segment from vertex 0
         };
         triangles.push(if chunk[0] & 64 != 0 { [t[2], t[1], t[0]] } else { t });
     }
@@ -277,7 +277,8 @@ pub fn writers(data: &[u8]) {
     let text = String::from_utf8_lossy(&data[1..]);
     let cut = text.char_indices().nth(text.chars().count() / 2).map_or(text.len(), |(i, _)| i);
     let (na, nb) = (&text[..cut], &text[cut..]);
-    let positions: [f32; 18] = [0., 0., 0., 2., 0., 0., 0., 2., 0., 0.5, 0.5, -1., 0.5, 0.5, 1., 1.5, 0.5, 1.];
+    let positions: [f32; 18] =
+        [0., 0., 0., 2., 0., 0., 0., 2., 0., 0.5, 0.5, -1., 0.5, 0.5, 1., 1.5, 0.5, 1.];
     let bytes: Vec<u8> = positions.iter().flat_map(|x| x.to_le_bytes()).collect();
     let b64 = {
         use std::fmt::Write;
@@ -285,9 +286,15 @@ pub fn writers(data: &[u8]) {
         const A: &[u8; 64] = b"ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
         let mut s = String::new();
         for ch in bytes.chunks(3) {
-            let n = (ch[0] as u32) << 16 | (*ch.get(1).unwrap_or(&0) as u32) << 8 | *ch.get(2).unwrap_or(&0) as u32;
+            let n = (ch[0] as u32) << 16
+                | (*ch.get(1).unwrap_or(&0) as u32) << 8
+                | *ch.get(2).unwrap_or(&0) as u32;
             for k in 0..4 {
-                let _ = if k <= ch.len() { s.write_char(A[(n >> (18 - 6 * k) & 63) as usize] as char) } else { s.write_char('=') };
+                let _ = if k <= ch.len() {
+                    s.write_char(A[(n >> (18 - 6 * k) & 63) as usize] as char)
+                } else {
+                    s.write_char('=')
+                };
             }
         }
         s
@@ -310,10 +317,24 @@ pub fn writers(data: &[u8]) {
     let out = |n: &str| dir.join(n).into_os_string();
     let version = if data[0] & 1 == 0 { "2.1" } else { "3.0" };
     let args: Vec<std::ffi::OsString> = vec![
-        "meshclash".into(), "scene".into(), input.into_os_string(), "--no-timings".into(),
-        "--threads".into(), "1".into(), "-o".into(), out("w.json"), "--junit".into(), out("w.xml"),
-        "--bcf".into(), out("w.bcfzip"), "--bcf-version".into(), version.into(), "--html".into(),
-        out("w.html"), "--export-glb".into(), out("w.glb"),
+        "meshclash".into(),
+        "scene".into(),
+        input.into_os_string(),
+        "--no-timings".into(),
+        "--threads".into(),
+        "1".into(),
+        "-o".into(),
+        out("w.json"),
+        "--junit".into(),
+        out("w.xml"),
+        "--bcf".into(),
+        out("w.bcfzip"),
+        "--bcf-version".into(),
+        version.into(),
+        "--html".into(),
+        out("w.html"),
+        "--export-glb".into(),
+        out("w.glb"),
     ];
     let argv: Vec<&std::ffi::OsStr> = args.iter().map(|a| a.as_os_str()).collect();
     let Some(rep) = run_args(&argv) else { return };
@@ -323,7 +344,8 @@ pub fn writers(data: &[u8]) {
     serde_json::from_slice::<serde_json::Value>(&json).expect("report is JSON");
     let junit = std::fs::read_to_string(dir.join("w.xml")).expect("junit written");
     roxmltree::Document::parse(&junit).expect("junit is XML");
-    let mut z = zip::ZipArchive::new(std::fs::File::open(dir.join("w.bcfzip")).expect("bcf written")).expect("zip");
+    let mut z =
+        zip::ZipArchive::new(std::fs::File::open(dir.join("w.bcfzip")).expect("bcf written")).expect("zip");
     for i in 0..z.len() {
         let mut f = z.by_index(i).expect("member");
         let mut s = String::new();
@@ -359,8 +381,10 @@ pub fn arrays(data: &[u8]) {
     }
     let rest = &data[1..];
     let cut = (rest.len() * data[0] as usize / 256) / 24 * 24;
-    let coords: Vec<f64> = rest[..cut].chunks_exact(8).map(|b| f64::from_le_bytes(b.try_into().unwrap())).collect();
-    let idx: Vec<i64> = rest[cut..].chunks_exact(8).map(|b| i64::from_le_bytes(b.try_into().unwrap())).collect();
+    let coords: Vec<f64> =
+        rest[..cut].chunks_exact(8).map(|b| f64::from_le_bytes(b.try_into().unwrap())).collect();
+    let idx: Vec<i64> =
+        rest[cut..].chunks_exact(8).map(|b| i64::from_le_bytes(b.try_into().unwrap())).collect();
     let positions: Vec<DVec3> = coords.chunks_exact(3).map(|c| DVec3::new(c[0], c[1], c[2])).collect();
     let label = Path::new("<arrays>");
     let tris = match meshclash::api::triangles_from(label, &idx, positions.len()) {
