@@ -89,7 +89,7 @@ fn instanced_scenes_within_the_caps_are_refused_under_1_gib_not_aborted() {
             let (code, err) = under_limit(1 << 20, &args);
             assert_eq!(code, Some(2), "{args:?} under ulimit -v 1 GiB: {err}");
             assert_eq!(err.trim_end().lines().count(), 1, "not one line: {err}");
-            assert!(err.contains(f) && err.contains("memory"), "{err}");
+            assert!(err.contains(f) && err.contains("GiB") && err.contains("may use"), "{err}");
         }
     }
 }
