@@ -521,7 +521,7 @@ mod tests {
         // A GLB: only its JSON chunk is read.
         let mut chunk =
             br#"{"asset":{"version":"2.0"},"buffers":[{"uri":"ext.bin","byteLength":4}]}"#.to_vec();
-        while chunk.len() % 4 != 0 {
+        while !chunk.len().is_multiple_of(4) {
             chunk.push(b' ');
         }
         let mut glb = b"glTF".to_vec();
