@@ -6,6 +6,8 @@
 mod assembly;
 #[path = "bcf.rs"]
 mod bcf;
+#[path = "bcf_schema.rs"]
+mod bcf_schema;
 #[path = "bench_cmd.rs"]
 mod bench_cmd;
 #[path = "bodies_penetration.rs"]
@@ -42,6 +44,10 @@ mod hostile;
 mod html;
 #[path = "layers.rs"]
 mod layers;
+#[path = "memory_bounds.rs"]
+mod memory_bounds;
+#[path = "never_lose.rs"]
+mod never_lose;
 #[path = "obj_vs_tobj.rs"]
 mod obj_vs_tobj;
 #[path = "outputs.rs"]

@@ -220,3 +220,187 @@ pub fn baseline(data: &[u8]) {
     let block = rep.baseline.as_ref().expect("baseline block");
     let _ = (block, base.ids.len());
 }
+
+/// The `self_fans` target: a small part built from the bytes with the shapes `self` used to be
+/// quadratic on (fans around one vertex, copies of one face, point and segment triangles,
+/// books of triangles on one edge), integer coordinates in [-4, 4]; `self_pairs` (every leaf
+/// size) must equal the brute force over every pair.
+pub fn self_fans(data: &[u8]) {
+    use meshclash::check::self_clash::{self_pairs, self_pairs_brute_force};
+    use meshclash::geom::DVec3;
+    if data.len() < 4 || data.len() > 4096 {
+        return;
+    }
+    let c = |b: u8| (b % 9) as f64 - 4.0;
+    let mut positions = vec![DVec3::ZERO, DVec3::new(0.0, 0.0, 1.0)];
+    let mut triangles: Vec<[u32; 3]> = Vec::new();
+    for chunk in data.chunks_exact(4).take(300) {
+        let p = DVec3::new(c(chunk[1]), c(chunk[2]), c(chunk[3]));
+        positions.push(p);
+        let last = positions.len() as u32 - 1;
+        let prev = if last > 2 { last - 1 } else { last };
+        let t = match chunk[0] % 6 {
+            0 | 1 => [0, prev, last], // a fan around vertex 0
+            2 => [1, 0, last],        // a book on the edge 0-1
+            3 => triangles.last().copied().unwrap_or([0, 1, last]).map(|v| v.min(last)), // a copy
+            4 => [last, last, last],  // a point
+            _ => [0, last, last],     // a segment from vertex 0
+        };
+        triangles.push(if chunk[0] & 64 != 0 { [t[2], t[1], t[0]] } else { t });
+    }
+    let mesh = meshclash::scene::mesh::Mesh {
+        tri_object: vec![0; triangles.len()],
+        triangles,
+        positions,
+        objects: vec![meshclash::scene::mesh::Object { name: "fuzz".into(), ..Default::default() }],
+    };
+    let (merged, _) = meshclash::scene::bodies::merge_vertices(&mesh.positions);
+    let all: Vec<u32> = (0..mesh.triangles.len() as u32).collect();
+    let want = self_pairs_brute_force(&mesh, &merged, &all);
+    for leaf_size in [1, 4] {
+        let opts = meshclash::bvh::BuildOptions { leaf_size, ..Default::default() };
+        let got = self_pairs(&mesh, &merged, &all, opts);
+        assert_eq!(got, want, "leaf size {leaf_size}");
+    }
+}
+
+/// The `writers` target: two crossing triangles in a glTF whose node names are the fuzzed
+/// bytes (any Unicode, control characters included), checked with every report writer
+/// (`-o` JSON, `--junit`, `--bcf` 2.1 or 3.0, `--html`, `--export-glb`) and the text summary:
+/// the JSON and every XML file must parse, and the text summary holds no control character
+/// but newlines.
+pub fn writers(data: &[u8]) {
+    use std::io::Read;
+    if data.is_empty() || data.len() > 512 {
+        return;
+    }
+    let text = String::from_utf8_lossy(&data[1..]);
+    let cut = text.char_indices().nth(text.chars().count() / 2).map_or(text.len(), |(i, _)| i);
+    let (na, nb) = (&text[..cut], &text[cut..]);
+    let positions: [f32; 18] =
+        [0., 0., 0., 2., 0., 0., 0., 2., 0., 0.5, 0.5, -1., 0.5, 0.5, 1., 1.5, 0.5, 1.];
+    let bytes: Vec<u8> = positions.iter().flat_map(|x| x.to_le_bytes()).collect();
+    let b64 = {
+        use std::fmt::Write;
+        // Hex would not be a data URI: encode base64 by hand (no extra dependency).
+        const A: &[u8; 64] = b"ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
+        let mut s = String::new();
+        for ch in bytes.chunks(3) {
+            let n = (ch[0] as u32) << 16
+                | (*ch.get(1).unwrap_or(&0) as u32) << 8
+                | *ch.get(2).unwrap_or(&0) as u32;
+            for k in 0..4 {
+                let _ = if k <= ch.len() {
+                    s.write_char(A[(n >> (18 - 6 * k) & 63) as usize] as char)
+                } else {
+                    s.write_char('=')
+                };
+            }
+        }
+        s
+    };
+    let gltf = serde_json::json!({
+        "asset": {"version": "2.0"}, "scene": 0, "scenes": [{"nodes": [0, 1]}],
+        "nodes": [{"name": na, "mesh": 0}, {"name": nb, "mesh": 1}],
+        "meshes": [{"name": na, "primitives": [{"attributes": {"POSITION": 0}}]},
+                   {"name": nb, "primitives": [{"attributes": {"POSITION": 1}}]}],
+        "buffers": [{"byteLength": 72, "uri": format!("data:application/octet-stream;base64,{b64}")}],
+        "bufferViews": [{"buffer": 0, "byteLength": 36}, {"buffer": 0, "byteOffset": 36, "byteLength": 36}],
+        "accessors": [
+            {"bufferView": 0, "componentType": 5126, "count": 3, "type": "VEC3", "min": [0, 0, 0], "max": [2, 2, 0]},
+            {"bufferView": 1, "componentType": 5126, "count": 3, "type": "VEC3", "min": [0.5, 0.5, -1], "max": [1.5, 0.5, 1]}
+        ]
+    });
+    let dir = scratch();
+    let input = dir.join("names.gltf");
+    std::fs::write(&input, gltf.to_string()).expect("scratch write");
+    let out = |n: &str| dir.join(n).into_os_string();
+    let version = if data[0] & 1 == 0 { "2.1" } else { "3.0" };
+    let args: Vec<std::ffi::OsString> = vec![
+        "meshclash".into(),
+        "scene".into(),
+        input.into_os_string(),
+        "--no-timings".into(),
+        "--threads".into(),
+        "1".into(),
+        "-o".into(),
+        out("w.json"),
+        "--junit".into(),
+        out("w.xml"),
+        "--bcf".into(),
+        out("w.bcfzip"),
+        "--bcf-version".into(),
+        version.into(),
+        "--html".into(),
+        out("w.html"),
+        "--export-glb".into(),
+        out("w.glb"),
+    ];
+    let argv: Vec<&std::ffi::OsStr> = args.iter().map(|a| a.as_os_str()).collect();
+    let Some(rep) = run_args(&argv) else { return };
+    let summary = meshclash::output::text::render(&rep, false);
+    assert!(!summary.chars().any(|c| c.is_control() && c != '\n'), "control character in {summary:?}");
+    let json = std::fs::read(dir.join("w.json")).expect("report written");
+    serde_json::from_slice::<serde_json::Value>(&json).expect("report is JSON");
+    let junit = std::fs::read_to_string(dir.join("w.xml")).expect("junit written");
+    roxmltree::Document::parse(&junit).expect("junit is XML");
+    let mut z =
+        zip::ZipArchive::new(std::fs::File::open(dir.join("w.bcfzip")).expect("bcf written")).expect("zip");
+    for i in 0..z.len() {
+        let mut f = z.by_index(i).expect("member");
+        let mut s = String::new();
+        f.read_to_string(&mut s).expect("UTF-8 member");
+        roxmltree::Document::parse(&s).unwrap_or_else(|e| panic!("{}: {e}", f.name().unwrap_or("?")));
+    }
+}
+
+/// The `merge_inputs` target: the bytes as a shard plan (`Plan::parse`) and as a shard report
+/// (its serde form, then each outcome read back against a small part count): `Ok`, or a one-line
+/// error, never a panic.
+pub fn merge_inputs(data: &[u8]) {
+    if let Err(e) = meshclash::shard::plan::Plan::parse(data) {
+        assert!(!e.contains('\n'), "plan error spans lines: {e}");
+    }
+    if let Ok(r) = serde_json::from_slice::<meshclash::shard::ShardReport>(data) {
+        if let Some(o) = &r.outcome {
+            if let Err(e) = o.outcome(8) {
+                assert!(!e.contains('\n'), "outcome error spans lines: {e}");
+            }
+        }
+    }
+}
+
+/// The `arrays` target (what the Python package hands over): the bytes as `f64` coordinates
+/// and `i64` indices (byte 0 splits them), through `api::triangles_from` and
+/// `api::mesh_from_arrays`: `Ok` with every index in range, or a one-line error naming the
+/// label.
+pub fn arrays(data: &[u8]) {
+    use meshclash::geom::DVec3;
+    if data.len() < 2 || data.len() > 1 << 16 {
+        return;
+    }
+    let rest = &data[1..];
+    let cut = (rest.len() * data[0] as usize / 256) / 24 * 24;
+    let coords: Vec<f64> =
+        rest[..cut].chunks_exact(8).map(|b| f64::from_le_bytes(b.try_into().unwrap())).collect();
+    let idx: Vec<i64> =
+        rest[cut..].chunks_exact(8).map(|b| i64::from_le_bytes(b.try_into().unwrap())).collect();
+    let positions: Vec<DVec3> = coords.chunks_exact(3).map(|c| DVec3::new(c[0], c[1], c[2])).collect();
+    let label = Path::new("<arrays>");
+    let tris = match meshclash::api::triangles_from(label, &idx, positions.len()) {
+        Ok(t) => t,
+        Err(e) => {
+            one_line(&e);
+            assert!(e.to_string().starts_with("<arrays>"), "{e}");
+            return;
+        }
+    };
+    match meshclash::api::mesh_from_arrays(label, "fuzz", positions, tris) {
+        Ok(m) => {
+            let n = m.positions.len();
+            assert!(m.triangles.iter().flatten().all(|&v| (v as usize) < n));
+            assert!(m.positions.iter().all(|p| p.is_finite()));
+        }
+        Err(e) => one_line(&e),
+    }
+}

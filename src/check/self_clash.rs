@@ -411,9 +411,13 @@ fn tri_meets_box(p: &[DVec3; 3], b: &Aabb) -> bool {
 /// Walk a tree (`nodes` in [`crate::bvh::Bvh`]'s layout) against itself: `leaf_self` gets each
 /// leaf once, `leaf_pair` each unordered pair of different leaves whose boxes meet (closed
 /// boxes) once, each leaf as its range of positions (`a .. a + count`). Results come back in an order that depends only on the tree.
-fn self_walk<T, S, P>(nodes: &[SNode], leaf_self: S, leaf_pair: P) -> Vec<T>
+///
+/// `settled(i, j)` (`i == j` for a node with itself) says that no pair of triangles under
+/// nodes `i` and `j` is a self-clash: that node pair is not opened.
+fn self_walk<T, Z, S, P>(nodes: &[SNode], settled: Z, leaf_self: S, leaf_pair: P) -> Vec<T>
 where
     T: Send,
+    Z: Fn(u32, u32) -> bool + Sync,
     S: Fn(Range<usize>, &mut Vec<T>) + Sync,
     P: Fn(Range<usize>, Range<usize>, &mut Vec<T>) + Sync,
 {
@@ -429,6 +433,8 @@ where
     let meet = |i: u32, j: u32| nodes[i as usize].b.meets(&nodes[j as usize].b);
     // Expand one job; leaf work goes to `out`, new jobs to `jobs`.
     let step = |job: Job, out: &mut Vec<T>, jobs: &mut Vec<Job>| match job {
+        Job::Node(i) if settled(i, i) => {}
+        Job::Pair(i, j) if settled(i, j) => {}
         Job::Node(i) => {
             let n = &nodes[i as usize];
             if n.is_leaf() {
@@ -522,9 +528,14 @@ pub fn self_pairs_with(
     opts: BuildOptions,
 ) -> (Vec<SelfPair>, SelfTimes) {
     let t0 = std::time::Instant::now();
-    let certified = certified_fans(mesh, tris, fans);
+    let copies = Copies::new(fans);
+    let certified = certified_fans(mesh, tris, fans, copies.as_ref().map(|c| c.walked.as_slice()));
     let corners = |k: usize| crate::bvh::triangle(mesh, tris[k]);
-    let (keys, centres) = tree::curve_keys(tris.len(), |k| tri_box(&corners(k)).center());
+    // The triangles walked: all, or the first of each set of copies.
+    let walked: Option<Vec<u32>> = copies.as_ref().map(|c| c.firsts());
+    let local = |i: usize| walked.as_ref().map_or(i, |w| w[i] as usize);
+    let count = walked.as_ref().map_or(tris.len(), Vec::len);
+    let (keys, centres) = tree::curve_keys(count, |i| tri_box(&corners(local(i))).center());
     let origin = if centres.center().is_finite() { centres.center() } else { DVec3::ZERO };
     // What the walk reads, in curve order (which the tree keeps), so that a leaf is one run of
     // memory: a box, the vertex numbers and the position in the part. Corners are read from
@@ -532,16 +543,18 @@ pub fn self_pairs_with(
     let mut slots: Vec<Slot> = keys
         .par_iter()
         .map(|&key| {
-            let k = key as u32;
+            let k = local(key as u32 as usize) as u32;
             let b = FBox::around(&tri_box(&corners(k as usize)), origin);
             Slot { b, ids: fans.ids[k as usize], k }
         })
         .collect();
     let nodes = tree::build(&mut slots, &keys, opts.leaf_size.clamp(1, 255) as usize);
     drop(keys);
+    drop(walked);
+    let is_certified = |v: u32| certified[v as usize / 64] >> (v % 64) & 1 != 0;
+    let shared = common_certified(&nodes, &slots, &is_certified);
     let tree_ms = t0.elapsed().as_secs_f64() * 1e3;
     let t1 = std::time::Instant::now();
-    let is_certified = |v: u32| certified[v as usize / 64] >> (v % 64) & 1 != 0;
     let tri = |s: &Slot| Tri { p: corners(s.k as usize), ids: s.ids, t: tris[s.k as usize] };
     // `x` against each of `ys`: the box test; then a pair sharing a vertex whose fan is
     // certified is settled; the rest get the exact box test and the pair test (`x`'s corners,
@@ -564,13 +577,17 @@ pub fn self_pairs_with(
                     continue;
                 }
                 if let Some(p) = test_pair(tx, fx, &ty, mx) {
-                    out.push(p);
+                    match &copies {
+                        None => out.push(p),
+                        Some(c) => c.every_pair(mesh, tris, fans, x.k, y.k, out),
+                    }
                 }
             }
         }
     };
     let mut pairs = self_walk(
         &nodes,
+        |i, j| certified_in_common(&shared[i as usize], &shared[j as usize]),
         |leaf, out| {
             let leaf = &slots[leaf];
             for (k, x) in leaf.iter().enumerate() {
@@ -588,7 +605,142 @@ pub fn self_pairs_with(
     (pairs, SelfTimes { tree_ms, walk_ms: t1.elapsed().as_secs_f64() * 1e3 })
 }
 
-/// Fans with more triangles than this are not certified (their pairs are tested one by one).
+/// Triangles of one part with the same distinct vertices (the same face stored again, in any
+/// order or winding; the same segment or point), by vertex number. Two of them are never a
+/// self-clash pair (they share every vertex either has), and against any third triangle all of
+/// them give the same verdict (the rule reads only the distinct vertices and what is shared).
+/// So the walk reads one of each set (its *first*: lowest position), and a pair found with a
+/// first stands for every pair of the two sets, each classified on its own.
+struct Copies {
+    /// Per triangle: is it the first of its set (the one walked)?
+    walked: Vec<bool>,
+    /// Per triangle: its set, as an index into `starts`.
+    set: Vec<u32>,
+    /// The sets' members, set after set, each ascending.
+    members: Vec<u32>,
+    /// Where each set starts in `members` (and the end).
+    starts: Vec<u32>,
+}
+
+impl Copies {
+    /// The sets, or `None` when no two triangles have the same distinct vertices (the walk
+    /// then reads every triangle, as it would anyway).
+    fn new(fans: &Fans) -> Option<Copies> {
+        // Distinct vertices ascending, padded with the last: [a, a, b] and [a, b, b] are one set.
+        let key = |k: usize| {
+            let mut i = fans.ids[k];
+            i.sort_unstable();
+            if i[0] == i[1] {
+                [i[0], i[2], i[2]]
+            } else {
+                i
+            }
+        };
+        let n = fans.ids.len();
+        let mut order: Vec<([u32; 3], u32)> = (0..n).into_par_iter().map(|k| (key(k), k as u32)).collect();
+        order.par_sort_unstable();
+        if order.windows(2).all(|w| w[0].0 != w[1].0) {
+            return None;
+        }
+        let mut walked = vec![false; n];
+        let mut set = vec![0u32; n];
+        let mut starts = Vec::new();
+        for (x, &(k, t)) in order.iter().enumerate() {
+            if x == 0 || k != order[x - 1].0 {
+                starts.push(x as u32);
+                walked[t as usize] = true;
+            }
+            set[t as usize] = starts.len() as u32 - 1;
+        }
+        starts.push(n as u32);
+        let members = order.into_iter().map(|(_, t)| t).collect();
+        Some(Copies { walked, set, members, starts })
+    }
+
+    /// The first triangle of every set, ascending.
+    fn firsts(&self) -> Vec<u32> {
+        (0..self.walked.len() as u32).filter(|&k| self.walked[k as usize]).collect()
+    }
+
+    /// The members of the set of triangle `k`.
+    fn of(&self, k: u32) -> &[u32] {
+        let s = self.set[k as usize] as usize;
+        &self.members[self.starts[s] as usize..self.starts[s + 1] as usize]
+    }
+
+    /// Every pair of the sets of `x` and `y` (two walked triangles found to be a self-clash
+    /// pair), each classified by [`classify_adjacent`] on its own triangles.
+    fn every_pair(&self, mesh: &Mesh, tris: &[u32], fans: &Fans, x: u32, y: u32, out: &mut Vec<SelfPair>) {
+        for &i in self.of(x) {
+            for &j in self.of(y) {
+                let (ti, tj) = (tris[i as usize], tris[j as usize]);
+                let ((a, ka), (b, kb)) = if ti < tj { ((ti, i), (tj, j)) } else { ((tj, j), (ti, i)) };
+                let (pa, pb) = (crate::bvh::triangle(mesh, a), crate::bvh::triangle(mesh, b));
+                if let Some(hit) = classify_adjacent(&pa, fans.ids[ka as usize], &pb, fans.ids[kb as usize]) {
+                    out.push(SelfPair { a, b, hit });
+                }
+            }
+        }
+    }
+}
+
+/// Up to three certified vertices that every triangle under a node has (ascending, then
+/// `u32::MAX`).
+type Common = [u32; 3];
+
+/// Per node of the self tree: the certified vertices all its triangles share. A node whose
+/// triangles all lie around one certified vertex has no self-clash pair inside it, and two
+/// nodes sharing such a vertex none between them ([`certified_in_common`]): the walk skips
+/// them whole instead of skipping their pairs one by one (a fan of `m` triangles is `m²/2`
+/// pairs).
+fn common_certified(nodes: &[SNode], slots: &[Slot], is_certified: &impl Fn(u32) -> bool) -> Vec<Common> {
+    let none = [u32::MAX; 3];
+    let meet = |a: &Common, b: &Common| {
+        let mut out = none;
+        let mut n = 0;
+        for &v in a.iter().filter(|&&v| v != u32::MAX) {
+            if b.contains(&v) {
+                out[n] = v;
+                n += 1;
+            }
+        }
+        out
+    };
+    let of_slot = |s: &Slot| {
+        let mut c = none;
+        let mut n = 0;
+        let mut ids = s.ids;
+        ids.sort_unstable();
+        for (k, &v) in ids.iter().enumerate() {
+            if is_certified(v) && (k == 0 || ids[k - 1] != v) {
+                c[n] = v;
+                n += 1;
+            }
+        }
+        c
+    };
+    let mut out = vec![none; nodes.len()];
+    // Children come after their parent (pre-order): fill from the end.
+    for i in (0..nodes.len()).rev() {
+        let n = &nodes[i];
+        out[i] = if n.is_leaf() {
+            let items = &slots[n.a as usize..(n.a + n.count) as usize];
+            items[1..].iter().fold(of_slot(&items[0]), |c, s| meet(&c, &of_slot(s)))
+        } else {
+            meet(&out[i + 1], &out[n.a as usize])
+        };
+    }
+    out
+}
+
+/// Do two nodes' triangles all share a certified vertex?
+#[inline]
+fn certified_in_common(a: &Common, b: &Common) -> bool {
+    a.iter().any(|&v| v != u32::MAX && b.contains(&v))
+}
+
+/// Fans with at most this many triangles are certified by the ring argument below (on the
+/// stack); larger ones by [`sectors_tile`].
 const CERTIFIED_FAN_MAX: usize = 32;
 
 /// One bit per vertex: set when every pair of triangles around the vertex is proven to meet
@@ -611,16 +763,30 @@ const CERTIFIED_FAN_MAX: usize = 32;
 /// downward (`s < 0`) count, and those are decided by comparing coordinates. Nothing is
 /// rounded, so a certified fan is a proof; a fan that is not certified only costs its pairs
 /// the pair test.
-fn certified_fans(mesh: &Mesh, tris: &[u32], fans: &Fans) -> Vec<u64> {
+///
+/// `walked` (when given) says which triangles the walk reads: the fan of `v` is then made of
+/// those only (the others repeat one of them: [`Copies`]). A fan of more than
+/// [`CERTIFIED_FAN_MAX`] triangles is certified by [`sectors_tile`] instead.
+fn certified_fans(mesh: &Mesh, tris: &[u32], fans: &Fans, walked: Option<&[bool]>) -> Vec<u64> {
     let n = fans.vertices();
     let corner = |e: u32, step: usize| {
         let (k, c) = (e as usize / 3, e as usize % 3);
         mesh.positions[mesh.triangles[tris[k] as usize][(c + step) % 3] as usize]
     };
     let certify = |v: usize| -> bool {
-        let group = fans.group(v);
+        let kept: Vec<u32>;
+        let group = match walked {
+            None => fans.group(v),
+            Some(w) => {
+                kept = fans.group(v).iter().copied().filter(|&e| w[e as usize / 3]).collect();
+                &kept
+            }
+        };
         let m = group.len();
-        if !(3..=CERTIFIED_FAN_MAX).contains(&m) {
+        if m > CERTIFIED_FAN_MAX {
+            return sectors_tile(group, fans, &corner);
+        }
+        if m < 3 {
             return false;
         }
         let k0 = group[0] as usize / 3;
@@ -665,6 +831,84 @@ fn certified_fans(mesh: &Mesh, tris: &[u32], fans: &Fans) -> Vec<u64> {
         .into_par_iter()
         .map(|w| (w * 64..(w * 64 + 64).min(n)).filter(|&v| certify(v)).fold(0u64, |b, v| b | 1 << (v % 64)))
         .collect()
+}
+
+/// Exact, for the fan `group` of a vertex `v` (corners `3k + c`; `corner(e, j)` is the point
+/// `j` steps after corner `e` in its triangle's winding, so `corner(e, 0) = v`): do its
+/// triangles meet only in what they share? Linear after a sort, for fans of any size.
+///
+/// Projected along an axis along which every triangle `(v, w1, w2)` has the same non-zero
+/// orientation (exact `orient2d`), each triangle is one-to-one onto a sector at `v` of less
+/// than a half turn, all turning one way. Read every sector from its first ray to its second
+/// in the turning direction and sort them by first ray (exactly: half-plane, then
+/// orientation). When each sector ends before the next one (cyclically) begins, or on that
+/// one's first ray with the same vertex there (a shared edge), the sectors meet only in `v` or
+/// in shared edges; so do the triangles (one-to-one over them): certified. Otherwise (two
+/// sectors overlap, or touch along a ray at different vertices) nothing is claimed.
+fn sectors_tile(group: &[u32], fans: &Fans, corner: &impl Fn(u32, usize) -> DVec3) -> bool {
+    let Some(&e0) = group.first() else { return true };
+    let v = corner(e0, 0);
+    let Some(axis) = pr::projection_axis(v, corner(e0, 1), corner(e0, 2)) else { return false };
+    let turn = pr::orient2d(v, corner(e0, 1), corner(e0, 2), axis);
+    // (first ray point, its vertex number, second ray point, its vertex number).
+    let mut sectors: Vec<(DVec3, u32, DVec3, u32)> = Vec::with_capacity(group.len());
+    for &e in group {
+        let (p, q) = (corner(e, 1), corner(e, 2));
+        if pr::orient2d(v, p, q, axis) != turn {
+            return false;
+        }
+        let (k, c) = (e as usize / 3, e as usize % 3);
+        let ids = fans.ids[k];
+        let (ip, iq) = (ids[(c + 1) % 3], ids[(c + 2) % 3]);
+        sectors.push(if turn > 0 { (p, ip, q, iq) } else { (q, iq, p, ip) });
+    }
+    // The angle of the ray v→d from the ray v→base, counter-clockwise in the projection, as
+    // (half, …): 0 the base ray itself, 1 the open half turn after it, 2 the opposite ray, 3
+    // the open half turn before it. Within 1 or 3, `orient2d` orders two rays exactly.
+    let half = |base: DVec3, d: DVec3| -> u8 {
+        match pr::orient2d(v, base, d, axis) {
+            1 => 1,
+            -1 => 3,
+            _ => {
+                // On the line through v and base: the same ray iff on the same side of v along
+                // an axis where base differs from v.
+                let j = (0..3).find(|&j| base[j] != v[j]).expect("base != v");
+                if (d[j] > v[j]) == (base[j] > v[j]) {
+                    0
+                } else {
+                    2
+                }
+            }
+        }
+    };
+    let cmp = |base: DVec3, a: DVec3, b: DVec3| -> std::cmp::Ordering {
+        let (ha, hb) = (half(base, a), half(base, b));
+        ha.cmp(&hb).then_with(|| {
+            if ha % 2 == 1 {
+                0.cmp(&pr::orient2d(v, a, b, axis))
+            } else {
+                std::cmp::Ordering::Equal
+            }
+        })
+    };
+    let base = sectors[0].0;
+    sectors.sort_by(|x, y| cmp(base, x.0, y.0));
+    let m = sectors.len();
+    (0..m).all(|i| {
+        let (first, _, end, end_id) = sectors[i];
+        let (next, next_id, _, _) = sectors[(i + 1) % m];
+        if m == 1 {
+            return true;
+        }
+        if half(first, next) == 0 {
+            return false; // two sectors start on one ray: they overlap
+        }
+        match cmp(first, end, next) {
+            std::cmp::Ordering::Less => true,
+            std::cmp::Ordering::Equal => end_id == next_id,
+            std::cmp::Ordering::Greater => false,
+        }
+    })
 }
 
 /// The same answer as [`self_pairs`] by testing every pair (quadratic; for tests).

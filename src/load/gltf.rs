@@ -138,15 +138,14 @@ pub(crate) fn load(path: &Path, bytes: &[u8]) -> Result<Loaded> {
     }
     // Instancing multiplies what a small file asks for: refuse up front, before anything is
     // expanded, a scene whose check cannot fit in the memory this process may use.
-    let need = (total_v as u64)
-        .saturating_mul(24)
-        .saturating_add((total_t as u64).saturating_mul(super::CHECK_BYTES_PER_TRIANGLE));
+    let need = super::scene_estimate(total_v as u64, total_t as u64, total_parts as u64);
     if let Some(available) = super::available_memory().filter(|&a| need > a) {
         let problem = InputProblem::NeedsMemory {
             triangles: total_t as u64,
             need,
             available,
-            per_triangle: super::CHECK_BYTES_PER_TRIANGLE,
+            // The whole estimate per triangle (parts included), so the message adds up.
+            per_triangle: need / (total_t as u64).max(1),
         };
         return Err(Error::in_file(path, problem));
     }

@@ -462,6 +462,34 @@ fn read_external(path: &Path, i: usize, uri: &str, declared: usize) -> Result<Ve
     Ok(data)
 }
 
+/// The files next to the glTF `path` that its JSON names as buffers or images (not `data:`
+/// URIs, not references [`read_external`] refuses), in order; nothing when the JSON does not
+/// parse. Only the `uri` members are kept while parsing.
+pub(crate) fn external_files(path: &Path, json: &[u8]) -> Vec<std::path::PathBuf> {
+    #[derive(serde::Deserialize)]
+    struct Named {
+        uri: Option<String>,
+    }
+    #[derive(serde::Deserialize)]
+    struct Doc {
+        #[serde(default)]
+        buffers: Vec<Named>,
+        #[serde(default)]
+        images: Vec<Named>,
+    }
+    let Ok(doc) = serde_json::from_slice::<Doc>(strip_bom(json)) else { return Vec::new() };
+    let dir = path.parent().unwrap_or(Path::new(""));
+    doc.buffers
+        .iter()
+        .chain(&doc.images)
+        .filter_map(|n| n.uri.as_deref())
+        .filter(|uri| !uri.starts_with("data:") && unsafe_relative_path(uri).is_none())
+        .filter_map(|uri| percent_decode(uri).ok())
+        .filter(|name| unsafe_relative_path(name).is_none())
+        .map(|name| dir.join(name))
+        .collect()
+}
+
 fn percent_decode(s: &str) -> std::result::Result<String, ()> {
     let b = s.as_bytes();
     let mut out = Vec::with_capacity(b.len());

@@ -35,6 +35,22 @@ pub use obj::MAX_FACE_VERTICES;
 /// scene that cannot fit.
 pub const CHECK_BYTES_PER_TRIANGLE: u64 = 100;
 
+/// What a check needs per part of a glTF scene after instancing (a node instance or a GPU
+/// instance), whatever its triangles: its object (name, world matrix: ~190 bytes), the
+/// loader's instance record, and the check's per-part records, trees and lists. Measured as
+/// the growth of peak memory with the part count of one-triangle parts (`scene` on 250,000
+/// and 500,000 GPU instances of one triangle); an estimate, used only to refuse up front.
+pub const CHECK_BYTES_PER_PART: u64 = 400;
+
+/// The memory a glTF scene's check is estimated to need: 24 bytes per vertex (its world
+/// positions), [`CHECK_BYTES_PER_TRIANGLE`] per triangle and [`CHECK_BYTES_PER_PART`] per part.
+pub fn scene_estimate(vertices: u64, triangles: u64, parts: u64) -> u64 {
+    vertices
+        .saturating_mul(24)
+        .saturating_add(triangles.saturating_mul(CHECK_BYTES_PER_TRIANGLE))
+        .saturating_add(parts.saturating_mul(CHECK_BYTES_PER_PART))
+}
+
 /// The memory this process may still use, in bytes: the least of the machine's available
 /// memory (`MemAvailable`), the cgroup's limit less its usage, and the address-space limit
 /// (`ulimit -v`) less what is mapped. `None` where none of them can be read.
@@ -105,15 +121,101 @@ impl Format {
 /// it is opened, so a FIFO cannot block the run and a device cannot stream without end
 /// (issue 11, item 5). Symlinks are followed: the link's target must be a regular file.
 pub fn load_path(path: &Path) -> Result<(Loaded, Format)> {
-    let cannot = |e: std::io::Error| Error::in_file(path, unreadable(Reading::File, &e));
-    let meta = std::fs::metadata(path).map_err(cannot)?;
-    if !meta.is_file() {
-        return Err(Error::in_file(path, InputProblem::NotARegularFile { kind: file_kind(&meta) }));
-    }
-    let bytes = std::fs::read(path).map_err(cannot)?;
+    let bytes = read_regular_file(path, Reading::File, u64::MAX)?;
     let format = detect_format(path, &bytes)?;
     let loaded = load_bytes(path, &bytes, format)?;
     Ok((loaded, format))
+}
+
+/// The most bytes a plan, shard report, baseline or clash-set file may have (1 GiB): read
+/// whole into memory and parsed, so bounded.
+pub const MAX_SMALL_FILE_BYTES: u64 = 1 << 30;
+
+/// Reads a file meshclash reads whole besides the meshes (a plan, shard report, baseline or
+/// clash-set file), `reading` saying which: [`read_regular_file`] with at most `limit` bytes.
+pub fn read_small_file(path: &Path, reading: Reading, limit: u64) -> Result<Vec<u8>> {
+    read_regular_file(path, reading, limit)
+}
+
+/// Opens `path` for reading and checks it is a regular file, without blocking: the file is
+/// opened with `O_NONBLOCK` (so a FIFO without a writer does not block the open) and the
+/// *opened* file is checked (`fstat`), so a path swapped between a check and the open cannot
+/// slip a FIFO or device through. Symlinks are followed. Returns the file and its size.
+pub fn open_regular(path: &Path, reading: Reading) -> Result<(std::fs::File, u64)> {
+    use std::os::unix::fs::OpenOptionsExt;
+    let cannot = |e: std::io::Error| Error::in_file(path, unreadable(reading.clone(), &e));
+    let nonblock = rustix::fs::OFlags::NONBLOCK.bits() as i32;
+    let f = std::fs::OpenOptions::new().read(true).custom_flags(nonblock).open(path).map_err(cannot)?;
+    let meta = f.metadata().map_err(cannot)?;
+    if !meta.is_file() {
+        return Err(Error::in_file(path, InputProblem::NotARegularFile { kind: file_kind(&meta) }));
+    }
+    Ok((f, meta.len()))
+}
+
+/// Reads the regular file `path` whole ([`open_regular`]): at most `limit` bytes, else a
+/// one-line error naming the file, its size and the limit (checked on the size before
+/// reading, and again while reading, in case the file grows).
+pub fn read_regular_file(path: &Path, reading: Reading, limit: u64) -> Result<Vec<u8>> {
+    use std::io::Read;
+    let (f, size) = open_regular(path, reading.clone())?;
+    let too_large = |size: u64| {
+        let msg = format!("the file has {size} bytes, more than the {limit} bytes supported");
+        Error::in_file(path, InputProblem::Invalid(msg))
+    };
+    if size > limit {
+        return Err(too_large(size));
+    }
+    let mut bytes = Vec::with_capacity(size as usize);
+    f.take(limit.saturating_add(1))
+        .read_to_end(&mut bytes)
+        .map_err(|e| Error::in_file(path, unreadable(reading, &e)))?;
+    if bytes.len() as u64 > limit {
+        return Err(too_large(bytes.len() as u64));
+    }
+    Ok(bytes)
+}
+
+/// Every file reading `path` as an input reads: `path` itself and, for a glTF (`.gltf` or
+/// `.glb`), the external files its buffers and images name (resolved next to it, as the loader
+/// resolves buffers; `data:` URIs and references the loader refuses are not files it reads).
+/// An output naming any of them would overwrite the model ([`crate::output::write`]).
+/// Best effort and never an error: a file that cannot be read or parsed here yields just
+/// `path`, and loading it reports the problem.
+pub fn files_read(path: &Path) -> Vec<std::path::PathBuf> {
+    let mut out = vec![path.to_path_buf()];
+    let ext = path.extension().map(|e| e.to_string_lossy().to_ascii_lowercase());
+    if !matches!(ext.as_deref(), Some("gltf" | "glb")) {
+        return out;
+    }
+    let Ok(json) = gltf_json_of(path) else { return out };
+    out.extend(gltf_data::external_files(path, &json));
+    out
+}
+
+/// The JSON of the glTF `path`: the whole file, or a GLB's JSON chunk (only it is read).
+fn gltf_json_of(path: &Path) -> Result<Vec<u8>> {
+    use std::io::Read;
+    let (mut f, size) = open_regular(path, Reading::File)?;
+    let mut head = [0u8; 20];
+    let n = f.read(&mut head).map_err(|e| Error::in_file(path, unreadable(Reading::File, &e)))?;
+    if n >= 4 && &head[..4] == b"glTF" {
+        // Header (12 bytes), then the first chunk's length and type: JSON.
+        f.read_exact(&mut head[n.min(20)..])
+            .map_err(|e| Error::in_file(path, unreadable(Reading::File, &e)))?;
+        let len = u32::from_le_bytes([head[12], head[13], head[14], head[15]]) as u64;
+        if &head[16..20] != b"JSON" || len > size {
+            return Err(Error::in_file(path, InputProblem::Invalid("no JSON chunk".into())));
+        }
+        let mut json = Vec::with_capacity(len as usize);
+        f.take(len)
+            .read_to_end(&mut json)
+            .map_err(|e| Error::in_file(path, unreadable(Reading::File, &e)))?;
+        return Ok(json);
+    }
+    let mut json = head[..n].to_vec();
+    f.read_to_end(&mut json).map_err(|e| Error::in_file(path, unreadable(Reading::File, &e)))?;
+    Ok(json)
 }
 
 /// The kind of a non-regular file.
@@ -379,6 +481,61 @@ mod tests {
         assert!(status.success());
         let e = load_path(&fifo).unwrap_err().to_string();
         assert!(e.contains("f.obj: not a regular file (a FIFO)"), "{e}");
+    }
+
+    #[test]
+    fn small_file_reader_refuses_fifo_directory_device_large_and_missing() {
+        let dir = tempfile::tempdir().unwrap();
+        let fifo = dir.path().join("plan.json");
+        assert!(std::process::Command::new("mkfifo").arg(&fifo).status().unwrap().success());
+        // A FIFO without a writer: refused at once (a blocking open would never return).
+        let e = read_small_file(&fifo, Reading::Plan, 1 << 20).unwrap_err().to_string();
+        assert!(e.contains("plan.json: not a regular file (a FIFO)"), "{e}");
+        assert_eq!(e.lines().count(), 1, "{e}");
+        let e = read_small_file(dir.path(), Reading::Baseline, 1 << 20).unwrap_err().to_string();
+        assert!(e.contains("not a regular file (a directory)"), "{e}");
+        let e =
+            read_small_file(Path::new("/dev/zero"), Reading::ShardReport, 1 << 20).unwrap_err().to_string();
+        assert!(e.contains("/dev/zero: not a regular file (a character device)"), "{e}");
+        let big = dir.path().join("big.json");
+        std::fs::write(&big, vec![b' '; 1001]).unwrap();
+        let e = read_small_file(&big, Reading::ClashSet, 1000).unwrap_err().to_string();
+        assert!(e.contains("big.json") && e.contains("1001 bytes") && e.contains("1000 bytes"), "{e}");
+        assert_eq!(read_small_file(&big, Reading::ClashSet, 1001).unwrap().len(), 1001);
+        let e = read_small_file(&dir.path().join("gone.json"), Reading::Baseline, 10).unwrap_err();
+        let e = e.to_string();
+        assert!(e.contains("gone.json") && e.contains("No such file"), "{e}");
+    }
+
+    #[test]
+    fn files_read_lists_external_buffers_and_images() {
+        let dir = tempfile::tempdir().unwrap();
+        let d = dir.path();
+        let json = r#"{"asset":{"version":"2.0"},
+            "buffers":[{"uri":"geo%20a.bin","byteLength":4},{"uri":"data:application/octet-stream;base64,AAAA","byteLength":3},
+                       {"uri":"../up.bin","byteLength":1},{"byteLength":2}],
+            "images":[{"uri":"tex.png"},{"bufferView":0}]}"#;
+        std::fs::write(d.join("m.gltf"), json).unwrap();
+        let got = files_read(&d.join("m.gltf"));
+        assert_eq!(got, [d.join("m.gltf"), d.join("geo a.bin"), d.join("tex.png")]);
+        // A GLB: only its JSON chunk is read.
+        let mut chunk =
+            br#"{"asset":{"version":"2.0"},"buffers":[{"uri":"ext.bin","byteLength":4}]}"#.to_vec();
+        while !chunk.len().is_multiple_of(4) {
+            chunk.push(b' ');
+        }
+        let mut glb = b"glTF".to_vec();
+        glb.extend(2u32.to_le_bytes());
+        glb.extend((20 + chunk.len() as u32).to_le_bytes());
+        glb.extend((chunk.len() as u32).to_le_bytes());
+        glb.extend(b"JSON");
+        glb.extend(&chunk);
+        std::fs::write(d.join("m.glb"), &glb).unwrap();
+        assert_eq!(files_read(&d.join("m.glb")), [d.join("m.glb"), d.join("ext.bin")]);
+        // Anything else, or a glTF that does not parse: the file alone.
+        assert_eq!(files_read(&d.join("a.obj")), [d.join("a.obj")]);
+        std::fs::write(d.join("bad.gltf"), "{").unwrap();
+        assert_eq!(files_read(&d.join("bad.gltf")), [d.join("bad.gltf")]);
     }
 
     #[test]

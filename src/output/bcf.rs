@@ -255,7 +255,7 @@ impl Xml {
     fn open(&mut self, name: &str, attrs: &[(&str, &str)]) -> &mut Self {
         let mut e = BytesStart::new(name);
         for &(k, v) in attrs {
-            e.push_attribute((k, v));
+            e.push_attribute((k, xml_chars(v).as_ref()));
         }
         self.0.write_event(Event::Start(e)).expect("in memory");
         self
@@ -263,7 +263,7 @@ impl Xml {
     fn empty(&mut self, name: &str, attrs: &[(&str, &str)]) -> &mut Self {
         let mut e = BytesStart::new(name);
         for &(k, v) in attrs {
-            e.push_attribute((k, v));
+            e.push_attribute((k, xml_chars(v).as_ref()));
         }
         self.0.write_event(Event::Empty(e)).expect("in memory");
         self
@@ -274,7 +274,7 @@ impl Xml {
     }
     fn leaf(&mut self, name: &str, text: &str) -> &mut Self {
         self.open(name, &[]);
-        self.0.write_event(Event::Text(BytesText::new(text))).expect("in memory");
+        self.0.write_event(Event::Text(BytesText::new(&xml_chars(text)))).expect("in memory");
         self.close(name)
     }
     fn point(&mut self, name: &str, p: DVec3) -> &mut Self {
@@ -287,6 +287,21 @@ impl Xml {
         v.push(b'\n');
         v
     }
+}
+
+/// `s` with every character XML 1.0 forbids (controls other than tab, newline and carriage
+/// return, U+FFFE, U+FFFF; not even a character reference may name them) written as its Rust
+/// escape (`\u{1b}`), so any part name makes a well-formed document; quick-xml then escapes
+/// markup characters.
+pub fn xml_chars(s: &str) -> std::borrow::Cow<'_, str> {
+    let bad = |c: char| (c < ' ' && !matches!(c, '\t' | '\n' | '\r')) || matches!(c, '\u{FFFE}' | '\u{FFFF}');
+    if !s.chars().any(bad) {
+        return s.into();
+    }
+    s.chars()
+        .map(|c| if bad(c) { c.escape_unicode().to_string() } else { c.to_string() })
+        .collect::<String>()
+        .into()
 }
 
 fn num(x: f64) -> String {
@@ -378,7 +393,14 @@ fn viewpoint(t: &Topic, v: Version) -> Vec<u8> {
     x.open("Coloring", &[]);
     for (name, file, color) in &t.components {
         x.open("Color", &[("Color", color)]);
+        // 3.0 wraps a colour's components in `<Components>`; 2.1 lists them directly.
+        if v == Version::V30 {
+            x.open("Components", &[]);
+        }
         component(&mut x, name, file);
+        if v == Version::V30 {
+            x.close("Components");
+        }
         x.close("Color");
     }
     x.close("Coloring");
@@ -442,6 +464,23 @@ mod tests {
         assert_eq!(ifc_guid("node0/node13/node72"), None);
         assert_eq!(ifc_guid("9O2Fr$t4X7Zf8NOew3FLOH"), None);
         assert_eq!(ifc_guid("2O2Fr-t4X7Zf8NOew3FLOH"), None);
+    }
+
+    #[test]
+    fn forbidden_characters_are_escaped_and_every_document_is_well_formed() {
+        assert_eq!(xml_chars("plain <&> name\ttab"), "plain <&> name\ttab");
+        assert_eq!(xml_chars("a\u{1b}[2Kb\u{0}\u{FFFF}"), "a\\u{1b}[2Kb\\u{0}\\u{ffff}");
+        // Every character 0..=0x10FFFF (but surrogates) in an element and an attribute.
+        let all: String = (0u32..0x11_0000).filter_map(char::from_u32).collect();
+        let mut x = Xml::new();
+        x.open("R", &[("Name", &all)]).leaf("T", &all).close("R");
+        let doc = String::from_utf8(x.bytes()).unwrap();
+        let parsed = roxmltree::Document::parse(&doc).unwrap();
+        let t = parsed.descendants().find(|n| n.has_tag_name("T")).unwrap().text().unwrap();
+        assert!(
+            t.contains("\\u{1}") && t.contains('\u{10FFFF}') && t.contains("<=>") && t.contains("%&'("),
+            "not escaped as expected"
+        );
     }
 
     #[test]

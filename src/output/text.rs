@@ -76,9 +76,23 @@ pub fn worst(r: &Report) -> Vec<&PairReport> {
     v
 }
 
-fn object(r: &Report, side: char, i: u32) -> &str {
+fn object(r: &Report, side: char, i: u32) -> std::borrow::Cow<'_, str> {
     let objs = if side == 'a' { &r.inputs.a.objects } else { &r.inputs.b.objects };
-    objs.get(i as usize).map_or("?", |o| o.name.as_str())
+    objs.get(i as usize).map_or("?".into(), |o| shown(&o.name))
+}
+
+/// A name or path as the summary prints it: control characters (escape sequences that could
+/// move the cursor or rewrite the verdict line) and the invisible bidirectional controls
+/// written as Rust escapes (`\u{1b}`), everything else as is.
+pub fn shown(s: &str) -> std::borrow::Cow<'_, str> {
+    let bad = |c: char| c.is_control() || matches!(c, '\u{202A}'..='\u{202E}' | '\u{2066}'..='\u{2069}');
+    if !s.chars().any(bad) {
+        return s.into();
+    }
+    s.chars()
+        .map(|c| if bad(c) { c.escape_unicode().to_string() } else { c.to_string() })
+        .collect::<String>()
+        .into()
 }
 
 /// One line describing a pair: kind, triangles with their objects, contact, where.
@@ -199,7 +213,7 @@ fn part_pairs(s: &mut String, c: &Paint, r: &Report) {
         if let Some(ct) = p.contained {
             let _ = write!(what, ", {}", ct.name());
         }
-        let _ = writeln!(s, "    {} x {}  ({what})", p.a_name, p.b_name);
+        let _ = writeln!(s, "    {} x {}  ({what})", shown(&p.a_name), shown(&p.b_name));
     }
 }
 
@@ -224,7 +238,7 @@ pub fn render(r: &Report, color: bool) -> String {
             s,
             "  {} {}  {}, {} triangles, {} object{}{}",
             c.p(BOLD, name),
-            i.path,
+            shown(&i.path),
             i.format,
             i.triangles,
             i.objects.len(),
@@ -344,7 +358,16 @@ pub fn render(r: &Report, color: bool) -> String {
 
 #[cfg(test)]
 mod tests {
-    use super::num;
+    use super::{num, shown};
+
+    #[test]
+    fn names_with_control_characters_are_escaped() {
+        assert_eq!(shown("bolt M8 / ü"), "bolt M8 / ü");
+        assert_eq!(shown("a\u{1b}[1A\rCLEAR\u{7}"), "a\\u{1b}[1A\\u{d}CLEAR\\u{7}");
+        assert_eq!(shown("x\u{202E}y\n"), "x\\u{202e}y\\u{a}");
+        let all: String = (0u32..0x3000).filter_map(char::from_u32).collect();
+        assert!(!shown(&all).chars().any(|c| c.is_control()));
+    }
 
     #[test]
     fn numbers_have_six_significant_digits() {

@@ -11,6 +11,13 @@
 //! - an existing path that is not a regular file (a device such as `/dev/null`, a FIFO, a
 //!   socket) is written directly, never renamed over (it cannot be staged: it is written when
 //!   its content is ready, before the other outputs are committed);
+//! - a path naming a file this process already holds open for writing (`/dev/stdout`,
+//!   `/dev/stderr` or `/proc/self/fd/N` while that descriptor is redirected to a file) is
+//!   written through that descriptor, at its offset and in its mode (appending under `>>`),
+//!   never truncated and never renamed over: what the shell wrote there before stays;
+//! - two outputs naming one file, existing or new, are refused;
+//! - every file an input reads counts as an input ([`crate::load::files_read`]: a glTF's
+//!   external buffers and images too);
 //! - a symlink is followed and its *target* is replaced atomically; the link stays a link;
 //! - temporaries get unpredictable names, created with `O_EXCL` (the `tempfile` crate) in the
 //!   target's directory, are synced, then renamed, so a planted symlink at a guessable temporary
@@ -75,6 +82,10 @@ impl Staged {
                 let mut w = BufWriter::new(f);
                 return fill(&mut w).and_then(|_| w.flush()).map_err(&err);
             }
+            Target::Descriptor(f) => {
+                let mut w = BufWriter::new(f);
+                return fill(&mut w).and_then(|_| w.flush()).map_err(&err);
+            }
             Target::Replace(t) => t,
         };
         // Mode 0666 less the umask, as for any new file (tempfile's default is 0600).
@@ -108,6 +119,9 @@ enum Target {
     /// (`/dev/stdout` redirected to a file: renaming over it would leave the shell's descriptor
     /// on the old file).
     Direct,
+    /// A regular file this process holds open for writing: written through (a duplicate of)
+    /// that descriptor, at its offset, without truncating.
+    Descriptor(std::fs::File),
     /// Staged in a temporary and renamed over this path (the final target of any symlinks).
     Replace(PathBuf),
 }
@@ -116,6 +130,11 @@ fn target(path: &Path) -> std::io::Result<Target> {
     match std::fs::metadata(path) {
         Ok(m) if m.is_dir() => return Ok(Target::Directory),
         Ok(m) if !m.is_file() => return Ok(Target::Direct),
+        Ok(m) => {
+            if let Some(f) = open_for_writing(&m) {
+                return Ok(Target::Descriptor(f));
+            }
+        }
         _ => {}
     }
     let t = resolve(path)?;
@@ -123,6 +142,48 @@ fn target(path: &Path) -> std::io::Result<Target> {
         return Ok(Target::Direct);
     }
     Ok(Target::Replace(t))
+}
+
+/// A handle on the regular file `m` (same device and inode) that this process already holds
+/// open for writing, written without truncating: a duplicate of standard output or standard
+/// error (sharing its offset and mode), else a reopening, in append mode, of another such
+/// descriptor (through `/proc/self/fd`). `None` when there is none, or when the descriptors
+/// cannot be listed (then only the path rules apply).
+fn open_for_writing(m: &std::fs::Metadata) -> Option<std::fs::File> {
+    use rustix::fs::OFlags;
+    use std::os::fd::AsFd;
+    let writable = |flags: OFlags| flags.intersects(OFlags::WRONLY | OFlags::RDWR);
+    let same = |dev: u64, ino: u64| dev == m.dev() && ino == m.ino();
+    let (out, err) = (std::io::stdout(), std::io::stderr());
+    for fd in [out.as_fd(), err.as_fd()] {
+        let (Ok(st), Ok(flags)) = (rustix::fs::fstat(fd), rustix::fs::fcntl_getfl(fd)) else {
+            continue;
+        };
+        if same(st.st_dev, st.st_ino) && writable(flags) {
+            return fd.try_clone_to_owned().ok().map(std::fs::File::from);
+        }
+    }
+    let mut fds: Vec<u32> = std::fs::read_dir("/proc/self/fd")
+        .ok()?
+        .filter_map(|e| e.ok()?.file_name().to_str()?.parse::<u32>().ok())
+        .filter(|&n| n > 2)
+        .collect();
+    fds.sort_unstable();
+    for n in fds {
+        let link = PathBuf::from(format!("/proc/self/fd/{n}"));
+        let Ok(st) = std::fs::metadata(&link) else { continue };
+        // `flags:` in fdinfo is octal; the access mode is its two low bits (0 read-only).
+        let flags = std::fs::read_to_string(format!("/proc/self/fdinfo/{n}")).ok().and_then(|t| {
+            let v = t.lines().find_map(|l| l.strip_prefix("flags:"))?.trim().to_string();
+            u32::from_str_radix(&v, 8).ok()
+        });
+        if same(st.dev(), st.ino()) && flags.is_some_and(|f| f & 3 != 0) {
+            if let Ok(f) = std::fs::OpenOptions::new().append(true).open(&link) {
+                return Some(f);
+            }
+        }
+    }
+    None
 }
 
 /// The directory a temporary for `target` goes in.
@@ -137,16 +198,20 @@ pub type Named<'a> = (&'a str, &'a Path);
 /// are the files the run reads (a missing one is skipped: loading it will report it).
 pub fn check_outputs(outputs: &[Named], inputs: &[&Path]) -> Result<()> {
     let id = |m: &std::fs::Metadata| (m.dev(), m.ino());
+    let read: Vec<PathBuf> = inputs.iter().flat_map(|p| crate::load::files_read(p)).collect();
     let inputs: Vec<((u64, u64), &Path)> =
-        inputs.iter().filter_map(|p| std::fs::metadata(p).ok().map(|m| (id(&m), *p))).collect();
+        read.iter().filter_map(|p| std::fs::metadata(p).ok().map(|m| (id(&m), p.as_path()))).collect();
     let mut seen: Vec<((u64, u64), &str)> = Vec::new();
+    // Outputs that do not exist yet, by their directory (resolved) and file name.
+    let mut new: Vec<(PathBuf, &str)> = Vec::new();
     for &(flag, path) in outputs {
         let fail = |problem: OutputProblem| Error::output(path, problem);
         let flag_ = || flag.to_string();
-        let target = match target(path).map_err(|e| fail(io_problem(&e)))? {
+        let (target, in_place) = match target(path).map_err(|e| fail(io_problem(&e)))? {
             Target::Directory => return Err(fail(OutputProblem::FlagNamesDirectory { flag: flag_() })),
-            Target::Direct => path.to_path_buf(),
-            Target::Replace(t) => t,
+            Target::Direct => (path.to_path_buf(), false),
+            Target::Descriptor(_) => (path.to_path_buf(), true),
+            Target::Replace(t) => (t, false),
         };
         match std::fs::metadata(&target) {
             Ok(m) => {
@@ -163,11 +228,24 @@ pub fn check_outputs(outputs: &[Named], inputs: &[&Path]) -> Result<()> {
                     continue; // a device, FIFO or socket: written directly (and may repeat)
                 }
                 seen.push((id(&m), flag));
-                if target.starts_with("/proc") || target.starts_with("/dev") {
+                if in_place || target.starts_with("/proc") || target.starts_with("/dev") {
                     continue; // written in place
                 }
             }
-            Err(e) if e.kind() == std::io::ErrorKind::NotFound => {}
+            Err(e) if e.kind() == std::io::ErrorKind::NotFound => {
+                // Two names of one new file: the same file name in the same directory.
+                let key = std::fs::canonicalize(dir_of(&target))
+                    .map(|d| d.join(target.file_name().unwrap_or_default()));
+                if let Ok(key) = key {
+                    if let Some((_, other)) = new.iter().find(|(k, _)| *k == key) {
+                        return Err(fail(OutputProblem::SameFile {
+                            flag: flag_(),
+                            other: other.to_string(),
+                        }));
+                    }
+                    new.push((key, flag));
+                }
+            }
             Err(e) => return Err(fail(io_problem(&e))),
         }
         let dir = dir_of(&target);
@@ -343,6 +421,51 @@ mod tests {
         std::fs::write(&r, b"old").unwrap();
         let e = check_outputs(&[("-o", &r), ("--junit", &r)], &[]).unwrap_err().to_string();
         assert!(e.contains("--junit names the same file as -o"), "{e}");
+    }
+
+    #[test]
+    fn two_outputs_naming_one_new_file_are_refused() {
+        let d = tempfile::tempdir().unwrap();
+        let r = d.path().join("r.json");
+        let dotted = d.path().join(".").join("r.json");
+        let e = check_outputs(&[("-o", &r), ("--junit", &dotted)], &[]).unwrap_err().to_string();
+        assert!(e.contains("--junit names the same file as -o"), "{e}");
+        let link = d.path().join("link.json");
+        std::os::unix::fs::symlink("r.json", &link).unwrap();
+        let e = check_outputs(&[("--junit", &r), ("--bcf", &link)], &[]).unwrap_err().to_string();
+        assert!(e.contains("--bcf names the same file as --junit"), "{e}");
+        check_outputs(&[("-o", &r), ("--junit", &d.path().join("j.xml"))], &[]).unwrap();
+    }
+
+    #[test]
+    fn output_naming_a_gltf_external_buffer_is_refused() {
+        let d = tempfile::tempdir().unwrap();
+        let gltf = d.path().join("m.gltf");
+        std::fs::write(&gltf, r#"{"buffers":[{"uri":"geo.bin","byteLength":4}],"images":[{"uri":"t.png"}]}"#)
+            .unwrap();
+        std::fs::write(d.path().join("geo.bin"), b"1234").unwrap();
+        std::fs::write(d.path().join("t.png"), b"png").unwrap();
+        for name in ["geo.bin", "t.png"] {
+            let out = d.path().join(name);
+            let e = check_outputs(&[("-o", &out)], &[&gltf]).unwrap_err().to_string();
+            assert!(e.contains("names the input") && e.contains(name), "{e}");
+        }
+    }
+
+    #[test]
+    fn a_file_held_open_for_appending_is_appended_to_not_replaced() {
+        // Standard error redirected to a file (the child's), written through `/dev/stderr`:
+        // tested in the binary's tests; here a descriptor other than 0-2.
+        let d = tempfile::tempdir().unwrap();
+        let log = d.path().join("log");
+        std::fs::write(&log, b"HEADER\n").unwrap();
+        let held = std::fs::OpenOptions::new().append(true).open(&log).unwrap();
+        let via = PathBuf::from(format!("/proc/self/fd/{}", std::os::fd::AsRawFd::as_raw_fd(&held)));
+        check_outputs(&[("-o", &via)], &[]).unwrap();
+        write_file(&via, b"report\n").unwrap();
+        assert_eq!(std::fs::read(&log).unwrap(), b"HEADER\nreport\n");
+        let ino = |p: &Path| std::fs::metadata(p).unwrap().ino();
+        assert_eq!(ino(&log), held.metadata().unwrap().ino(), "the file was replaced");
     }
 
     #[test]

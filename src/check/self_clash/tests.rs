@@ -390,7 +390,7 @@ fn certified_vertices(m: &Mesh) -> Vec<u32> {
     let (merged, _) = crate::scene::bodies::merge_vertices(&m.positions);
     let all: Vec<u32> = (0..m.triangles.len() as u32).collect();
     let fans = Fans::new(m, &merged, &all);
-    let bits = certified_fans(m, &all, &fans);
+    let bits = certified_fans(m, &all, &fans, None);
     let mut out = Vec::new();
     for (k, t) in m.triangles.iter().enumerate() {
         for c in 0..3 {
@@ -477,4 +477,150 @@ proptest! {
     fn certified_fans_lose_no_pair(m in bent_octahedron()) {
         pairs(&m);
     }
+}
+
+/// A fan of `m` triangles around the origin over ring points `ring` (integers), triangle `i`
+/// = (v, ring[i], ring[i + 1]), closed when `closed`.
+fn fan(ring: &[[f64; 3]], closed: bool) -> Mesh {
+    let mut p = vec![[0.0, 0.0, 0.0]];
+    p.extend_from_slice(ring);
+    let n = ring.len() as u32;
+    let last = if closed { n } else { n - 1 };
+    let t: Vec<[u32; 3]> = (0..last).map(|i| [0, 1 + i, 1 + (i + 1) % n]).collect();
+    mesh(&p, &t)
+}
+
+/// `m` points on a circle of radius `r`, rounded to integers (distinct for the sizes used).
+fn circle(m: usize, r: f64, z: impl Fn(usize) -> f64) -> Vec<[f64; 3]> {
+    (0..m)
+        .map(|i| {
+            let a = i as f64 * std::f64::consts::TAU / m as f64;
+            [(r * a.cos()).round(), (r * a.sin()).round(), z(i)]
+        })
+        .collect()
+}
+
+#[test]
+fn large_fans_are_certified_by_their_sectors_exactly_when_they_tile() {
+    // Flat and closed (a disc of 200 triangles): certified, no pair.
+    let flat = fan(&circle(200, 1000.0, |_| 0.0), true);
+    assert_eq!(certified_vertices(&flat), [0]);
+    assert!(pairs(&flat).is_empty());
+    // Open (a half disc), and a wavy cone: certified as well.
+    let half: Vec<[f64; 3]> = circle(400, 1000.0, |_| 0.0).into_iter().take(201).collect();
+    assert!(certified_vertices(&fan(&half, false)).contains(&0));
+    let wavy = fan(&circle(100, 1000.0, |i| (i % 3) as f64 - 1.0), true);
+    assert!(certified_vertices(&wavy).contains(&0));
+    assert!(pairs(&wavy).is_empty());
+    // A fan turning one and a half times: its sectors overlap; not certified, and the walk
+    // finds the brute-force pairs (checked inside `pairs`).
+    let ring = circle(40, 1000.0, |_| 0.0);
+    let twice: Vec<[f64; 3]> = ring.iter().chain(&ring[..20]).map(|q| [q[0], q[1], 0.0]).collect();
+    let mut m = fan(&twice, false);
+    // The second turn's points are other vertices at the same places: pull them halfway to
+    // v so they are distinct points, in the same plane, over the first turn.
+    for q in &mut m.positions[41..] {
+        *q *= 0.5;
+    }
+    assert!(!certified_vertices(&m).contains(&0));
+    assert!(!pairs(&m).is_empty());
+    // Two sectors touching along one ray at different vertices: not certified.
+    let mut touching = fan(&circle(60, 1000.0, |_| 0.0), false);
+    touching.positions[60] = touching.positions[1] * 0.5; // the last ray is the first one
+    assert!(!certified_vertices(&touching).contains(&0));
+    pairs(&touching);
+}
+
+/// Fans of 33 to 48 triangles around the origin over random integer ring points: folds,
+/// repeats, collinear rays, zero-area triangles; certified or not, the walk gives the brute
+/// force answer.
+fn big_fan() -> impl Strategy<Value = Mesh> {
+    (33usize..48, prop::collection::vec((0usize..48, prop::array::uniform3(-3i32..4)), 0..3), any::<bool>())
+        .prop_map(|(m, moves, closed)| {
+            let mut ring = circle(m, 40.0, |i| (i % 2) as f64);
+            for (i, to) in moves {
+                ring[i % m] = to.map(|c| c as f64);
+            }
+            fan(&ring, closed)
+        })
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig { cases: 200, ..ProptestConfig::default() })]
+
+    #[test]
+    fn large_fan_certificates_lose_no_pair(m in big_fan()) {
+        pairs(&m);
+    }
+}
+
+#[test]
+fn copies_of_a_face_are_walked_once_and_every_pair_of_two_sets_is_listed() {
+    // 30 copies of one triangle in every winding and with separate vertices, 20 copies of a
+    // triangle crossing it, 10 point triangles at a point on it, 5 segments through it.
+    let mut p: Vec<[f64; 3]> = Vec::new();
+    let mut t: Vec<[u32; 3]> = Vec::new();
+    let mut add = |pts: [[f64; 3]; 3], order: [usize; 3], p: &mut Vec<[f64; 3]>| {
+        let b = p.len() as u32;
+        p.extend(pts);
+        t.push(order.map(|k| b + k as u32));
+    };
+    let flat = [[0.0, 0.0, 0.0], [4.0, 0.0, 0.0], [0.0, 4.0, 0.0]];
+    let upright = [[1.0, 1.0, -1.0], [1.0, 1.0, 1.0], [2.0, 1.0, 1.0]];
+    let orders = [[0, 1, 2], [1, 2, 0], [2, 1, 0], [0, 2, 1]];
+    for i in 0..30 {
+        add(flat, orders[i % 4], &mut p);
+    }
+    for i in 0..20 {
+        add(upright, orders[i % 4], &mut p);
+    }
+    for _ in 0..10 {
+        add([[1.0, 2.0, 0.0]; 3], [0, 1, 2], &mut p);
+    }
+    for i in 0..5 {
+        add([[3.0, 3.0, -1.0], [3.0, 3.0, 1.0], [3.0, 3.0, 1.0]], orders[i % 4], &mut p);
+    }
+    let m = mesh(&p, &t);
+    let (merged, _) = crate::scene::bodies::merge_vertices(&m.positions);
+    let fans = Fans::new(&m, &merged, &(0..m.triangles.len() as u32).collect::<Vec<_>>());
+    let copies = Copies::new(&fans).expect("copies");
+    assert_eq!(copies.firsts().len(), 4);
+    let got = pairs(&m);
+    // Flat × upright crossing, point × flat touching; the segments (x + y = 6 > 4) miss.
+    assert_eq!(got.iter().filter(|q| q.2).count(), 30 * 20);
+    assert_eq!(got.len(), 30 * 20 + 30 * 10);
+}
+
+/// The constructions that were quadratic, at a size the brute force can check: copies of one
+/// triangle, point triangles at one point, a closed flat fan, triangles on one edge, collinear
+/// overlapping zero-area triangles.
+#[test]
+fn hostile_constructions_match_the_brute_force() {
+    let n = 300;
+    let copies = mesh(&[[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]], &vec![[0, 1, 2]; n]);
+    assert!(pairs(&copies).is_empty());
+    let points: Vec<[f64; 3]> = vec![[0.5, 0.5, 0.0]; 3 * n];
+    let t: Vec<[u32; 3]> = (0..n as u32).map(|i| [3 * i, 3 * i + 1, 3 * i + 2]).collect();
+    assert!(pairs(&mesh(&points, &t)).is_empty());
+    let disc = fan(&circle(n, 10_000.0, |_| 0.0), true);
+    assert!(pairs(&disc).is_empty());
+    // A book: pages at angles k·(2π/n) around the z axis, every third page repeated at twice the
+    // distance (coplanar, same side: a fold with the first).
+    let mut p = vec![[0.0, 0.0, 0.0], [0.0, 0.0, 1.0]];
+    let mut t = Vec::new();
+    for k in 0..n / 3 {
+        let a = k as f64 * std::f64::consts::TAU / (n / 3) as f64;
+        let (x, y) = ((100.0 * a.cos()).round(), (100.0 * a.sin()).round());
+        p.push([x, y, 0.5]);
+        t.push([0, 1, p.len() as u32 - 1]);
+        if k % 3 == 0 {
+            p.push([2.0 * x, 2.0 * y, 0.5]);
+            t.push([0, 1, p.len() as u32 - 1]);
+        }
+    }
+    assert!(!pairs(&mesh(&p, &t)).is_empty());
+    // Collinear: triangles (i, i + 2, i + 5) on the x axis.
+    let p: Vec<[f64; 3]> = (0..n + 5).map(|i| [i as f64, 0.0, 0.0]).collect();
+    let t: Vec<[u32; 3]> = (0..n as u32).map(|i| [i, i + 2, i + 5]).collect();
+    assert!(!pairs(&mesh(&p, &t)).is_empty());
 }

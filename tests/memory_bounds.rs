@@ -1,0 +1,148 @@
+//! Inputs that used to abort or run without end, through the real binary: instanced glTF
+//! scenes within the documented caps under a 1 GiB address-space limit (refused up front with
+//! exit 2 and one line naming the file), and `self` on 100,000-triangle constructions around
+//! one vertex (copies of one face, point triangles at one point, a flat disc fan), which must
+//! finish (a child process bounded by a generous time limit: a hang fails, no speed is
+//! asserted).
+
+use std::io::Write;
+use std::path::Path;
+use std::time::{Duration, Instant};
+
+fn exe() -> &'static str {
+    env!("CARGO_BIN_EXE_meshclash")
+}
+
+/// Runs `sh -c 'ulimit -v KIB; exec meshclash ARGS --threads 1'`: (exit code, stderr).
+fn under_limit(kib: u64, args: &[&str]) -> (Option<i32>, String) {
+    let script = format!(r#"ulimit -v {kib} && exec "$0" "$@" --threads 1"#);
+    let out =
+        std::process::Command::new("/bin/sh").arg("-c").arg(script).arg(exe()).args(args).output().unwrap();
+    (out.status.code(), String::from_utf8_lossy(&out.stderr).into_owned())
+}
+
+/// One triangle's positions as a base64 data URI buffer prefix (36 bytes).
+fn triangle_bytes() -> Vec<u8> {
+    [0f32, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0, 0.0].iter().flat_map(|x| x.to_le_bytes()).collect()
+}
+
+/// `n` nodes, each placing a one-triangle mesh 2 apart along x.
+fn many_nodes(path: &Path, n: usize) {
+    use base64::Engine;
+    let data = base64::engine::general_purpose::STANDARD.encode(triangle_bytes());
+    let mut f = std::io::BufWriter::new(std::fs::File::create(path).unwrap());
+    write!(f, r#"{{"asset":{{"version":"2.0"}},"scene":0,"scenes":[{{"nodes":["#).unwrap();
+    for i in 0..n {
+        write!(f, "{}{i}", if i == 0 { "" } else { "," }).unwrap();
+    }
+    write!(f, r#"]}}],"nodes":["#).unwrap();
+    for i in 0..n {
+        write!(f, r#"{}{{"mesh":0,"translation":[{},0,0]}}"#, if i == 0 { "" } else { "," }, 2 * i).unwrap();
+    }
+    write!(
+        f,
+        r#"],"meshes":[{{"primitives":[{{"attributes":{{"POSITION":0}}}}]}}],
+"buffers":[{{"byteLength":36,"uri":"data:application/octet-stream;base64,{data}"}}],
+"bufferViews":[{{"buffer":0,"byteLength":36}}],
+"accessors":[{{"bufferView":0,"componentType":5126,"count":3,"type":"VEC3","min":[0,0,0],"max":[1,1,0]}}]}}"#
+    )
+    .unwrap();
+}
+
+/// One node with `n` EXT_mesh_gpu_instancing instances (translations 2 apart along x) of a
+/// one-triangle mesh; the buffer is an external file next to it.
+fn gpu_instances(path: &Path, n: usize) {
+    let mut bin = triangle_bytes();
+    for i in 0..n {
+        bin.extend([2.0 * i as f32, 0.0, 0.0].iter().flat_map(|x| x.to_le_bytes()));
+    }
+    std::fs::write(path.with_extension("bin"), &bin).unwrap();
+    let name = path.with_extension("bin").file_name().unwrap().to_string_lossy().into_owned();
+    let json = format!(
+        r#"{{"asset":{{"version":"2.0"}},"extensionsUsed":["EXT_mesh_gpu_instancing"],"scene":0,"scenes":[{{"nodes":[0]}}],
+"nodes":[{{"mesh":0,"extensions":{{"EXT_mesh_gpu_instancing":{{"attributes":{{"TRANSLATION":1}}}}}}}}],
+"meshes":[{{"primitives":[{{"attributes":{{"POSITION":0}}}}]}}],
+"buffers":[{{"byteLength":{},"uri":"{name}"}}],
+"bufferViews":[{{"buffer":0,"byteLength":36}},{{"buffer":0,"byteOffset":36,"byteLength":{}}}],
+"accessors":[{{"bufferView":0,"componentType":5126,"count":3,"type":"VEC3","min":[0,0,0],"max":[1,1,0]}},
+{{"bufferView":1,"componentType":5126,"count":{n},"type":"VEC3"}}]}}"#,
+        bin.len(),
+        12 * n
+    );
+    std::fs::write(path, json).unwrap();
+}
+
+#[test]
+fn instanced_scenes_within_the_caps_are_refused_under_1_gib_not_aborted() {
+    if !cfg!(target_os = "linux") {
+        return;
+    }
+    let d = tempfile::tempdir().unwrap();
+    let nodes = d.path().join("nodes.gltf");
+    many_nodes(&nodes, 1_000_000);
+    let gpu = d.path().join("gpu.gltf");
+    gpu_instances(&gpu, 4_000_000);
+    let good = concat!(env!("CARGO_MANIFEST_DIR"), "/meshes/fcl_rob.obj");
+    for file in [&nodes, &gpu] {
+        let f = file.to_str().unwrap();
+        for args in [vec!["scene", f, "-o", "/dev/null"], vec![good, f, "-o", "/dev/null"]] {
+            let (code, err) = under_limit(1 << 20, &args);
+            assert_eq!(code, Some(2), "{args:?} under ulimit -v 1 GiB: {err}");
+            assert_eq!(err.trim_end().lines().count(), 1, "not one line: {err}");
+            assert!(err.contains(f) && err.contains("GiB") && err.contains("may use"), "{err}");
+        }
+    }
+}
+
+/// Runs `meshclash self FILE -o /dev/null` in a child, killed after `limit`: the exit code,
+/// or `None` when it had to be killed.
+fn self_within(file: &Path, limit: Duration) -> Option<i32> {
+    let mut child = std::process::Command::new(exe())
+        .args(["self", file.to_str().unwrap(), "-q", "--no-timings", "-o", "/dev/null"])
+        .stdout(std::process::Stdio::null())
+        .stderr(std::process::Stdio::null())
+        .spawn()
+        .unwrap();
+    let start = Instant::now();
+    loop {
+        if let Some(status) = child.try_wait().unwrap() {
+            return status.code();
+        }
+        if start.elapsed() > limit {
+            child.kill().unwrap();
+            child.wait().unwrap();
+            return None;
+        }
+        std::thread::sleep(Duration::from_millis(50));
+    }
+}
+
+#[test]
+fn self_on_100k_triangles_around_one_vertex_finishes() {
+    let n = 100_000usize;
+    let d = tempfile::tempdir().unwrap();
+    let write = |name: &str, text: String| {
+        let p = d.path().join(name);
+        std::fs::write(&p, text).unwrap();
+        p
+    };
+    let copies = write("copies.obj", format!("v 0 0 0\nv 1 0 0\nv 0 1 0\n{}", "f 1 2 3\n".repeat(n)));
+    let mut pts = "v 0.5 0.5 0\n".repeat(3 * n);
+    for i in 0..n {
+        pts.push_str(&format!("f {} {} {}\n", 3 * i + 1, 3 * i + 2, 3 * i + 3));
+    }
+    let points = write("points.obj", pts);
+    let mut disc = String::from("v 0 0 0\n");
+    for i in 0..n {
+        let a = i as f64 * std::f64::consts::TAU / n as f64;
+        disc.push_str(&format!("v {} {} 0\n", a.cos(), a.sin()));
+    }
+    for i in 0..n {
+        disc.push_str(&format!("f 1 {} {}\n", 2 + i, 2 + (i + 1) % n));
+    }
+    let fan = write("fan.obj", disc);
+    // Generous: a hang or the old quadratic walk (hours) fails; the figures are in benchmarks.
+    for f in [&copies, &points, &fan] {
+        assert_eq!(self_within(f, Duration::from_secs(120)), Some(0), "{}", f.display());
+    }
+}
