@@ -1,6 +1,6 @@
-//! The one integration-test crate (issue 13: one test binary links once instead of one per
-//! file). Every `tests/*.rs` file is a module here; run one file's tests with
-//! `cargo test --test suite cli::` (module path as the filter).
+//! The one integration-test crate: one test binary links once instead of once per file. Every
+//! `tests/*.rs` file is a module here; run one file's tests with `cargo test --test suite cli::`
+//! (module path as the filter). `common` finds the test meshes (shipped, or the corpus).
 
 #[path = "assembly.rs"]
 mod assembly;
@@ -22,6 +22,8 @@ mod cli_errors;
 mod cli_messages;
 #[path = "cli_subcommands.rs"]
 mod cli_subcommands;
+#[path = "common.rs"]
+mod common;
 #[path = "extremes.rs"]
 mod extremes;
 #[path = "fcl_reference.rs"]
