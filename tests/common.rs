@@ -25,7 +25,7 @@ fn search_dirs() -> Vec<PathBuf> {
 }
 
 /// The corpus directory when it exists: `$MESHCLASH_SHARED_MESHES`, else `../shared/meshes`.
-fn corpus_dir() -> Option<PathBuf> {
+pub fn corpus_dir() -> Option<PathBuf> {
     let dir = match std::env::var_os(CORPUS_VAR) {
         Some(d) if !d.is_empty() => PathBuf::from(d),
         _ => root().join("../shared/meshes"),
@@ -59,7 +59,7 @@ fn missing(name: &str) {
 
 /// One line straight to the process's stderr: the test harness captures `eprintln!` of passing
 /// tests, and a skip must show in a plain `cargo test`.
-fn say(line: &str) {
+pub fn say(line: &str) {
     use std::io::Write;
     let _ = writeln!(std::io::stderr().lock(), "{line}");
 }

@@ -24,6 +24,8 @@ mod cli_messages;
 mod cli_subcommands;
 #[path = "common.rs"]
 mod common;
+#[path = "docs_commands.rs"]
+mod docs_commands;
 #[path = "extremes.rs"]
 mod extremes;
 #[path = "fcl_reference.rs"]
