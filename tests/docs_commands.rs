@@ -250,7 +250,8 @@ fn documentation_speaks_of_the_product_only() {
     let root = common::root();
     let mut files = doc_files();
     files.extend(["CHANGELOG.md", "meshes/README.md", "tests/data/meshes/README.md"].map(|f| root.join(f)));
-    let banned = ["issue ", "issue-", "this round", "previous round", "session"];
+    // Spelled in pieces so that a search of the sources for these phrases finds only real uses.
+    let banned = ["issue ", "issue-", concat!("this", " round"), concat!("previous", " round"), "session"];
     let mut found = Vec::new();
     for f in files {
         for (n, line) in std::fs::read_to_string(&f).unwrap().lines().enumerate() {
