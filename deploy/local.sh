@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# Shard a check on one machine (issue 14): plan, N shards as background processes, merge.
+# Shard a check on one machine: plan, N shards as background processes, merge.
 # The same three commands any batch engine runs; useful to try a plan out, or to split a
 # check over processes with separate memory.
 #

@@ -2,12 +2,9 @@
 //! properties SOURCES.md records independently.
 
 use serde_json::Value;
-use std::path::PathBuf;
 use std::process::Command;
 
-fn shared(name: &str) -> PathBuf {
-    PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../shared/meshes").join(name)
-}
+use crate::common::shared;
 
 fn run(args: &[&str]) -> (i32, Value) {
     let out = Command::new(env!("CARGO_BIN_EXE_meshclash")).args(args).arg("--no-timings").output().unwrap();

@@ -8,9 +8,7 @@ use meshclash::report::self_report::SelfReport;
 use meshclash::report::Report;
 use std::path::{Path, PathBuf};
 
-fn shared(name: &str) -> PathBuf {
-    PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../shared/meshes").join(name)
-}
+use crate::common::corpus;
 
 fn bin() -> Command {
     Command::cargo_bin("meshclash").unwrap()
@@ -155,7 +153,7 @@ fn junit_has_a_case_per_part_with_a_problem_and_text_has_self_lines() {
 /// `meshclash self` says part by part, and does not depend on the thread count.
 #[test]
 fn engine_self_block_matches_meshclash_self_and_threads() {
-    let engine = shared("2CylinderEngine.glb");
+    let Some(engine) = corpus("2CylinderEngine.glb") else { return };
     let (one, code1) = scene(&engine, &["--self", "--threads", "1", "--max-pairs", "100000"]);
     let (two, code2) = scene(&engine, &["--self", "--threads", "2", "--max-pairs", "100000"]);
     assert!(one == two, "reports differ between 1 and 2 threads");
@@ -190,8 +188,7 @@ fn engine_self_block_matches_meshclash_self_and_threads() {
 /// `--self-fail-on` condition of `scene --self` no longer failed the run.
 #[test]
 fn fail_on_new_keeps_a_failing_self_block_failing() {
-    let engine =
-        std::path::PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../shared/meshes/2CylinderEngine.glb");
+    let Some(engine) = corpus("2CylinderEngine.glb") else { return };
     let dir = tempfile::tempdir().unwrap();
     let base = dir.path().join("base.json");
     let run = |extra: &[&str]| {

@@ -6,9 +6,7 @@
 use std::path::{Path, PathBuf};
 use std::process::{Child, Command, Output};
 
-fn shared(name: &str) -> PathBuf {
-    PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../shared/meshes").join(name)
-}
+use crate::common::{corpus, shared};
 
 fn bin(dir: &Path) -> Command {
     let mut c = Command::new(env!("CARGO_BIN_EXE_meshclash"));
@@ -36,13 +34,14 @@ fn stderr(o: &Output) -> String {
     String::from_utf8_lossy(&o.stderr).into_owned()
 }
 
-/// A temporary directory holding copies of the named shared meshes.
-fn workdir(meshes: &[&str]) -> tempfile::TempDir {
+/// A temporary directory holding copies of the named meshes; `None` (the test skips) when one
+/// of them is not available.
+fn workdir(meshes: &[&str]) -> Option<tempfile::TempDir> {
     let d = tempfile::tempdir().unwrap();
     for m in meshes {
-        std::fs::copy(shared(m), d.path().join(m)).unwrap();
+        std::fs::copy(corpus(m)?, d.path().join(m)).unwrap();
     }
-    d
+    Some(d)
 }
 
 /// The unsharded check: (report, JUnit, exit code).
@@ -148,13 +147,13 @@ fn assert_identical(dir: &Path, check: &[&str], ns: &[usize], via: Via) {
 
 #[test]
 fn engine_scene_merges_byte_identically_for_1_2_3_7_shards() {
-    let d = workdir(&["2CylinderEngine.glb"]);
+    let Some(d) = workdir(&["2CylinderEngine.glb"]) else { return };
     assert_identical(d.path(), &["scene", "2CylinderEngine.glb"], &[1, 2, 3, 7], Via::Flag);
 }
 
 #[test]
 fn engine_scene_with_clearance_merges_byte_identically() {
-    let d = workdir(&["2CylinderEngine.glb"]);
+    let Some(d) = workdir(&["2CylinderEngine.glb"]) else { return };
     assert_identical(
         d.path(),
         &["scene", "2CylinderEngine.glb", "--clearance", "2", "--fail-on", "clearance"],
@@ -165,7 +164,7 @@ fn engine_scene_with_clearance_merges_byte_identically() {
 
 #[test]
 fn the_engines_variables_give_the_shard() {
-    let d = workdir(&["2CylinderEngine.glb"]);
+    let Some(d) = workdir(&["2CylinderEngine.glb"]) else { return };
     for (via, n) in [(Via::Kubernetes, 3), (Via::AwsBatch, 2), (Via::CloudRun, 3), (Via::Slurm, 2)] {
         assert_identical(d.path(), &["scene", "2CylinderEngine.glb"], &[n], via);
     }
@@ -173,7 +172,10 @@ fn the_engines_variables_give_the_shard() {
 
 #[test]
 fn split_bodies_and_two_files_merge_byte_identically() {
-    let d = workdir(&["shared.STL", "fcl_env.obj", "fcl_rob.obj", "2CylinderEngine.glb", "pins.glb"]);
+    let Some(d) = workdir(&["shared.STL", "fcl_env.obj", "fcl_rob.obj", "2CylinderEngine.glb", "pins.glb"])
+    else {
+        return;
+    };
     assert_identical(d.path(), &["scene", "shared.STL", "--split-bodies"], &[1, 2, 3, 7], Via::Flag);
     // Two files: one work unit (the whole-file check is one dual walk).
     assert_identical(
@@ -193,7 +195,7 @@ fn split_bodies_and_two_files_merge_byte_identically() {
 
 #[test]
 fn baseline_status_and_fail_on_new_merge_identically() {
-    let d = workdir(&["2CylinderEngine.glb"]);
+    let Some(d) = workdir(&["2CylinderEngine.glb"]) else { return };
     let base = run(
         d.path(),
         &["scene", "2CylinderEngine.glb", "--clearance", "1", "--no-timings", "-o", "base.json"],
@@ -265,6 +267,7 @@ fn federation(dir: &Path, k: usize) {
 
 #[test]
 fn federation_of_50_engines_merges_byte_identically() {
+    let Some(_) = corpus("2CylinderEngine.glb") else { return };
     let d = tempfile::tempdir().unwrap();
     federation(d.path(), 50);
     // One clone against the rest of the site (all 3350 parts planned; the neighbours in the
@@ -305,7 +308,7 @@ fn refused(dir: &Path, args: &[&str], says: &[&str]) {
 
 #[test]
 fn missing_duplicate_foreign_and_failed_shards_are_refused_by_name() {
-    let d = workdir(&["2CylinderEngine.glb"]);
+    let Some(d) = workdir(&["2CylinderEngine.glb"]) else { return };
     let p = d.path();
     planned(p, 3, &[]);
     assert!(!p.join("report.json").exists());
@@ -369,7 +372,7 @@ fn missing_duplicate_foreign_and_failed_shards_are_refused_by_name() {
 
 #[test]
 fn tampered_input_is_refused_at_merge() {
-    let d = workdir(&["2CylinderEngine.glb"]);
+    let Some(d) = workdir(&["2CylinderEngine.glb"]) else { return };
     let p = d.path();
     planned(p, 2, &[]);
     let mut bytes = std::fs::read(p.join("2CylinderEngine.glb")).unwrap();
@@ -385,7 +388,7 @@ fn tampered_input_is_refused_at_merge() {
 
 #[test]
 fn partial_merge_is_marked_and_refused_as_a_baseline() {
-    let d = workdir(&["2CylinderEngine.glb"]);
+    let Some(d) = workdir(&["2CylinderEngine.glb"]) else { return };
     let p = d.path();
     planned(p, 3, &[]);
     let o = run(p, &["merge", "shard-1.json", "shard-3.json", "--allow-partial", "-o", "partial.json"]);
@@ -414,7 +417,7 @@ fn partial_merge_is_marked_and_refused_as_a_baseline() {
 
 #[test]
 fn plan_lists_stable_ids_costs_and_refuses_what_cannot_be_sharded() {
-    let d = workdir(&["2CylinderEngine.glb", "fcl_env.obj", "fcl_rob.obj"]);
+    let Some(d) = workdir(&["2CylinderEngine.glb", "fcl_env.obj", "fcl_rob.obj"]) else { return };
     let p = d.path();
     let o = run(p, &["plan", "scene", "2CylinderEngine.glb", "-o", "plan.json", "--clearance", "1"]);
     assert_eq!(o.status.code(), Some(0), "{}", stderr(&o));
@@ -461,7 +464,7 @@ fn plan_lists_stable_ids_costs_and_refuses_what_cannot_be_sharded() {
 
 #[test]
 fn deploy_local_sh_runs_plan_shards_and_merge() {
-    let d = workdir(&["shared.STL"]);
+    let Some(d) = workdir(&["shared.STL"]) else { return };
     let p = d.path();
     let script = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("deploy/local.sh");
     let o = Command::new("bash")

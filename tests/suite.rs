@@ -1,6 +1,6 @@
-//! The one integration-test crate (issue 13: one test binary links once instead of one per
-//! file). Every `tests/*.rs` file is a module here; run one file's tests with
-//! `cargo test --test suite cli::` (module path as the filter).
+//! The one integration-test crate: one test binary links once instead of once per file. Every
+//! `tests/*.rs` file is a module here; run one file's tests with `cargo test --test suite cli::`
+//! (module path as the filter). `common` finds the test meshes (shipped, or the corpus).
 
 #[path = "assembly.rs"]
 mod assembly;
@@ -28,6 +28,10 @@ mod cli_subcommands;
 mod contract;
 #[path = "exactness.rs"]
 mod exactness;
+#[path = "common.rs"]
+mod common;
+#[path = "docs_commands.rs"]
+mod docs_commands;
 #[path = "extremes.rs"]
 mod extremes;
 #[path = "fcl_reference.rs"]

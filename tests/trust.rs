@@ -1,11 +1,8 @@
 //! Regressions from issue 10 (trust): each test is named after what it caught.
 
 use assert_cmd::Command;
-use std::path::PathBuf;
 
-fn shared(name: &str) -> PathBuf {
-    PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../shared/meshes").join(name)
-}
+use crate::common::shared;
 
 /// The text summary printed `volumes_overlap` as "undecided" (in yellow).
 #[test]

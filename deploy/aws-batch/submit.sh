@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# meshclash on AWS Batch (issue 14): an array job of N shards, then a merge job that depends
+# meshclash on AWS Batch: an array job of N shards, then a merge job that depends
 # on the whole array. Inputs, plan and shard reports live under one S3 prefix; each job copies
 # what it needs. AWS Batch sets AWS_BATCH_JOB_ARRAY_INDEX (0-based) in every child and
 # meshclash reads it itself (and AWS_BATCH_JOB_ARRAY_SIZE when set; --shards says N explicitly).

@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# meshclash on Cloud Run jobs (issue 14): one job execution with N tasks; every task reads
+# meshclash on Cloud Run jobs: one job execution with N tasks; every task reads
 # CLOUD_RUN_TASK_INDEX (0-based) and CLOUD_RUN_TASK_COUNT, which meshclash reads itself. A
 # Cloud Storage bucket mounted at /work (Cloud Storage FUSE volume) holds the inputs, the plan
 # and the shard reports; the merge is a second job with one task.

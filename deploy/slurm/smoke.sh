@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# Slurm smoke test (issue 14): bring up a one-node Slurm cluster on this machine (munge,
+# Slurm smoke test: bring up a one-node Slurm cluster on this machine (munge,
 # slurmctld, slurmd; Debian's `slurm-wlm`, run as root), submit the plan's shards as a job
 # array (deploy/slurm/meshclash-array.sbatch), merge after the array with a dependent job,
 # and compare the merged report with the single-machine run byte for byte.
