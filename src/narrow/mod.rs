@@ -2,5 +2,6 @@
 //! predicates from [`crate::geom::predicates`]); [`distance`] gives closed-form triangle–triangle
 //! and point–triangle distances.
 
+pub mod convex;
 pub mod distance;
 pub mod tri_tri;
