@@ -242,6 +242,21 @@ pub fn penetration(a: &Polytope<'_>, b: &Polytope<'_>) -> Option<Penetration> {
     Some(Penetration { depth, normal, point, axis: winner })
 }
 
+/// The exact penetration of two meshes given as arrays, when both are convex
+/// ([`is_convex`]): `None` when either is not (then no exact depth exists here), `Some(None)`
+/// when both are convex and disjoint, else the penetration (depth 0 when they only touch).
+/// The entry point of `--penetration`'s `exact_convex` method.
+pub fn exact_convex_penetration(
+    a: (&[DVec3], &[[u32; 3]]),
+    b: (&[DVec3], &[[u32; 3]]),
+) -> Option<Option<Penetration>> {
+    let sa = Surface::of(a.1).filter(|s| is_convex(a.0, a.1, s))?;
+    let sb = Surface::of(b.1).filter(|s| is_convex(b.0, b.1, s))?;
+    let pa = Polytope { positions: a.0, triangles: a.1, surface: &sa };
+    let pb = Polytope { positions: b.0, triangles: b.1, surface: &sb };
+    Some(penetration(&pa, &pb))
+}
+
 /// One candidate axis with an interval holding its exact `h / |n|`.
 struct Candidate {
     axis: Axis,

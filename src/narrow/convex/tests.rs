@@ -225,6 +225,12 @@ fn boxes_with_known_depths() {
     let p = penetration(&big.poly(), &small.poly()).unwrap();
     assert_eq!(p.depth, 3.0); // down through y = 0: the small box's top is at 3
     assert_eq!(p.normal, DVec3::new(0.0, -1.0, 0.0));
+    let arrays = |s: &Shape| (s.positions.clone(), s.triangles.clone());
+    let ((pb, tb), (ps, ts)) = (arrays(&big), arrays(&small));
+    assert_eq!(exact_convex_penetration((&pb, &tb), (&ps, &ts)).unwrap().unwrap().depth, 3.0);
+    let far = small.moved(DVec3::new(20.0, 0.0, 0.0));
+    assert_eq!(exact_convex_penetration((&pb, &tb), (&far.positions, &far.triangles)), Some(None));
+    assert_eq!(exact_convex_penetration((&pb, &tb[1..]), (&ps, &ts)), None);
     for (x, y) in [(&unit, &unit), (&big, &small), (&small, &big)] {
         check(x, y);
     }
