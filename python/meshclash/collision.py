@@ -138,7 +138,8 @@ class CollisionObject:
 def _contacts(names, contacts, containment):
     if not contacts:
         return [ContactData(names, (-1, -1), None, None, 0.0, kind=containment or "containment")]
-    return [ContactData(names, (fa, fb), p, n, depth) for fa, fb, p, n, depth in contacts]
+    kind = containment or "contact"
+    return [ContactData(names, (fa, fb), p, n, depth, kind=kind) for fa, fb, p, n, depth in contacts]
 
 
 def _matrix(transform):

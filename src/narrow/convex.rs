@@ -160,12 +160,18 @@ pub struct Penetration {
 /// 0 when they only touch.
 pub fn penetration(a: &Polytope<'_>, b: &Polytope<'_>) -> Option<Penetration> {
     let mut cands: Vec<Candidate> = Vec::new();
+    let na: Vec<Plane> = a.triangles.iter().map(|t| Plane::new(&t.map(|v| a.vertex(v)))).collect();
+    let nb: Vec<Plane> = b.triangles.iter().map(|t| Plane::new(&t.map(|v| b.vertex(v)))).collect();
+    let prune = Prune::new(a, &na, b, &nb);
+    if prune.separated {
+        return None;
+    }
     // Faces of A against the vertices of B, then faces of B against the vertices of A.
-    for (side, (p, q)) in [(a, b), (b, a)].into_iter().enumerate() {
-        for f in 0..p.triangles.len() as u32 {
-            let t = p.tri(f);
-            let plane = Plane::new(&t);
-            if plane.degenerate(&t) {
+    for (side, (p, planes, q)) in [(a, &na, b), (b, &nb, a)].into_iter().enumerate() {
+        let ball = if side == 0 { prune.ball_b } else { prune.ball_a };
+        for (f, plane) in planes.iter().enumerate() {
+            let t = p.tri(f as u32);
+            if plane.degenerate(&t) || prune.skips(plane, t[0], ball) {
                 continue;
             }
             let (min_lo, min_hi) = q.surface.vertices.iter().fold((f64::INFINITY, f64::INFINITY), |m, &v| {
@@ -176,17 +182,28 @@ pub fn penetration(a: &Polytope<'_>, b: &Polytope<'_>) -> Option<Penetration> {
                 return None; // every vertex strictly above this face: separated
             }
             let h = Iv { lo: -min_hi, hi: -min_lo };
-            let axis = if side == 0 { Axis::FaceA(f) } else { Axis::FaceB(f) };
+            let axis = if side == 0 { Axis::FaceA(f as u32) } else { Axis::FaceB(f as u32) };
             cands.push(Candidate { axis, d: h.div(plane.norm2().sqrt()) });
         }
     }
-    // Edge pairs whose Gauss-map arcs cross.
-    let na: Vec<Plane> = a.triangles.iter().map(|t| Plane::new(&t.map(|v| a.vertex(v)))).collect();
-    let nb: Vec<Plane> = b.triangles.iter().map(|t| Plane::new(&t.map(|v| b.vertex(v)))).collect();
-    for (i, ea) in a.surface.edges.iter().enumerate() {
+    // Edge pairs whose Gauss-map arcs cross (of the edges the bounds keep).
+    let keep = |p: &Polytope<'_>, planes: &[Plane], ball| -> Vec<usize> {
+        (0..p.surface.edges.len())
+            .filter(|&i| {
+                let e = p.surface.edges[i];
+                let v = p.vertex(e.v[0]);
+                !(prune.skips(&planes[e.f[0] as usize], v, ball)
+                    && prune.skips(&planes[e.f[1] as usize], v, ball))
+            })
+            .collect()
+    };
+    let (edges_a, edges_b) = (keep(a, &na, prune.ball_b), keep(b, &nb, prune.ball_a));
+    for &i in &edges_a {
+        let ea = a.surface.edges[i];
         let (a0, a1) = (a.vertex(ea.v[0]), a.vertex(ea.v[1]));
         let da = Dir::new(a0, a1);
-        for (j, eb) in b.surface.edges.iter().enumerate() {
+        for &j in &edges_b {
+            let eb = b.surface.edges[j];
             let s1 = face_dot_edge(b, &nb[eb.f[0] as usize], eb.f[0], &da, a0, a1);
             let s2 = face_dot_edge(b, &nb[eb.f[1] as usize], eb.f[1], &da, a0, a1);
             if s1 * s2 >= 0 {
@@ -255,6 +272,67 @@ pub fn exact_convex_penetration(
     let pa = Polytope { positions: a.0, triangles: a.1, surface: &sa };
     let pb = Polytope { positions: b.0, triangles: b.1, surface: &sb };
     Some(penetration(&pa, &pb))
+}
+
+/// Bounds that settle most axes without the `O(vertices)` support: an inner ball of each
+/// polytope (a center and a radius the polytope contains around it) and an upper bound `u` of
+/// the depth. Along a unit face normal `n` of `A` (plane point `p`) the depth is at least
+/// `(p - c_B)·n + r_B` (B's ball reaches that far below the plane), so a face with that bound
+/// above `u` cannot give the depth; an edge's axes lie between its two faces' normals, where
+/// `(v - c)·n` is at least the smaller of its values at the two normals (when that is not
+/// negative), so an edge whose two faces are both skipped has no axis that can give the depth.
+/// `u` is the overlap along the centers' direction (any direction's overlap bounds the depth
+/// from above). Every bound is computed in f64 and loosened by its rounding: the search margin
+/// [`predicates::distance_rounding_slack`] of the coordinates' scale, plus the direction error
+/// of each unit normal (its cross product's filter bound over its length) times the lever arm.
+/// Only candidates strictly above the depth are skipped, so ties and the exact answer are kept.
+struct Prune {
+    u: f64,
+    slack: f64,
+    ball_a: Option<(DVec3, f64)>,
+    ball_b: Option<(DVec3, f64)>,
+    /// The overlap along the centers' direction is certainly negative: disjoint.
+    separated: bool,
+}
+
+impl Prune {
+    fn new(a: &Polytope<'_>, na: &[Plane], b: &Polytope<'_>, nb: &[Plane]) -> Prune {
+        let verts =
+            |p: &Polytope<'_>| -> Vec<DVec3> { p.surface.vertices.iter().map(|&v| p.vertex(v)).collect() };
+        let (va, vb) = (verts(a), verts(b));
+        let scale = va.iter().chain(&vb).fold(0.0f64, |m, v| m.max(v.abs().max_element()));
+        let slack = predicates::distance_rounding_slack(scale);
+        let center = |v: &[DVec3]| crate::geom::Aabb::of_points(v).center();
+        let (ca, cb) = (center(&va), center(&vb));
+        let d = (cb - ca).try_normalize().unwrap_or(DVec3::X);
+        let max_a = va.iter().map(|v| v.dot(d)).fold(f64::NEG_INFINITY, f64::max);
+        let min_b = vb.iter().map(|v| v.dot(d)).fold(f64::INFINITY, f64::min);
+        let u = max_a - min_b + slack;
+        let ball = |p: &Polytope<'_>, planes: &[Plane], c: DVec3| -> Option<(DVec3, f64)> {
+            let r = planes
+                .iter()
+                .zip(p.triangles)
+                .map(|(pl, t)| match pl.unit() {
+                    Some((n, err)) => {
+                        let lever = p.vertex(t[0]) - c;
+                        lever.dot(n) - lever.length() * err - slack
+                    }
+                    None => f64::INFINITY, // degenerate: no facet
+                })
+                .fold(f64::INFINITY, f64::min);
+            (r > 0.0 && r.is_finite()).then_some((c, r))
+        };
+        let separated = max_a - min_b + 2.0 * slack < 0.0;
+        Prune { u, slack, ball_a: ball(a, na, ca), ball_b: ball(b, nb, cb), separated }
+    }
+
+    /// Can the face with this plane (through `p`) be skipped against the other polytope's ball?
+    fn skips(&self, plane: &Plane, p: DVec3, ball: Option<(DVec3, f64)>) -> bool {
+        let (Some((c, r)), Some((n, err))) = (ball, plane.unit()) else { return false };
+        let lever = p - c;
+        let x = lever.dot(n) - lever.length() * err - self.slack;
+        x >= 0.0 && x + r > self.u
+    }
 }
 
 /// One candidate axis with an interval holding its exact `h / |n|`.
@@ -354,6 +432,17 @@ impl Plane {
         let e = self.perm * ORIENT2D_FILTER_BOUND + DVec3::splat(FILTER_UNDERFLOW_ALLOWANCE);
         let n = self.n.abs();
         !(n.x > e.x || n.y > e.y || n.z > e.z) && predicates::collinear(t[0], t[1], t[2])
+    }
+
+    /// The unit normal and a bound on its direction error (radians, as a length on the unit
+    /// sphere): the f64 normal is within `C2·|perm|` of the exact one, which turns its
+    /// direction by at most twice that over its length; normalizing adds a few ulps. `None`
+    /// when the bound says nothing (a sliver or degenerate triangle).
+    fn unit(&self) -> Option<(DVec3, f64)> {
+        let len = self.n.length();
+        let err =
+            2.0 * (ORIENT2D_FILTER_BOUND * self.perm.length() + FILTER_UNDERFLOW_ALLOWANCE) / len + WIDEN;
+        (len > 0.0 && err < 0.5).then(|| (self.n / len, err))
     }
 
     /// An interval holding `orient3d(p, q, r, x)` (the orient3d filter's bound).

@@ -322,3 +322,42 @@ proptest! {
         check(&a, &b);
     }
 }
+
+/// A prism over a regular `n`-gon of radius `r` (turned by `turn`) centered at `c`, of height
+/// `h`: exactly convex (a flat fan on each cap, vertical planar sides).
+fn ngon_prism(n: u32, r: f64, turn: f64, c: DVec3, h: f64) -> Shape {
+    let mut v = Vec::new();
+    for z in [c.z, c.z + h] {
+        for k in 0..n {
+            let a = turn + std::f64::consts::TAU * k as f64 / n as f64;
+            v.push(DVec3::new(c.x + r * a.cos(), c.y + r * a.sin(), z));
+        }
+    }
+    let mut t = Vec::new();
+    for k in 1..n - 1 {
+        t.push([0, k + 1, k]);
+        t.push([n, n + k, n + k + 1]);
+    }
+    for k in 0..n {
+        let j = (k + 1) % n;
+        t.push([k, j, j + n]);
+        t.push([k, j + n, k + n]);
+    }
+    Shape::new(v, t)
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig { cases: 6, ..ProptestConfig::default() })]
+    /// Many faces and edges: most axes are settled by the inner-ball bounds, the answer must
+    /// still be the brute force's.
+    #[test]
+    fn many_sided_prisms_match_brute_force(
+        n in 5u32..10, m in 5u32..10, turn in 0.0..1.0f64, dx in -3.0..3.0f64, dy in -3.0..3.0f64, dz in -2.0..2.0f64,
+    ) {
+        let a = ngon_prism(n, 2.0, 0.0, DVec3::ZERO, 3.0);
+        let b = ngon_prism(m, 1.5, turn, DVec3::new(dx, dy, dz), 2.5);
+        prop_assume!(is_convex(&a.positions, &a.triangles, &a.surface));
+        prop_assume!(is_convex(&b.positions, &b.triangles, &b.surface));
+        check(&a, &b);
+    }
+}
