@@ -70,9 +70,8 @@ fn tetrahedron(p: [DVec3; 4]) -> Option<Shape> {
 /// A triangle `base` extruded by `t` (a slanted prism; its side quads are exactly planar).
 fn prism(base: [DVec3; 3], t: DVec3) -> Option<Shape> {
     let top = base.map(|p| p + t);
-    if predicates::exact_translation(&base, &top).is_none() {
-        return None; // the translation rounded: the sides would not be planar
-    }
+    // The translation must be exact, or the sides would not be planar.
+    predicates::exact_translation(&base, &top)?;
     let mut b = base;
     match predicates::orient3d(b[0], b[1], b[2], top[0]) {
         0 => return None,
