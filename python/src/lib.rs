@@ -6,8 +6,8 @@ use glam::{DMat4, DVec3, DVec4};
 use meshclash::api::{self, Options, Placed, Prepared, Source, Tolerance};
 use meshclash::bvh::{BuildOptions, Strategy};
 use meshclash::check::assembly::Selection;
-use meshclash::check::query::{Detail, DistanceError, Mode};
 use meshclash::check::containment::Containment;
+use meshclash::check::query::{Detail, DistanceError, Mode};
 use meshclash::geom::Aabb;
 use meshclash::prepared;
 use meshclash::Error;
@@ -15,8 +15,8 @@ use numpy::{PyReadonlyArray2, PyUntypedArrayMethods};
 use pyo3::exceptions::{PyMemoryError, PyOSError, PyValueError};
 use pyo3::prelude::*;
 use rayon::prelude::*;
-use std::path::{Path, PathBuf};
 use std::collections::HashMap;
+use std::path::{Path, PathBuf};
 use std::sync::{Arc, Mutex};
 
 /// A library error as the Python exception the API documents: OSError for files that cannot be
@@ -104,9 +104,9 @@ fn memory_available() -> Option<u64> {
     let system = meminfo.as_deref().and_then(|t| field(t, "MemAvailable:")).map(|kb| kb * 1024);
     let limits = std::fs::read_to_string("/proc/self/limits").ok();
     let status = std::fs::read_to_string("/proc/self/status").ok();
-    let address_space = limits.as_deref().and_then(|t| field(t, "Max address space")).and_then(|limit| {
+    let address_space = limits.as_deref().and_then(|t| field(t, "Max address space")).map(|limit| {
         let used = status.as_deref().and_then(|t| field(t, "VmSize:")).unwrap_or(0) * 1024;
-        Some(limit.saturating_sub(used))
+        limit.saturating_sub(used)
     });
     match (system, address_space) {
         (Some(a), Some(b)) => Some(a.min(b)),
