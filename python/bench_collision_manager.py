@@ -1,13 +1,18 @@
 #!/usr/bin/env python3
-"""Benchmark (not a test): CollisionManager.in_collision_internal and min_distance_internal on
-2CylinderEngine's parts, meshclash against trimesh + python-fcl, in the same run.
+"""Benchmark (not a test): trimesh's CollisionManager scenes, meshclash against trimesh +
+python-fcl in the same process, with same-run ratios.
 
-    python python/bench_collision_manager.py [path/to/2CylinderEngine.glb] [--repeat N]
+    python python/bench_collision_manager.py [--repeat N] [--only spheres,cycloidal,engine,motion]
 
-Both managers get the same parts, in world coordinates (float64 vertices; identity
-transforms, so trimesh's float32 cast of transforms plays no part). Prints the median time of
-each query for both, and the ratio. The verdicts are printed too: on this assembly they may
-differ where parts only touch or one lies inside another (see meshclash.collision's docstring).
+Scenes:
+  spheres    1000 random icospheres (trimesh's test_random_spheres, seeded), via
+             scene_to_collision: in_collision_internal, min_distance_internal.
+  cycloidal  the cycloidal gearbox (trimesh's models/cycloidal.3DXML, from
+             ../shared/trimesh-collision-tests/models), via scene_to_collision.
+  engine     2CylinderEngine's parts (../shared/meshes/2CylinderEngine.glb) in world coordinates.
+  motion     one icosphere moved by set_transform, then in_collision_single of a second mesh,
+             1,000 steps (the time of the whole loop).
+Each query: the median of --repeat runs. add_object: adding every object once.
 """
 
 import argparse
@@ -21,21 +26,14 @@ HERE = Path(__file__).resolve().parent
 # module): import the installed package instead.
 sys.path = [p for p in sys.path if Path(p or ".").resolve() != HERE]
 
-import meshclash  # noqa: E402
+import numpy as np  # noqa: E402
 import trimesh  # noqa: E402
-from trimesh.collision import CollisionManager as FclManager  # noqa: E402
-DEFAULT = HERE.parent.parent / "shared" / "meshes" / "2CylinderEngine.glb"
+import trimesh.collision as tc  # noqa: E402
 
+import meshclash  # noqa: E402
 
-def parts(path):
-    scene = trimesh.load(path, force="scene", process=False)
-    out = {}
-    for node in scene.graph.nodes_geometry:
-        t, geom = scene.graph[node]
-        m = scene.geometry[geom].copy()
-        m.apply_transform(t)
-        out[node] = m
-    return out
+SHARED = HERE.parent.parent / "shared"
+FCL = tc.CollisionManager
 
 
 def timed(f, repeat):
@@ -47,50 +45,120 @@ def timed(f, repeat):
     return statistics.median(times), result
 
 
+def from_scene(make, scene):
+    """Every geometry node of the scene into a fresh manager (as scene_to_collision)."""
+    t0 = time.perf_counter()
+    m = make()
+    for node in scene.graph.nodes_geometry:
+        t, geom = scene.graph[node]
+        m.add_object(node, scene.geometry[geom], t)
+    return m, time.perf_counter() - t0
+
+
+def spheres_scene():
+    rng = np.random.default_rng(0)
+    spheres = [trimesh.creation.icosphere(radius=r[0]).apply_translation(r[1:] * 100) for r in rng.random((1000, 4))]
+    return trimesh.Scene(spheres)
+
+
+def cycloidal_scene():
+    path = SHARED / "trimesh-collision-tests" / "models" / "cycloidal.3DXML"
+    if not path.exists():
+        print(f"cycloidal: {path} is missing, skipped")
+        return None
+    return trimesh.load(str(path), force="scene")
+
+
+def engine_scene():
+    path = SHARED / "meshes" / "2CylinderEngine.glb"
+    if not path.exists():
+        print(f"engine: {path} is missing, skipped")
+        return None
+    scene = trimesh.load(str(path), force="scene", process=False)
+    out = trimesh.Scene()
+    for node in scene.graph.nodes_geometry:
+        t, geom = scene.graph[node]
+        m = scene.geometry[geom].copy()
+        m.apply_transform(t)
+        out.add_geometry(m, node_name=node, geom_name=node)
+    return out
+
+
+def describe(d):
+    return f"{d:.6g}" if isinstance(d, float) else repr(d)
+
+
+def scene_rows(label, scene, repeat):
+    rows = []
+    managers = {}
+    for name, make in [("meshclash", meshclash.CollisionManager), ("fcl", FCL)]:
+        managers[name], add = from_scene(make, scene)
+        rows.append((label, "add_object (all)", name, add, None))
+    queries = [
+        ("in_collision_internal()", lambda m: m.in_collision_internal()),
+        ("in_collision_internal(names)", lambda m: len(m.in_collision_internal(return_names=True)[1])),
+        ("min_distance_internal()", lambda m: m.min_distance_internal()),
+    ]
+    for q, f in queries:
+        for name, m in managers.items():
+            t, r = timed(lambda: f(m), repeat)
+            rows.append((label, q, name, t, r))
+    return rows
+
+
+def motion_rows(repeat, steps=1000):
+    mover = trimesh.creation.icosphere(radius=1.0)
+    probe = trimesh.creation.icosphere(radius=1.0)
+    rng = np.random.default_rng(1)
+    paths = rng.random((steps, 3)) * 6.0 - 3.0
+    rows = []
+    for name, make in [("meshclash", meshclash.CollisionManager), ("fcl", FCL)]:
+        m = make()
+        m.add_object("mover", mover)
+        for k in range(20):
+            m.add_object(f"fixed{k}", trimesh.creation.icosphere(radius=0.5).apply_translation([k * 3.0 - 30, 4, 0]))
+
+        def loop():
+            hits = 0
+            for p in paths:
+                t = np.eye(4)
+                t[:3, 3] = p
+                m.set_transform("mover", t)
+                hits += m.in_collision_single(probe)
+            return hits
+
+        t, r = timed(loop, repeat)
+        rows.append(("motion", f"{steps} x (set_transform + in_collision_single)", name, t, r))
+    return rows
+
+
 def main():
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    ap.add_argument("path", nargs="?", default=str(DEFAULT))
     ap.add_argument("--repeat", type=int, default=5)
-    ap.add_argument(
-        "--explode",
-        type=float,
-        default=0.0,
-        help="move each part away from the assembly's centre by this factor times its offset "
-        "(parts of the engine touch, so min_distance_internal is 0 without it)",
-    )
+    ap.add_argument("--only", default="spheres,cycloidal,engine,motion")
     args = ap.parse_args()
-    meshes = parts(args.path)
-    if args.explode:
-        centre = sum(m.bounds.mean(axis=0) for m in meshes.values()) / len(meshes)
-        for m in meshes.values():
-            m.apply_translation((m.bounds.mean(axis=0) - centre) * args.explode)
-    tris = sum(len(m.faces) for m in meshes.values())
-    print(f"{args.path}: {len(meshes)} parts, {tris} triangles; median of {args.repeat} runs")
-
+    only = set(args.only.split(","))
     rows = []
-    for label, make in [("meshclash", meshclash.CollisionManager), ("trimesh+fcl", FclManager)]:
-        t0 = time.perf_counter()
-        m = make()
-        for name, mesh in meshes.items():
-            m.add_object(name, mesh)
-        add = time.perf_counter() - t0
-        t_any, hit = timed(m.in_collision_internal, args.repeat)
-        t_names, (_, names) = timed(lambda: m.in_collision_internal(return_names=True), args.repeat)
-        t_dist, d = timed(m.min_distance_internal, args.repeat)
-        rows.append((label, add, t_any, t_names, t_dist, hit, len(names), d))
-
-    print(f"{'':12} {'add_object':>11} {'in_collision':>13} {'  +names':>10} {'min_distance':>13}   answers")
-    for label, add, t_any, t_names, t_dist, hit, n, d in rows:
+    for label, make in [("spheres", spheres_scene), ("cycloidal", cycloidal_scene), ("engine", engine_scene)]:
+        if label in only:
+            scene = make()
+            if scene is not None:
+                print(f"{label}: {len(scene.graph.nodes_geometry)} objects", flush=True)
+                rows += scene_rows(label, scene, args.repeat)
+    if "motion" in only:
+        rows += motion_rows(max(1, args.repeat // 2))
+    print(f"\nmedian of {args.repeat} runs; ratio = trimesh+FCL time / meshclash time (same run)\n")
+    print(f"| scene | query | meshclash | trimesh + FCL | ratio | answers (meshclash / FCL) |")
+    print("|---|---|---|---|---|---|")
+    by = {}
+    for label, q, name, t, r in rows:
+        by.setdefault((label, q), {})[name] = (t, r)
+    for (label, q), v in by.items():
+        (tm, rm), (tf, rf) = v["meshclash"], v["fcl"]
         print(
-            f"{label:12} {add * 1e3:9.1f}ms {t_any * 1e3:11.2f}ms {t_names * 1e3:8.2f}ms {t_dist * 1e3:11.2f}ms"
-            f"   collision={hit} pairs={n} min_distance={d:.6g}"
+            f"| {label} | {q} | {tm * 1e3:.3f} ms | {tf * 1e3:.3f} ms | {tf / tm:.1f}x | "
+            f"{describe(rm)} / {describe(rf)} |"
         )
-    (_, add_m, any_m, names_m, dist_m, *_), (_, add_f, any_f, names_f, dist_f, *_) = rows
-    print(
-        f"speed-up (trimesh+fcl time / meshclash time): in_collision_internal {any_f / any_m:.1f}x, "
-        f"with return_names {names_f / names_m:.1f}x, min_distance_internal {dist_f / dist_m:.1f}x, "
-        f"add_object (all parts) {add_f / add_m:.1f}x"
-    )
 
 
 if __name__ == "__main__":

@@ -14,6 +14,7 @@ use crate::check::query::{self, Closest, DistanceError, PairFinding, PairKind, S
 use crate::error::{Error, InputProblem, Location, Result};
 use crate::geom::predicates::{self, BoxMap, Tolerances};
 use crate::geom::{Aabb, DVec3};
+use crate::narrow::convex::{self, Penetration, Polytope, Surface};
 use crate::scene::mesh::{Mesh, TriMesh};
 use glam::DMat4;
 use std::path::{Path, PathBuf};
@@ -29,6 +30,8 @@ pub struct Prepared {
     pub tree: Bvh,
     /// Its name in error messages and reports.
     pub label: PathBuf,
+    surface: OnceLock<Option<Surface>>,
+    convex: OnceLock<bool>,
 }
 
 impl Prepared {
@@ -36,7 +39,26 @@ impl Prepared {
     pub fn new(label: &Path, mesh: Mesh, opts: BuildOptions) -> Result<Prepared> {
         query::check_range(&mesh, label)?;
         let tree = Bvh::build(&mesh, opts);
-        Ok(Prepared { mesh, tree, label: label.to_path_buf() })
+        Ok(Prepared {
+            mesh,
+            tree,
+            label: label.to_path_buf(),
+            surface: OnceLock::new(),
+            convex: OnceLock::new(),
+        })
+    }
+
+    /// The closed surface's edges (`None` unless closed and consistently oriented), found once.
+    pub fn surface(&self) -> Option<&Surface> {
+        self.surface.get_or_init(|| Surface::of(&self.mesh.triangles)).as_ref()
+    }
+
+    /// Exact: is the mesh, in its own coordinates, a convex polytope facing out
+    /// ([`convex::is_convex`])? Decided once, when first asked.
+    pub fn is_convex(&self) -> bool {
+        *self.convex.get_or_init(|| {
+            self.surface().is_some_and(|s| convex::is_convex(&self.mesh.positions, &self.mesh.triangles, s))
+        })
     }
 
     /// Place the mesh: every vertex transformed in f64 (as `--transform` does; identity keeps
@@ -52,6 +74,7 @@ impl Prepared {
                 tree: Mapping::Own,
                 root,
                 topology: OnceLock::new(),
+                convex: OnceLock::new(),
             });
         }
         let mut world = Vec::with_capacity(local.len());
@@ -80,6 +103,7 @@ impl Prepared {
             tree,
             root,
             topology: OnceLock::new(),
+            convex: OnceLock::new(),
         })
     }
 }
@@ -121,6 +145,7 @@ pub struct Placed {
     tree: Mapping,
     root: Aabb,
     topology: OnceLock<Topology>,
+    convex: OnceLock<bool>,
 }
 
 /// A placed mesh as the checks read it (world coordinates; nothing copied).
@@ -176,6 +201,33 @@ impl Placed {
     /// The exact world box.
     pub fn bounds(&self) -> Aabb {
         self.root
+    }
+
+    /// Exact: are the world coordinates a convex polytope facing out? The prepared mesh's
+    /// answer when they are its own coordinates or an exact translation of them (orientation
+    /// signs unchanged); otherwise decided on the world coordinates, once (a rotated convex
+    /// mesh whose coplanar triangles rounding bent apart is not convex).
+    pub fn is_convex(&self) -> bool {
+        *self.convex.get_or_init(|| {
+            let p = &self.prepared;
+            if !p.is_convex() {
+                return false;
+            }
+            match &self.world {
+                None => true,
+                Some(w) if predicates::exact_translation(&p.mesh.positions, w).is_some() => true,
+                Some(w) => p.surface().is_some_and(|s| convex::is_convex(w, &p.mesh.triangles, s)),
+            }
+        })
+    }
+
+    /// The convex polytope the depth computation reads, when [`Placed::is_convex`].
+    pub fn polytope(&self) -> Option<Polytope<'_>> {
+        if !self.is_convex() {
+            return None;
+        }
+        let surface = self.prepared.surface()?;
+        Some(Polytope { positions: self.positions(), triangles: &self.prepared.mesh.triangles, surface })
     }
 
     fn topology(&self) -> &Topology {
@@ -366,6 +418,79 @@ pub fn distance(a: &Placed, b: &Placed, bound: f64) -> Option<Closest> {
     query::closest_pair(&ma, &ta, &mb, &tb, DistanceError::default()).filter(|c| c.distance <= bound)
 }
 
+/// The exact penetration of two placed convex meshes ([`convex::penetration`]): `None` unless
+/// both are convex ([`Placed::is_convex`]) and they meet (depth 0 when they only touch).
+pub fn penetration(a: &Placed, b: &Placed) -> Option<Penetration> {
+    if !a.bounds().overlaps(&b.bounds()) {
+        return None;
+    }
+    convex::penetration(&a.polytope()?, &b.polytope()?)
+}
+
+/// The signed distance a collision manager reports between two placed meshes, with a witness
+/// on each: see [`signed_distance`].
+#[derive(Debug, Clone, PartialEq)]
+pub struct Signed {
+    /// The gap between the surfaces when the meshes do not collide; `-depth` when they collide
+    /// and both are convex (the exact penetration depth); 0 when they collide otherwise (0 is
+    /// then an upper bound: the depth of non-convex parts is not computed).
+    pub distance: f64,
+    /// Triangle of A (-1 when none applies: a contained part with no meeting triangles) and a
+    /// point of A.
+    pub a: (i64, DVec3),
+    /// Triangle of B (or -1) and a point of B.
+    pub b: (i64, DVec3),
+    /// The penetration when both are convex and they collide.
+    pub penetration: Option<Penetration>,
+}
+
+/// The signed distance of two placed meshes: positive (the surfaces' minimum distance, as
+/// [`distance`]) when they do not collide ([`collide`]: no triangles meet, neither inside the
+/// other); never positive when they collide — `-depth` for convex meshes, 0 otherwise, so a part
+/// inside another never reports a gap. `None` when they do not collide and are farther apart
+/// than `bound`.
+pub fn signed_distance(a: &Placed, b: &Placed, bound: f64) -> Option<Signed> {
+    if a.bounds().overlaps(&b.bounds()) {
+        let c = collide(a, b, false);
+        if c.collides() {
+            return Some(colliding(a, b, &c));
+        }
+    }
+    distance(a, b, bound).map(|c| Signed {
+        distance: c.distance,
+        a: (c.a.0 as i64, c.a.1),
+        b: (c.b.0 as i64, c.b.1),
+        penetration: None,
+    })
+}
+
+fn colliding(a: &Placed, b: &Placed, c: &Collision) -> Signed {
+    let contact =
+        c.contacts.first().map(|p| (p.a as i64, p.b as i64, query::pair_witness(&a.mesh(), &b.mesh(), p)));
+    if let Some(p) = a.polytope().zip(b.polytope()).and_then(|(pa, pb)| convex::penetration(&pa, &pb)) {
+        let half = p.normal * (p.depth * 0.5);
+        let (fa, fb) = contact.as_ref().map_or((-1, -1), |c| (c.0, c.1));
+        return Signed {
+            distance: 0.0 - p.depth,
+            a: (fa, p.point + half),
+            b: (fb, p.point - half),
+            penetration: Some(p),
+        };
+    }
+    match contact {
+        Some((fa, fb, w)) => Signed { distance: 0.0, a: (fa, w.a.1), b: (fb, w.b.1), penetration: None },
+        None => {
+            // Containment: no triangles meet; the witness is the first vertex of the mesh
+            // (some of) whose components lie inside the other.
+            let inner = match c.containment {
+                Containment::BInA | Containment::BPartlyInA => b.positions()[0],
+                _ => a.positions()[0],
+            };
+            Signed { distance: 0.0, a: (-1, inner), b: (-1, inner), penetration: None }
+        }
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -431,5 +556,42 @@ mod tests {
         assert!(c.contacts.is_empty());
         assert_eq!(c.containment, Containment::BInA);
         assert_eq!(distance(&pbig, &small, f64::INFINITY).unwrap().distance, 1.0);
+    }
+
+    #[test]
+    fn signed_distance_is_never_positive_for_colliding_parts() {
+        let a = prepared(cube(DVec3::ZERO));
+        let at = |x: f64, y: f64, z: f64| a.place(DMat4::from_translation(DVec3::new(x, y, z))).unwrap();
+        let origin = at(0.0, 0.0, 0.0);
+        assert!(origin.is_convex());
+        // Coincident unit cubes: depth 1; overlapping by 0.25 along x: -0.25; apart: the gap.
+        let s = signed_distance(&origin, &at(0.0, 0.0, 0.0), f64::INFINITY).unwrap();
+        assert_eq!(s.distance, -1.0);
+        let s = signed_distance(&origin, &at(0.75, 0.0, 0.0), f64::INFINITY).unwrap();
+        assert_eq!(s.distance, -0.25);
+        assert_eq!((s.a.1 - s.b.1).length(), 0.25);
+        assert_eq!(signed_distance(&origin, &at(3.0, 0.0, 0.0), f64::INFINITY).unwrap().distance, 2.0);
+        assert_eq!(signed_distance(&origin, &at(1.0, 0.5, 0.0), f64::INFINITY).unwrap().distance, 0.0);
+        assert!(signed_distance(&origin, &at(3.0, 0.0, 0.0), 1.5).is_none());
+        // A unit cube inside a cube of side 4 (scaled: convexity decided on the world
+        // coordinates): the shortest way out is 1.5, through x = 0.
+        let big = a.place(DMat4::from_scale(DVec3::splat(4.0))).unwrap();
+        assert!(big.is_convex());
+        let s = signed_distance(&big, &at(0.5, 1.5, 1.25), f64::INFINITY).unwrap();
+        assert_eq!(s.distance, -1.5);
+        assert_eq!(penetration(&big, &at(0.5, 1.5, 1.25)).unwrap().normal, DVec3::new(-1.0, 0.0, 0.0));
+        // The same inside a non-convex part (the big cube and a far one in one mesh): no depth,
+        // but never the positive gap between the surfaces.
+        let mut two = cube(DVec3::ZERO);
+        two.positions.iter_mut().for_each(|p| *p *= 4.0);
+        let far = cube(DVec3::splat(10.0));
+        two.triangles.extend(far.triangles.iter().map(|t| t.map(|v| v + 8)));
+        two.positions.extend(far.positions);
+        two.tri_object = vec![0; two.triangles.len()];
+        let two = prepared(two).place(DMat4::IDENTITY).unwrap();
+        assert!(!two.is_convex());
+        let s = signed_distance(&two, &at(0.5, 1.5, 1.25), f64::INFINITY).unwrap();
+        assert_eq!((s.distance, s.penetration), (0.0, None));
+        assert!(penetration(&two, &at(0.5, 1.5, 1.25)).is_none());
     }
 }

@@ -30,6 +30,10 @@ __all__ = [
     "scene",
     "Mesh",
     "CollisionManager",
+    "CollisionObject",
+    "scene_to_collision",
+    "mesh_to_BVH",
+    "mesh_to_convex",
     "ContactData",
     "DistanceData",
     "__version__",
@@ -282,4 +286,12 @@ class Mesh:
         return f"meshclash.Mesh(name={self.name!r}, vertices={self.vertex_count}, faces={self.face_count})"
 
 
-from .collision import CollisionManager, ContactData, DistanceData  # noqa: E402
+from .collision import (  # noqa: E402
+    CollisionManager,
+    CollisionObject,
+    ContactData,
+    DistanceData,
+    mesh_to_BVH,
+    mesh_to_convex,
+    scene_to_collision,
+)

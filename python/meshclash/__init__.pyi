@@ -7,6 +7,10 @@ import numpy as np
 import numpy.typing as npt
 
 from .collision import CollisionManager as CollisionManager
+from .collision import CollisionObject as CollisionObject
+from .collision import mesh_to_BVH as mesh_to_BVH
+from .collision import mesh_to_convex as mesh_to_convex
+from .collision import scene_to_collision as scene_to_collision
 from .collision import ContactData as ContactData
 from .collision import DistanceData as DistanceData
 

@@ -10,21 +10,29 @@ Where FCL (python-fcl, behind trimesh) and meshclash disagree, meshclash is exac
 * **Touching counts as collision**, as in FCL, but always: FCL calls two exactly touching
   parts colliding or not depending on rounding (and on float32: trimesh casts transforms to
   float32); meshclash decides it exactly for the f64 coordinates.
-* **Containment counts as collision**, unlike FCL: a closed part entirely inside another closed
-  part (no triangles meet) collides here; FCL's BVH meshes are surfaces and say no. The contact
-  then has face index -1 and no point (``ContactData.point`` is None).
-* **Convex meshes are meshes**: trimesh hands convex meshes to FCL as convex solids (GJK), which
-  makes containment in a convex part a collision there; meshclash treats every mesh the same way
-  (surfaces, plus exact containment for closed ones).
-* **Distances** are between surfaces, in f64, with a witness on each: 0 with a shared point when
-  they meet; for a part inside another, the positive gap between their surfaces (FCL's distance
-  between overlapping meshes is 0 or negative with no witness).
-* ``ContactData.depth`` is 0.0 (no penetration depth is computed) and ``normal`` is the unit
-  normal of the contact's triangle on the second named object. With ``return_data`` every
-  meeting triangle pair of every colliding object pair is listed (sorted); FCL caps them.
+* **Containment counts as collision**, unlike FCL's BVH meshes: a closed part entirely inside
+  another closed part (no triangles meet) collides here. The contact then has face index -1.
+* **Convex parts**: trimesh hands convex meshes to FCL as convex solids (GJK/EPA, in floats);
+  meshclash decides convexity exactly (closed, facing out, every vertex on or below every
+  face's plane) and computes the exact penetration depth by the separating-axis theorem. A
+  colliding convex pair gives one contact: ``depth`` the exact depth, ``normal`` the unit
+  direction to move the second object by ``depth`` to separate them, ``point`` halfway along
+  the deepest penetration. A convex mesh placed by a rotation whose rounding bends its coplanar
+  triangles apart is not exactly convex any more and is treated as non-convex.
+* **Non-convex colliding parts**: one contact per meeting triangle pair (every pair, sorted;
+  FCL caps them), ``point`` on both triangles (the middle of their common segment), ``normal``
+  the unit normal of the second object's triangle, ``depth`` 0.0 (not computed: 0 is a lower
+  bound).
+* **Distances are signed**: the surfaces' minimum distance (f64, with a witness on each) when
+  nothing collides; when a pair collides (triangles meet or a part lies inside another), the
+  answer is that pair's signed distance, never positive: ``-depth`` when both are convex (as
+  FCL's signed distance), 0 otherwise. Like FCL, a distance query stops at the first colliding
+  pair it finds; here that is the first in insertion order (deterministic), not the deepest.
 """
 
 from __future__ import annotations
+
+import weakref
 
 import numpy as np
 
@@ -34,37 +42,42 @@ from . import _meshclash
 class ContactData:
     """One contact of two colliding objects (as ``trimesh.collision.ContactData``)."""
 
-    def __init__(self, names, faces, point, normal, kind="contact"):
+    def __init__(self, names, faces, point, normal, depth=0.0, kind="contact"):
         self.names = set(names)
         self._names = tuple(names)
         self._inds = {names[0]: faces[0], names[1]: faces[1]}
         self._point = None if point is None else np.array(point)
         self._normal = None if normal is None else np.array(normal)
+        self._depth = float(depth)
         self.kind = kind
 
     @property
     def normal(self):
-        """Unit normal of the contact triangle of the second named object (None for
-        containment)."""
+        """Convex pair: the unit direction to move the second named object by ``depth`` to
+        separate the two. Otherwise the unit normal of the contact triangle of the second named
+        object (None for containment)."""
         return self._normal
 
     @property
     def point(self):
-        """A point both triangles share (the middle of their common segment), or None for
-        containment."""
+        """Convex pair: halfway along the deepest penetration. Otherwise a point both triangles
+        share (the middle of their common segment), or None for containment."""
         return self._point
 
     @property
     def depth(self):
-        """Always 0.0: no penetration depth is computed."""
-        return 0.0
+        """Convex pair: the exact penetration depth. Otherwise 0.0 (not computed)."""
+        return self._depth
 
     def index(self, name):
-        """Index of the face in contact on object ``name`` (-1 for containment)."""
+        """Index of the face in contact on object ``name`` (-1 where none applies)."""
         return self._inds[name]
 
     def __repr__(self):
-        return f"ContactData(names={self._names}, faces={tuple(self._inds.values())}, kind={self.kind!r})"
+        return (
+            f"ContactData(names={self._names}, faces={tuple(self._inds.values())}, "
+            f"depth={self._depth!r}, kind={self.kind!r})"
+        )
 
 
 class DistanceData:
@@ -79,22 +92,54 @@ class DistanceData:
 
     @property
     def distance(self):
-        """The distance between the two objects' surfaces."""
+        """The signed distance: the gap between the surfaces, or ``-depth`` (convex) or 0
+        when the two collide."""
         return self._distance
 
     def index(self, name):
-        """Index of the closest face on object ``name``."""
+        """Index of the closest face on object ``name`` (-1 for a contained part)."""
         return self._inds[name]
 
     def point(self, name):
-        """The closest point on object ``name``."""
+        """The closest point on object ``name`` (colliding convex pair: the deepest points)."""
         return self._points[name]
+
+
+class CollisionObject:
+    """What :meth:`CollisionManager.add_object` returns (trimesh returns FCL's
+    ``CollisionObject``): the object's name, its prepared geometry and current transform."""
+
+    __slots__ = ("name", "geometry", "_transform")
+
+    def __init__(self, name, geometry, transform):
+        self.name = name
+        self.geometry = geometry
+        self._transform = transform
+
+    @property
+    def transform(self):
+        """The current 4x4 placement (f64)."""
+        return self._transform.copy()
+
+    def getTransform(self):  # noqa: N802 - FCL's spelling
+        """The current 4x4 placement, as ``fcl.CollisionObject.getTransform`` would give."""
+        return self.transform
+
+    def getTranslation(self):  # noqa: N802
+        return self._transform[:3, 3].copy()
+
+    def getRotation(self):  # noqa: N802
+        return self._transform[:3, :3].copy()
+
+    def __repr__(self):
+        return f"CollisionObject(name={self.name!r})"
 
 
 def _contacts(names, contacts, containment):
     if not contacts:
-        return [ContactData(names, (-1, -1), None, None, kind=containment or "containment")]
-    return [ContactData(names, (fa, fb), p, n) for fa, fb, p, n in contacts]
+        return [ContactData(names, (-1, -1), None, None, 0.0, kind=containment or "containment")]
+    kind = containment or "contact"
+    return [ContactData(names, (fa, fb), p, n, depth, kind=kind) for fa, fb, p, n, depth in contacts]
 
 
 def _matrix(transform):
@@ -106,16 +151,64 @@ def _matrix(transform):
     return m.tolist()
 
 
+# Prepared meshes of the trimesh objects queries were given, so that asking again with the
+# same mesh (a motion loop's in_collision_single) converts and prepares it once: id -> (weak
+# reference, content hash, native mesh). trimesh's hash(mesh) is a hash of its vertices and
+# faces, cached by trimesh until they change, so an edited mesh is prepared again.
+_PREPARED = {}
+_PREPARED_MAX = 64
+
+
 def _prepare(mesh):
     from . import Mesh
 
-    return Mesh.from_mesh(mesh)._native
+    if isinstance(mesh, Mesh):
+        return mesh._native
+    if isinstance(mesh, _meshclash.Mesh):
+        return mesh
+    try:
+        ref, key = weakref.ref(mesh), hash(mesh)
+    except TypeError:
+        return Mesh.from_mesh(mesh)._native
+    hit = _PREPARED.get(id(mesh))
+    if hit is not None and hit[0]() is mesh and hit[1] == key:
+        return hit[2]
+    native = Mesh.from_mesh(mesh)._native
+    if len(_PREPARED) >= _PREPARED_MAX:
+        _PREPARED.clear()
+    _PREPARED[id(mesh)] = (ref, key, native)
+    return native
 
 
 def _pack(result, extra, flags):
     """trimesh's return convention: the result, then each requested extra in order."""
     out = (result,) + tuple(x for x, f in zip(extra, flags) if f)
     return out if len(out) > 1 else result
+
+
+def mesh_to_BVH(mesh):  # noqa: N802 - trimesh's name
+    """trimesh's ``mesh_to_BVH`` equivalent: the mesh prepared once (validated, tree built), a
+    :class:`meshclash.Mesh` that ``add_object`` and ``in_collision_single`` accept as is."""
+    from . import Mesh
+
+    return Mesh.from_mesh(mesh)
+
+
+def mesh_to_convex(mesh):
+    """trimesh's ``mesh_to_convex`` equivalent: the same prepared mesh as :func:`mesh_to_BVH`
+    (convexity is decided exactly, per placement, where a depth needs it)."""
+    return mesh_to_BVH(mesh)
+
+
+def scene_to_collision(scene):
+    """trimesh's ``scene_to_collision``: a :class:`CollisionManager` holding every geometry
+    node of the trimesh ``scene`` under its world transform, and ``{node: CollisionObject}``."""
+    manager = CollisionManager()
+    objects = {}
+    for node in scene.graph.nodes_geometry:
+        transform, geometry = scene.graph[node]
+        objects[node] = manager.add_object(name=node, mesh=scene.geometry[geometry], transform=transform)
+    return manager, objects
 
 
 class CollisionManager:
@@ -133,10 +226,14 @@ class CollisionManager:
         """Add ``mesh`` (a trimesh.Trimesh, anything with ``vertices``/``faces``, a
         ``(vertices, faces)`` pair or a :class:`meshclash.Mesh`) as ``name``, placed by the 4x4
         ``transform`` (identity when None); an object of the same name is replaced. The
-        transform is applied in f64 (trimesh casts it to float32)."""
+        transform is applied in f64 (trimesh casts it to float32). Returns the
+        :class:`CollisionObject` (trimesh returns FCL's)."""
         native = _prepare(mesh)
-        self._native.add(name, native, _matrix(transform))
-        self._meshes[name] = native
+        m = _matrix(transform)
+        self._native.add(name, native, m)
+        obj = CollisionObject(name, native, np.eye(4) if m is None else np.array(m))
+        self._meshes[name] = obj
+        return obj
 
     def remove_object(self, name):
         """Delete object ``name``; ValueError if there is none."""
@@ -149,7 +246,9 @@ class CollisionManager:
         """Replace the transform of object ``name``."""
         if name not in self._meshes:
             raise ValueError(f"{name} not in collision manager!")
-        self._native.set_transform(name, _matrix(transform))
+        m = _matrix(transform)
+        self._native.set_transform(name, m)
+        self._meshes[name]._transform = np.array(m)
 
     def in_collision_single(self, mesh, transform=None, return_names=False, return_data=False):
         """Does ``mesh`` (placed by ``transform``) collide with any object of the manager?

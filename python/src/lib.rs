@@ -6,14 +6,17 @@ use glam::{DMat4, DVec3, DVec4};
 use meshclash::api::{self, Options, Placed, Prepared, Source, Tolerance};
 use meshclash::bvh::{BuildOptions, Strategy};
 use meshclash::check::assembly::Selection;
+use meshclash::check::containment::Containment;
 use meshclash::check::query::{Detail, DistanceError, Mode};
+use meshclash::geom::Aabb;
+use meshclash::prepared;
 use meshclash::Error;
 use numpy::{PyReadonlyArray2, PyUntypedArrayMethods};
-use pyo3::exceptions::{PyOSError, PyValueError};
+use pyo3::exceptions::{PyMemoryError, PyOSError, PyValueError};
 use pyo3::prelude::*;
 use rayon::prelude::*;
+use std::collections::HashMap;
 use std::path::{Path, PathBuf};
-use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::{Arc, Mutex};
 
 /// A library error as the Python exception the API documents: OSError for files that cannot be
@@ -84,12 +87,67 @@ fn triangles(label: &Path, f: &Bound<'_, PyAny>, vertices: usize) -> PyResult<Ve
     }
 }
 
+/// Peak bytes preparing a mesh takes per vertex and per triangle, measured with margin: the f64
+/// positions, the vertex merge's table, the tree and its build, the face copies.
+const BYTES_PER_VERTEX: u64 = 96;
+const BYTES_PER_TRIANGLE: u64 = 192;
+
+/// The memory this process may still allocate: the smaller of the address-space limit left
+/// (`RLIMIT_AS` from /proc/self/limits, minus the current size) and the system's available
+/// memory (/proc/meminfo). `None` where neither is known.
+fn memory_available() -> Option<u64> {
+    let field = |text: &str, key: &str| -> Option<u64> {
+        let line = text.lines().find(|l| l.starts_with(key))?;
+        line[key.len()..].split_whitespace().next()?.parse().ok()
+    };
+    let meminfo = std::fs::read_to_string("/proc/meminfo").ok();
+    let system = meminfo.as_deref().and_then(|t| field(t, "MemAvailable:")).map(|kb| kb * 1024);
+    let limits = std::fs::read_to_string("/proc/self/limits").ok();
+    let status = std::fs::read_to_string("/proc/self/status").ok();
+    let address_space = limits.as_deref().and_then(|t| field(t, "Max address space")).map(|limit| {
+        let used = status.as_deref().and_then(|t| field(t, "VmSize:")).unwrap_or(0) * 1024;
+        limit.saturating_sub(used)
+    });
+    match (system, address_space) {
+        (Some(a), Some(b)) => Some(a.min(b)),
+        (a, b) => a.or(b),
+    }
+}
+
+/// MemoryError, before anything is allocated, when preparing `vertices` and `triangles` would
+/// need more memory than the process may still allocate (an abort otherwise).
+fn check_memory(label: &Path, vertices: usize, triangles: usize) -> PyResult<()> {
+    let need = BYTES_PER_VERTEX
+        .saturating_mul(vertices as u64)
+        .saturating_add(BYTES_PER_TRIANGLE.saturating_mul(triangles as u64));
+    match memory_available() {
+        Some(free) if need > free => Err(PyMemoryError::new_err(format!(
+            "{}: {vertices} vertices and {triangles} triangles need about {} MB to prepare, more than \
+             the {} MB this process may still allocate",
+            label.display(),
+            need >> 20,
+            free >> 20
+        ))),
+        _ => Ok(()),
+    }
+}
+
+/// The number of rows of an (n, 3) array argument, if it is one (for the memory check).
+fn rows(x: &Bound<'_, PyAny>) -> usize {
+    x.getattr("shape")
+        .and_then(|s| s.extract::<Vec<usize>>())
+        .ok()
+        .and_then(|s| s.first().copied())
+        .unwrap_or(0)
+}
+
 fn mesh_from(
     label: &Path,
     name: &str,
     v: &Bound<'_, PyAny>,
     f: &Bound<'_, PyAny>,
 ) -> PyResult<meshclash::scene::mesh::Mesh> {
+    check_memory(label, rows(v), rows(f))?;
     let p = positions(label, v)?;
     let t = triangles(label, f, p.len())?;
     api::mesh_from_arrays(label, name, p, t).map_err(py_err)
@@ -416,8 +474,10 @@ fn transform_of(t: Option<Vec<Vec<f64>>>) -> PyResult<DMat4> {
     transform("transform", t)
 }
 
-/// One meeting triangle pair: (face, face, shared point, unit normal of the second face).
-type Contact = (u32, u32, [f64; 3], [f64; 3]);
+/// One contact: (face, face, point, unit normal, depth). Faces are -1 where none applies (a
+/// contained part); for a convex pair the one contact of the exact penetration, else one per
+/// meeting triangle pair (depth 0.0, the normal of the second triangle).
+type Contact = (i64, i64, [f64; 3], [f64; 3], f64);
 
 /// One colliding pair: (index in the first list, index in the second, contacts, containment
 /// name or None).
@@ -433,20 +493,21 @@ type Witness = (f64, [f64; 3], [f64; 3], u32, u32);
 type SingleHit = (String, Vec<Contact>, Option<&'static str>);
 
 /// The closest object to a single mesh: (distance, name, face, face, point, point).
-type SingleNear = (f64, String, u32, u32, [f64; 3], [f64; 3]);
+type SingleNear = (f64, String, i64, i64, [f64; 3], [f64; 3]);
 
 /// A closest pair by name: (distance, name, name, face, face, point, point).
-type NamedNear = (f64, String, String, u32, u32, [f64; 3], [f64; 3]);
+type NamedNear = (f64, String, String, i64, i64, [f64; 3], [f64; 3]);
 
-fn hit(i: usize, j: usize, a: &Placed, b: &Placed, all: bool) -> Option<Hit> {
-    let c = api::collide(a, b, all);
-    if !c.collides() {
-        return None;
+/// The contacts of a colliding pair (`c` from `collide`): the exact penetration as one contact
+/// when both are convex, else every meeting triangle pair found.
+fn contacts(a: &Placed, b: &Placed, c: &api::Collision) -> Vec<Contact> {
+    let first = c.contacts.first().map_or((-1, -1), |p| (p.a as i64, p.b as i64));
+    if let Some(p) = prepared::penetration(a, b) {
+        return vec![(first.0, first.1, p.point.to_array(), p.normal.to_array(), p.depth)];
     }
     let mb = b.positions();
     let tris = &b.prepared.mesh.triangles;
-    let contacts = c
-        .contacts
+    c.contacts
         .iter()
         .map(|p| {
             let point = match p.segment {
@@ -455,98 +516,176 @@ fn hit(i: usize, j: usize, a: &Placed, b: &Placed, all: bool) -> Option<Hit> {
             };
             let [x, y, z] = tris[p.b as usize].map(|v| mb[v as usize]);
             let n = (y - x).cross(z - x).normalize_or_zero();
-            (p.a, p.b, point.to_array(), n.to_array())
+            (p.a as i64, p.b as i64, point.to_array(), n.to_array(), 0.0)
         })
-        .collect();
-    Some((i, j, contacts, c.containment.name()))
+        .collect()
 }
 
-/// Exact collision of every candidate pair `(i, j)` (boxes meet); `stop_at_first` ends the
-/// search at the first colliding pair found (a yes/no question). Sorted by (i, j).
+/// Exact collision of every candidate pair `(i, j)` (boxes meet), sorted by (i, j). With
+/// `stop_at_first` (a yes/no question) the answer is the first colliding pair in (i, j) order:
+/// meeting triangles are looked for in every pair first (a crossing settles it), containment
+/// only when no pair has any.
 fn collide_pairs(
-    pairs: Vec<(usize, usize)>,
+    pairs: &[(usize, usize)],
     a: &[Arc<Placed>],
     b: &[Arc<Placed>],
-    all: bool,
+    data: bool,
     stop_at_first: bool,
 ) -> Vec<Hit> {
-    let stop = AtomicBool::new(false);
-    let mut hits: Vec<Hit> = pairs
-        .into_par_iter()
-        .filter_map(|(i, j)| {
-            if stop.load(Ordering::Relaxed) {
-                return None;
-            }
-            let h = hit(i, j, &a[i], &b[j], all);
-            if h.is_some() && stop_at_first {
-                stop.store(true, Ordering::Relaxed);
-            }
-            h
-        })
+    let hit = |&(i, j): &(usize, usize), c: api::Collision| -> Option<Hit> {
+        if !c.collides() {
+            return None;
+        }
+        let cs = if data { contacts(&a[i], &b[j], &api::collide(&a[i], &b[j], true)) } else { Vec::new() };
+        Some((i, j, cs, c.containment.name()))
+    };
+    if stop_at_first {
+        let meet = |p: &(usize, usize)| {
+            let (x, y) = (&a[p.0], &b[p.1]);
+            let m = api::meeting_pairs(&x.mesh(), &x.tree(), &y.mesh(), &y.tree(), true);
+            (!m.is_empty()).then(|| hit(p, api::Collision { contacts: m, containment: Containment::None }))?
+        };
+        let found = if pairs.len() <= SEQUENTIAL_PAIRS {
+            pairs.iter().find_map(meet)
+        } else {
+            pairs.par_iter().find_map_first(meet)
+        };
+        if let Some(h) = found {
+            return vec![h];
+        }
+        let contained = |p: &(usize, usize)| hit(p, api::collide(&a[p.0], &b[p.1], false));
+        return if pairs.len() <= SEQUENTIAL_PAIRS {
+            pairs.iter().find_map(contained)
+        } else {
+            pairs.par_iter().find_map_first(contained)
+        }
+        .into_iter()
         .collect();
-    hits.sort_by_key(|h| (h.0, h.1));
-    hits
-}
-
-/// Candidate pairs whose world boxes meet (closed boxes: touching boxes count).
-#[allow(clippy::needless_range_loop)]
-fn box_pairs(a: &[Arc<Placed>], b: Option<&[Arc<Placed>]>) -> Vec<(usize, usize)> {
-    let mut out = Vec::new();
-    match b {
-        None => {
-            for i in 0..a.len() {
-                for j in i + 1..a.len() {
-                    if a[i].bounds().overlaps(&a[j].bounds()) {
-                        out.push((i, j));
-                    }
-                }
-            }
-        }
-        Some(b) => {
-            for i in 0..a.len() {
-                for j in 0..b.len() {
-                    if a[i].bounds().overlaps(&b[j].bounds()) {
-                        out.push((i, j));
-                    }
-                }
-            }
-        }
     }
-    out
+    let run = |p: &(usize, usize)| hit(p, api::collide(&a[p.0], &b[p.1], false));
+    if pairs.len() <= SEQUENTIAL_PAIRS {
+        pairs.iter().filter_map(run).collect()
+    } else {
+        pairs.par_iter().filter_map(run).collect()
+    }
 }
 
-/// The closest pair over candidate object pairs: (distance, i, j, face i, face j, point i,
-/// point j); ties broken by (i, j). Pairs whose boxes are farther apart than the best distance
-/// so far are skipped.
-type Near = (f64, usize, usize, u32, u32, [f64; 3], [f64; 3]);
+/// Up to this many candidate object pairs, a query runs them on the calling thread (waking the
+/// pool costs more than a few exact checks; a speed threshold, no answer depends on it).
+const SEQUENTIAL_PAIRS: usize = 8;
+
+/// The closest pair over candidate object pairs: (signed distance, i, j, face i, face j, point
+/// i, point j). When some pair with meeting boxes collides, the first colliding pair in (i, j)
+/// order, with its signed distance (<= 0); otherwise the smallest gap, ties broken by (i, j),
+/// pairs whose boxes are farther apart than the best gap so far skipped.
+type Near = (f64, usize, usize, i64, i64, [f64; 3], [f64; 3]);
+
+fn near(d: prepared::Signed, i: usize, j: usize) -> Near {
+    (d.distance, i, j, d.a.0, d.b.0, d.a.1.to_array(), d.b.1.to_array())
+}
 
 fn nearest(pairs: Vec<(usize, usize)>, a: &[Arc<Placed>], b: &[Arc<Placed>]) -> Option<Near> {
+    let overlapping: Vec<(usize, usize)> =
+        pairs.iter().copied().filter(|&(i, j)| a[i].bounds().overlaps(&b[j].bounds())).collect();
+    let colliding = |&(i, j): &(usize, usize)| {
+        let c = api::collide(&a[i], &b[j], false);
+        c.collides().then(|| near(prepared::signed_distance(&a[i], &b[j], 0.0).expect("colliding"), i, j))
+    };
+    let first = if overlapping.len() <= SEQUENTIAL_PAIRS {
+        overlapping.iter().find_map(colliding)
+    } else {
+        overlapping.par_iter().find_map_first(colliding)
+    };
+    if first.is_some() {
+        return first;
+    }
     let key = |x: &(f64, usize, usize), y: &(f64, usize, usize)| {
         x.0.total_cmp(&y.0).then((x.1, x.2).cmp(&(y.1, y.2)))
     };
     let mut by_bound: Vec<(f64, usize, usize)> =
         pairs.into_iter().map(|(i, j)| (a[i].bounds().distance_sq(&b[j].bounds()).sqrt(), i, j)).collect();
+    // Only pairs whose box distance is at most the smallest box pair's true distance can win.
+    let (_, i0, j0) = *by_bound.iter().min_by(|x, y| key(x, y))?;
+    let cap = api::distance(&a[i0], &b[j0], f64::INFINITY).map_or(f64::INFINITY, |c| c.distance);
+    by_bound.retain(|x| x.0 <= cap);
     by_bound.sort_by(key);
     // The best (distance, i, j) so far: a pair can only beat it if its (lower bound, i, j)
     // comes first, so the answer (smallest distance, then smallest (i, j)) does not depend on
     // the order the threads finish in.
     let best = Mutex::new((f64::INFINITY, usize::MAX, usize::MAX));
-    let found: Vec<Near> = by_bound
-        .par_iter()
-        .filter_map(|&(lb, i, j)| {
-            let bound = *best.lock().unwrap();
-            if key(&(lb, i, j), &bound).is_gt() {
-                return None;
-            }
-            let c = api::distance(&a[i], &b[j], bound.0)?;
-            let mut g = best.lock().unwrap();
-            if key(&(c.distance, i, j), &g).is_lt() {
-                *g = (c.distance, i, j);
-            }
-            Some((c.distance, i, j, c.a.0, c.b.0, c.a.1.to_array(), c.b.1.to_array()))
-        })
-        .collect();
+    let eval = |&(lb, i, j): &(f64, usize, usize)| {
+        let bound = *best.lock().unwrap();
+        if key(&(lb, i, j), &bound).is_gt() {
+            return None;
+        }
+        let c = prepared::signed_distance(&a[i], &b[j], bound.0)?;
+        let mut g = best.lock().unwrap();
+        if key(&(c.distance, i, j), &g).is_lt() {
+            *g = (c.distance, i, j);
+        }
+        Some(near(c, i, j))
+    };
+    let found: Vec<Near> = if by_bound.len() <= SEQUENTIAL_PAIRS {
+        by_bound.iter().filter_map(eval).collect()
+    } else {
+        by_bound.par_iter().filter_map(eval).collect()
+    };
     found.into_iter().min_by(|x, y| key(&(x.0, x.1, x.2), &(y.0, y.1, y.2)))
+}
+
+/// A sweep-and-prune broad phase over the objects' world boxes, kept across queries: the
+/// objects sorted by their boxes' lower x, updated when one is added, moved or removed.
+#[derive(Default)]
+struct Sweep {
+    /// (box min x, object index), ascending.
+    order: Vec<(f64, usize)>,
+}
+
+impl Sweep {
+    fn insert(&mut self, i: usize, b: &Aabb) {
+        let k = (b.min.x, i);
+        let at = self.order.partition_point(|x| x.0.total_cmp(&k.0).then(x.1.cmp(&k.1)).is_lt());
+        self.order.insert(at, k);
+    }
+    fn remove(&mut self, i: usize, b: &Aabb) {
+        let k = (b.min.x, i);
+        let at = self.order.partition_point(|x| x.0.total_cmp(&k.0).then(x.1.cmp(&k.1)).is_lt());
+        debug_assert_eq!(self.order[at].1, i);
+        self.order.remove(at);
+    }
+    /// After removing object `i`: the indices above it move down by one.
+    fn renumber_after(&mut self, i: usize) {
+        for x in &mut self.order {
+            if x.1 > i {
+                x.1 -= 1;
+            }
+        }
+    }
+    /// Every pair (i < j) whose boxes meet (closed boxes), sorted.
+    fn pairs(&self, objs: &[Arc<Placed>]) -> Vec<(usize, usize)> {
+        let mut out = Vec::new();
+        for (k, &(_, i)) in self.order.iter().enumerate() {
+            let bi = objs[i].bounds();
+            for &(min_x, j) in &self.order[k + 1..] {
+                if min_x > bi.max.x {
+                    break;
+                }
+                if bi.overlaps(&objs[j].bounds()) {
+                    out.push((i.min(j), i.max(j)));
+                }
+            }
+        }
+        out.sort_unstable();
+        out
+    }
+    /// The objects whose boxes meet `q`, ascending.
+    fn against(&self, objs: &[Arc<Placed>], q: &Aabb) -> Vec<usize> {
+        let end = self.order.partition_point(|x| x.0 <= q.max.x);
+        let mut out: Vec<usize> =
+            self.order[..end].iter().map(|x| x.1).filter(|&i| objs[i].bounds().overlaps(q)).collect();
+        out.sort_unstable();
+        out
+    }
 }
 
 /// The native collision manager (`meshclash.CollisionManager` wraps it with trimesh's
@@ -555,15 +694,34 @@ fn nearest(pairs: Vec<(usize, usize)>, a: &[Arc<Placed>], b: &[Arc<Placed>]) -> 
 #[derive(Default)]
 struct Manager {
     names: Vec<String>,
+    index: HashMap<String, usize>,
     objs: Vec<Arc<Placed>>,
+    sweep: Sweep,
 }
 
 impl Manager {
     fn find(&self, name: &str) -> PyResult<usize> {
-        self.names
-            .iter()
-            .position(|n| n == name)
+        self.index
+            .get(name)
+            .copied()
             .ok_or_else(|| PyValueError::new_err(format!("{name} not in collision manager!")))
+    }
+
+    fn set(&mut self, i: usize, placed: Arc<Placed>) {
+        self.sweep.remove(i, &self.objs[i].bounds());
+        self.sweep.insert(i, &placed.bounds());
+        self.objs[i] = placed;
+    }
+
+    /// Pairs (ours, theirs) whose boxes meet, sorted.
+    fn pairs_with(&self, other: &[Arc<Placed>]) -> Vec<(usize, usize)> {
+        let mut out: Vec<(usize, usize)> = other
+            .iter()
+            .enumerate()
+            .flat_map(|(j, o)| self.sweep.against(&self.objs, &o.bounds()).into_iter().map(move |i| (i, j)))
+            .collect();
+        out.sort_unstable();
+        out
     }
 }
 
@@ -589,9 +747,12 @@ impl Manager {
         transform: Option<Vec<Vec<f64>>>,
     ) -> PyResult<()> {
         let placed = place(py, &mesh.inner, transform_of(transform)?)?;
-        match self.names.iter().position(|n| *n == name) {
-            Some(i) => self.objs[i] = placed,
+        match self.index.get(&name) {
+            Some(&i) => self.set(i, placed),
             None => {
+                let i = self.objs.len();
+                self.sweep.insert(i, &placed.bounds());
+                self.index.insert(name.clone(), i);
                 self.names.push(name);
                 self.objs.push(placed);
             }
@@ -601,15 +762,19 @@ impl Manager {
 
     fn remove(&mut self, name: &str) -> PyResult<()> {
         let i = self.find(name)?;
+        self.sweep.remove(i, &self.objs[i].bounds());
+        self.sweep.renumber_after(i);
         self.names.remove(i);
         self.objs.remove(i);
+        self.index = self.names.iter().enumerate().map(|(k, n)| (n.clone(), k)).collect();
         Ok(())
     }
 
     fn set_transform(&mut self, py: Python<'_>, name: &str, transform: Vec<Vec<f64>>) -> PyResult<()> {
         let i = self.find(name)?;
         let p = self.objs[i].prepared.clone();
-        self.objs[i] = place(py, &p, transform_of(Some(transform))?)?;
+        let placed = place(py, &p, transform_of(Some(transform))?)?;
+        self.set(i, placed);
         Ok(())
     }
 
@@ -618,9 +783,10 @@ impl Manager {
     }
 
     /// Colliding pairs among the objects: (name, name, contacts, containment).
-    fn collide_internal(&self, py: Python<'_>, all: bool, stop_at_first: bool) -> Vec<NamedHit> {
-        let objs = self.objs.clone();
-        let hits = py.detach(move || collide_pairs(box_pairs(&objs, None), &objs, &objs, all, stop_at_first));
+    fn collide_internal(&self, py: Python<'_>, data: bool, stop_at_first: bool) -> Vec<NamedHit> {
+        let pairs = self.sweep.pairs(&self.objs);
+        let objs = &self.objs;
+        let hits = py.detach(|| collide_pairs(&pairs, objs, objs, data, stop_at_first));
         hits.into_iter().map(|(i, j, c, k)| (self.names[i].clone(), self.names[j].clone(), c, k)).collect()
     }
 
@@ -629,36 +795,37 @@ impl Manager {
         &self,
         py: Python<'_>,
         other: PyRef<'_, Manager>,
-        all: bool,
+        data: bool,
         stop_at_first: bool,
     ) -> Vec<NamedHit> {
-        let (a, b) = (self.objs.clone(), other.objs.clone());
-        let hits = py.detach(move || collide_pairs(box_pairs(&a, Some(&b)), &a, &b, all, stop_at_first));
+        let pairs = self.pairs_with(&other.objs);
+        let (a, b) = (&self.objs, &other.objs);
+        let hits = py.detach(|| collide_pairs(&pairs, a, b, data, stop_at_first));
         hits.into_iter().map(|(i, j, c, k)| (self.names[i].clone(), other.names[j].clone(), c, k)).collect()
     }
 
     /// Our objects colliding with `mesh` placed by `transform`: (name, contacts with the
     /// manager's face first, containment).
-    #[pyo3(signature = (mesh, transform, all, stop_at_first))]
+    #[pyo3(signature = (mesh, transform, data, stop_at_first))]
     fn collide_single(
         &self,
         py: Python<'_>,
         mesh: PyRef<'_, Mesh>,
         transform: Option<Vec<Vec<f64>>>,
-        all: bool,
+        data: bool,
         stop_at_first: bool,
     ) -> PyResult<Vec<SingleHit>> {
         let single = vec![place(py, &mesh.inner, transform_of(transform)?)?];
-        let a = self.objs.clone();
-        let hits =
-            py.detach(move || collide_pairs(box_pairs(&a, Some(&single)), &a, &single, all, stop_at_first));
+        let pairs = self.pairs_with(&single);
+        let a = &self.objs;
+        let hits = py.detach(|| collide_pairs(&pairs, a, &single, data, stop_at_first));
         Ok(hits.into_iter().map(|(i, _, c, k)| (self.names[i].clone(), c, k)).collect())
     }
 
     /// The closest pair among our objects (or between `name` and the others).
     #[pyo3(signature = (name=None))]
     fn distance_internal(&self, py: Python<'_>, name: Option<String>) -> PyResult<Option<NamedNear>> {
-        let objs = self.objs.clone();
+        let objs = &self.objs;
         let pairs: Vec<(usize, usize)> = match &name {
             None => (0..objs.len()).flat_map(|i| (i + 1..objs.len()).map(move |j| (i, j))).collect(),
             Some(n) => {
@@ -666,17 +833,17 @@ impl Manager {
                 (0..objs.len()).filter(|&j| j != k).map(|j| (k, j)).collect()
             }
         };
-        let near = py.detach(move || nearest(pairs, &objs, &objs));
+        let near = py.detach(|| nearest(pairs, objs, objs));
         Ok(near.map(|(d, i, j, fi, fj, pi, pj)| {
             (d, self.names[i].clone(), self.names[j].clone(), fi, fj, pi, pj)
         }))
     }
 
     fn distance_other(&self, py: Python<'_>, other: PyRef<'_, Manager>) -> Option<NamedNear> {
-        let (a, b) = (self.objs.clone(), other.objs.clone());
+        let (a, b) = (&self.objs, &other.objs);
         let pairs: Vec<(usize, usize)> =
             (0..a.len()).flat_map(|i| (0..b.len()).map(move |j| (i, j))).collect();
-        let near = py.detach(move || nearest(pairs, &a, &b));
+        let near = py.detach(|| nearest(pairs, a, b));
         near.map(|(d, i, j, fi, fj, pi, pj)| {
             (d, self.names[i].clone(), other.names[j].clone(), fi, fj, pi, pj)
         })
@@ -690,9 +857,9 @@ impl Manager {
         transform: Option<Vec<Vec<f64>>>,
     ) -> PyResult<Option<SingleNear>> {
         let single = vec![place(py, &mesh.inner, transform_of(transform)?)?];
-        let a = self.objs.clone();
+        let a = &self.objs;
         let pairs: Vec<(usize, usize)> = (0..a.len()).map(|i| (i, 0)).collect();
-        let near = py.detach(move || nearest(pairs, &a, &single));
+        let near = py.detach(|| nearest(pairs, a, &single));
         Ok(near.map(|(d, i, _, fi, fj, pi, pj)| (d, self.names[i].clone(), fi, fj, pi, pj)))
     }
 }

@@ -33,9 +33,12 @@ def test_internal_collisions_names_and_data():
     for c in data:
         (x, y) = sorted(c.names)
         assert 0 <= c.index(x) < 12 and 0 <= c.index(y) < 12
-        assert c.point.shape == (3,) and abs(np.linalg.norm(c.normal) - 1) < 1e-12 and c.depth == 0.0
+        assert c.point.shape == (3,) and abs(np.linalg.norm(c.normal) - 1) < 1e-12
+    # Convex pairs: one contact each, with the exact depth (a and b overlap by 0.5 along every
+    # axis; c and d touch).
+    assert sorted(c.depth for c in data) == [0.0, 0.5]
     hit, data = m.in_collision_internal(return_data=True)
-    assert hit and len(data) > 2
+    assert hit and len(data) == 2
     m.set_transform("d", at(np.nextafter(6.0, 7.0)))
     assert m.in_collision_internal(return_names=True)[1] == {("a", "b")}
     m.remove_object("b")
@@ -48,9 +51,16 @@ def test_containment_is_a_collision():
     m = manager(big=(big, None), small=(CUBE, None))
     hit, names, data = m.in_collision_internal(return_names=True, return_data=True)
     assert hit and names == {("big", "small")}
-    assert len(data) == 1 and data[0].point is None and data[0].index("big") == -1
+    # Both convex: the contact is the exact penetration (out through x, y or z = 5: depth 5),
+    # with no meeting triangles (face -1).
+    assert len(data) == 1 and data[0].depth == 5.0 and data[0].index("big") == -1
     assert data[0].kind == "a_in_b" or data[0].kind == "b_in_a"
-    assert m.min_distance_internal() == 4.0
+    assert m.min_distance_internal() == -5.0
+    # Non-convex container: the contact has no point, the distance is 0 (never the gap).
+    m.add_object("big", l_prism(scale=10.0, at=(-1.0, -1.0, -1.0)))
+    hit, data = m.in_collision_internal(return_data=True)
+    assert hit and len(data) == 1 and data[0].point is None and data[0].depth == 0.0
+    assert m.min_distance_internal() == 0.0
 
 
 def test_single_and_other():

@@ -3,6 +3,7 @@
 //! and point–triangle distances; [`exact_distance`] the exact distance where a threshold or a
 //! reported figure needs it.
 
+pub mod convex;
 pub mod distance;
 pub mod exact_distance;
 pub mod tri_tri;

@@ -1,0 +1,221 @@
+//! Exact dyadic rationals `m · 2^e` (`m` an integer of any size): every finite f64 is one, and
+//! sums, differences and products of them are computed without rounding. Used by the convex
+//! penetration depth for the few comparisons its float filter cannot decide; small and slow on
+//! purpose (schoolbook multiplication on base-2^32 limbs).
+
+use std::cmp::Ordering;
+
+/// `(-1)^neg · mag · 2^exp`, `mag` little-endian base-2^32 limbs without trailing zero limbs
+/// (zero is the empty magnitude, never negative).
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct Dyadic {
+    neg: bool,
+    mag: Vec<u32>,
+    exp: i64,
+}
+
+fn trim(mut m: Vec<u32>) -> Vec<u32> {
+    while m.last() == Some(&0) {
+        m.pop();
+    }
+    m
+}
+
+fn cmp_mag(a: &[u32], b: &[u32]) -> Ordering {
+    a.len().cmp(&b.len()).then_with(|| a.iter().rev().cmp(b.iter().rev()))
+}
+
+fn add_mag(a: &[u32], b: &[u32]) -> Vec<u32> {
+    let (long, short) = if a.len() >= b.len() { (a, b) } else { (b, a) };
+    let mut out = Vec::with_capacity(long.len() + 1);
+    let mut carry = 0u64;
+    for (i, &x) in long.iter().enumerate() {
+        let s = x as u64 + short.get(i).copied().unwrap_or(0) as u64 + carry;
+        out.push(s as u32);
+        carry = s >> 32;
+    }
+    if carry > 0 {
+        out.push(carry as u32);
+    }
+    out
+}
+
+/// `a - b` for `|a| >= |b|`.
+fn sub_mag(a: &[u32], b: &[u32]) -> Vec<u32> {
+    let mut out = Vec::with_capacity(a.len());
+    let mut borrow = 0i64;
+    for (i, &x) in a.iter().enumerate() {
+        let mut d = x as i64 - b.get(i).copied().unwrap_or(0) as i64 - borrow;
+        borrow = (d < 0) as i64;
+        if d < 0 {
+            d += 1 << 32;
+        }
+        out.push(d as u32);
+    }
+    trim(out)
+}
+
+fn mul_mag(a: &[u32], b: &[u32]) -> Vec<u32> {
+    if a.is_empty() || b.is_empty() {
+        return Vec::new();
+    }
+    let mut out = vec![0u32; a.len() + b.len()];
+    for (i, &x) in a.iter().enumerate() {
+        let mut carry = 0u64;
+        for (j, &y) in b.iter().enumerate() {
+            let t = out[i + j] as u64 + x as u64 * y as u64 + carry;
+            out[i + j] = t as u32;
+            carry = t >> 32;
+        }
+        out[i + b.len()] = carry as u32;
+    }
+    trim(out)
+}
+
+fn shl_mag(a: &[u32], bits: u64) -> Vec<u32> {
+    if a.is_empty() {
+        return Vec::new();
+    }
+    let (limbs, rem) = ((bits / 32) as usize, (bits % 32) as u32);
+    let mut out = vec![0u32; limbs];
+    if rem == 0 {
+        out.extend_from_slice(a);
+    } else {
+        let mut carry = 0u32;
+        for &x in a {
+            out.push((x << rem) | carry);
+            carry = x >> (32 - rem);
+        }
+        out.push(carry);
+    }
+    trim(out)
+}
+
+impl Dyadic {
+    /// Zero.
+    pub fn zero() -> Dyadic {
+        Dyadic { neg: false, mag: Vec::new(), exp: 0 }
+    }
+
+    /// The exact value of a finite `x` (panics on infinities and NaN: callers pass checked
+    /// coordinates).
+    pub fn from_f64(x: f64) -> Dyadic {
+        assert!(x.is_finite(), "exact arithmetic on a non-finite value");
+        let bits = x.to_bits();
+        let neg = bits >> 63 == 1;
+        let biased = ((bits >> 52) & 0x7ff) as i64;
+        let frac = bits & ((1u64 << 52) - 1);
+        let (m, e) = if biased == 0 { (frac, -1074) } else { (frac | (1u64 << 52), biased - 1075) };
+        if m == 0 {
+            return Dyadic::zero();
+        }
+        Dyadic { neg, mag: trim(vec![m as u32, (m >> 32) as u32]), exp: e }
+    }
+
+    /// -1, 0 or 1.
+    pub fn signum(&self) -> i8 {
+        if self.mag.is_empty() {
+            0
+        } else if self.neg {
+            -1
+        } else {
+            1
+        }
+    }
+
+    /// `-self`.
+    pub fn neg(&self) -> Dyadic {
+        Dyadic { neg: !self.neg && !self.mag.is_empty(), mag: self.mag.clone(), exp: self.exp }
+    }
+
+    /// `self + other`, exactly.
+    pub fn add(&self, other: &Dyadic) -> Dyadic {
+        if self.mag.is_empty() {
+            return other.clone();
+        }
+        if other.mag.is_empty() {
+            return self.clone();
+        }
+        let exp = self.exp.min(other.exp);
+        let a = shl_mag(&self.mag, (self.exp - exp) as u64);
+        let b = shl_mag(&other.mag, (other.exp - exp) as u64);
+        if self.neg == other.neg {
+            return Dyadic { neg: self.neg, mag: add_mag(&a, &b), exp };
+        }
+        match cmp_mag(&a, &b) {
+            Ordering::Equal => Dyadic::zero(),
+            Ordering::Greater => Dyadic { neg: self.neg, mag: sub_mag(&a, &b), exp },
+            Ordering::Less => Dyadic { neg: other.neg, mag: sub_mag(&b, &a), exp },
+        }
+    }
+
+    /// `self - other`, exactly.
+    pub fn sub(&self, other: &Dyadic) -> Dyadic {
+        self.add(&other.neg())
+    }
+
+    /// `self · other`, exactly.
+    pub fn mul(&self, other: &Dyadic) -> Dyadic {
+        let mag = mul_mag(&self.mag, &other.mag);
+        if mag.is_empty() {
+            return Dyadic::zero();
+        }
+        Dyadic { neg: self.neg != other.neg, mag, exp: self.exp + other.exp }
+    }
+
+    /// The exact order of two values.
+    pub fn cmp(&self, other: &Dyadic) -> Ordering {
+        self.sub(other).signum().cmp(&0)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use num_bigint::BigInt;
+    use num_rational::BigRational;
+    use proptest::prelude::*;
+
+    fn rational(d: &Dyadic) -> BigRational {
+        let mut m = BigInt::from(0);
+        for &l in d.mag.iter().rev() {
+            m = (m << 32) + BigInt::from(l);
+        }
+        if d.neg {
+            m = -m;
+        }
+        if d.exp >= 0 {
+            BigRational::from_integer(m << d.exp as usize)
+        } else {
+            BigRational::new(m, BigInt::from(1) << (-d.exp) as usize)
+        }
+    }
+
+    fn exact(x: f64) -> BigRational {
+        BigRational::from_float(x).unwrap()
+    }
+
+    proptest! {
+        #[test]
+        fn arithmetic_matches_rationals(
+            a in prop_oneof![any::<f64>().prop_filter("finite", |x| x.is_finite()), -8.0..8.0f64],
+            b in prop_oneof![any::<f64>().prop_filter("finite", |x| x.is_finite()), -8.0..8.0f64, Just(0.0)],
+        ) {
+            let (da, db) = (Dyadic::from_f64(a), Dyadic::from_f64(b));
+            prop_assert_eq!(rational(&da), exact(a));
+            prop_assert_eq!(rational(&da.add(&db)), exact(a) + exact(b));
+            prop_assert_eq!(rational(&da.sub(&db)), exact(a) - exact(b));
+            prop_assert_eq!(rational(&da.mul(&db)), exact(a) * exact(b));
+            prop_assert_eq!(da.cmp(&db), a.partial_cmp(&b).unwrap());
+        }
+    }
+
+    #[test]
+    fn cancellation_and_subnormals_are_exact() {
+        let tiny = f64::from_bits(1);
+        let d = Dyadic::from_f64(1.0).add(&Dyadic::from_f64(tiny)).sub(&Dyadic::from_f64(1.0));
+        assert_eq!(d, Dyadic::from_f64(tiny));
+        assert_eq!(Dyadic::from_f64(0.1).sub(&Dyadic::from_f64(0.1)).signum(), 0);
+        assert_eq!(Dyadic::from_f64(-0.0).signum(), 0);
+    }
+}
