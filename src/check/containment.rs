@@ -834,6 +834,33 @@ mod tests {
         assert_eq!(inside(DVec3::splat(1e8 + 0.5), &f), Inside::Yes);
     }
 
+    /// Weighted points whose value is a short binary fraction (so the f64 point is exact) get
+    /// the answers of the f64 point: on a triangle or not, and inside the cube or not.
+    #[test]
+    fn weighted_points_agree_with_their_exact_f64_value() {
+        let c = cube(DVec3::ZERO, DVec3::ONE);
+        let tree = Bvh::build(&c, BuildOptions::default());
+        let tris = [
+            [DVec3::new(-0.5, 0.25, 0.5), DVec3::new(1.5, 0.25, 0.5), DVec3::new(0.5, 0.25, 1.5)],
+            [DVec3::new(0.0, 0.0, 0.0), DVec3::new(1.0, 0.0, 0.0), DVec3::new(0.0, 1.0, 0.0)],
+            [DVec3::new(0.5, -1.0, 0.25), DVec3::new(0.5, 2.0, 0.75), DVec3::new(0.5, 0.5, 3.0)],
+        ];
+        for t in tris {
+            for w in [[1, 1, 2], [2, 1, 1], [1, 2, 1], [5, 2, 1], [1, 1, 6], [3, 4, 1]] {
+                let sum = (w[0] + w[1] + w[2]) as f64;
+                let p = (t[0] * w[0] as f64 + t[1] * w[1] as f64 + t[2] * w[2] as f64) / sum;
+                let x = Weighted { t, w };
+                for g in (0..12).map(|k| c.triangle(k)) {
+                    let on = crate::narrow::tri_tri::classify(&[p, p, p], &g).is_some();
+                    assert_eq!(x.on_triangle(&g), on, "{t:?} {w:?} {g:?}");
+                }
+                if !on_surface(p, &c, &tree) {
+                    assert_eq!(parity(&x, Aabb::of_triangle(&t), &c, &tree), inside(p, &c), "{t:?} {w:?}");
+                }
+            }
+        }
+    }
+
     #[test]
     fn box_in_box_both_ways() {
         let outer = cube(DVec3::ZERO, DVec3::splat(10.0));
