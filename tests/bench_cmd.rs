@@ -1,4 +1,4 @@
-//! `meshclash bench` after the harness moved to the `meshclash-bench` crate (issue 13): the
+//! `meshclash bench` after the harness moved to the `meshclash-bench` crate: the
 //! subcommand forwards its arguments to a `meshclash-bench` next to the executable, and without
 //! one says how to run it (exit 2). The harness's own tests are in `bench/tests/`.
 

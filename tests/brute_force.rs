@@ -5,7 +5,7 @@ use meshclash::bvh::{BuildOptions, Strategy as Split};
 use meshclash::check::query::{check, PairKind, Settings};
 use meshclash::geom::predicates::Tolerances;
 use meshclash::geom::DVec3;
-use meshclash::narrow::distance::triangle_distance;
+use meshclash::narrow::exact_distance::exact_distance_sq;
 use meshclash::narrow::tri_tri::classify;
 use meshclash::scene::mesh::{Mesh, Object};
 use proptest::prelude::*;
@@ -50,7 +50,8 @@ fn brute(a: &[[DVec3; 3]], b: &[[DVec3; 3]]) -> Brute {
                     pairs.push((i as u32, j as u32, h.crossing));
                     min = 0.0;
                 }
-                None => min = min.min(triangle_distance(ta, tb).distance),
+                // The exact distance, correctly rounded (what the reported minimum is).
+                None => min = min.min(exact_distance_sq(ta, tb).rounded()),
             }
         }
     }

@@ -1,4 +1,4 @@
-//! Issue 10 item 5, through the real binary: every subcommand is listed in `--help` and the man
+//! Through the real binary: every subcommand is listed in `--help` and the man
 //! page, flags given before a subcommand apply to it (or are refused by name), help wraps to
 //! 100 columns when stdout is not a terminal, and `--format json` names the report schema.
 

@@ -404,6 +404,23 @@ fn oracle_containment(a: &Mesh, b: &Mesh, rows: &[Row]) -> Cont {
             None => Some(false),
         }
     };
+    // Every vertex of one part on the other's surface, yet a face of it runs through the other's
+    // interior (a thin wedge in a tilted frame): shared volume. A point of a triangle off the other
+    // surface decides for the whole triangle when nothing crosses (the centroid, rounded, is
+    // within an ulp of the triangle and far from the other surface here).
+    let face_inside = |inner: &Mesh, ti: &[[DVec3; 3]], to: &[[DVec3; 3]]| -> bool {
+        let all_on =
+            inner.positions.iter().all(|&p| to.iter().any(|t| oracle::classify(&[p, p, p], t).is_some()));
+        all_on
+            && oracle::closed(to)
+            && ti.iter().any(|t| {
+                let c = (t[0] + t[1] + t[2]) / 3.0;
+                to.iter().all(|u| oracle::classify(&[c, c, c], u).is_none()) && oracle::inside(c, to)
+            })
+    };
+    if face_inside(a, &ta, &tb) || face_inside(b, &tb, &ta) {
+        return Cont::Overlap;
+    }
     match (one_way(a, b, &tb), one_way(b, a, &ta)) {
         (Some(true), _) => Cont::AInB,
         (_, Some(true)) => Cont::BInA,

@@ -287,7 +287,7 @@ fn the_reader_sees_cycles() {
     );
 }
 
-/// `autotests = false` (one test binary, issue 13): a `tests/*.rs` file that `tests/suite.rs`
+/// `autotests = false` (one test binary): a `tests/*.rs` file that `tests/suite.rs`
 /// does not declare would silently never run.
 #[test]
 fn every_test_file_is_in_the_suite() {

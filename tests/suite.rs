@@ -24,14 +24,14 @@ mod cli_errors;
 mod cli_messages;
 #[path = "cli_subcommands.rs"]
 mod cli_subcommands;
-#[path = "contract.rs"]
-mod contract;
-#[path = "exactness.rs"]
-mod exactness;
 #[path = "common.rs"]
 mod common;
+#[path = "contract.rs"]
+mod contract;
 #[path = "docs_commands.rs"]
 mod docs_commands;
+#[path = "exactness.rs"]
+mod exactness;
 #[path = "extremes.rs"]
 mod extremes;
 #[path = "fcl_reference.rs"]

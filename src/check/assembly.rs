@@ -668,11 +668,11 @@ pub struct Selection {
     pub select_b: Vec<String>,
     /// Globs removing parts from both sides.
     pub exclude: Vec<String>,
-    /// Sharding (issue 14, `crate::shard`): restrict or stand in for the part-pair check.
+    /// Sharding (`crate::shard`): restrict or stand in for the part-pair check.
     pub hook: Option<Hook>,
 }
 
-/// The sharding hook of [`run`] (issue 14): a shard checks only its candidate part pairs, and
+/// The sharding hook of [`run`]: a shard checks only its candidate part pairs, and
 /// a merge stands in the shards' combined outcome for the check; everything around [`run`]
 /// (loading, report, regions, baseline, JUnit) stays the single-machine code path.
 pub trait PartsHook: Send + Sync + std::fmt::Debug {

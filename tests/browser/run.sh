@@ -1,5 +1,5 @@
 #!/bin/sh
-# Browser test of the HTML report (issue 17): generate reports from the shipped meshes with the
+# Browser test of the HTML report: generate reports from the shipped meshes with the
 # release binary, load each from disk in headless Chromium (Debian package `chromium`; Node.js
 # runs the driver, no npm package needed), screenshot the overview and the first clash, and
 # assert the clash colours are in the frame, no network request was made and the console has no
