@@ -780,8 +780,8 @@ fn book_is_clean(mesh: &Mesh, tris: &[u32], fans: &Fans, u: u32, w: u32, pages: 
         let k = e as usize / 3;
         let ids = fans.ids[k];
         let mut third = None;
-        for c in 0..3 {
-            match ids[c] {
+        for (c, &id) in ids.iter().enumerate() {
+            match id {
                 x if x == u => pu = Some(point(k, c)),
                 x if x == w => pw = Some(point(k, c)),
                 _ => third = Some(point(k, c)),
