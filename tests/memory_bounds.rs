@@ -1,7 +1,8 @@
 //! Inputs that used to abort or run without end, through the real binary: instanced glTF
 //! scenes within the documented caps under a 1 GiB address-space limit (refused up front with
 //! exit 2 and one line naming the file), and `self` on 100,000-triangle constructions around
-//! one vertex (copies of one face, point triangles at one point, a flat disc fan), which must
+//! one vertex or edge (copies of one face, point triangles at one point, a flat disc fan,
+//! pages on one edge), which must
 //! finish (a child process bounded by a generous time limit: a hang fails, no speed is
 //! asserted).
 
@@ -118,7 +119,7 @@ fn self_within(file: &Path, limit: Duration) -> Option<i32> {
 }
 
 #[test]
-fn self_on_100k_triangles_around_one_vertex_finishes() {
+fn self_on_100k_triangles_around_one_vertex_or_edge_finishes() {
     let n = 100_000usize;
     let d = tempfile::tempdir().unwrap();
     let write = |name: &str, text: String| {
@@ -141,8 +142,17 @@ fn self_on_100k_triangles_around_one_vertex_finishes() {
         disc.push_str(&format!("f 1 {} {}\n", 2 + i, 2 + (i + 1) % n));
     }
     let fan = write("fan.obj", disc);
+    let mut pages = String::from("v 0 0 0\nv 0 0 1\n");
+    for i in 0..n {
+        let a = i as f64 * std::f64::consts::TAU / n as f64;
+        pages.push_str(&format!("v {} {} 0.5\n", a.cos(), a.sin()));
+    }
+    for i in 0..n {
+        pages.push_str(&format!("f 1 2 {}\n", 3 + i));
+    }
+    let book = write("book.obj", pages);
     // Generous: a hang or the old quadratic walk (hours) fails; the figures are in benchmarks.
-    for f in [&copies, &points, &fan] {
+    for f in [&copies, &points, &fan, &book] {
         assert_eq!(self_within(f, Duration::from_secs(120)), Some(0), "{}", f.display());
     }
 }

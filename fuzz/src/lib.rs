@@ -350,7 +350,7 @@ pub fn writers(data: &[u8]) {
         let mut f = z.by_index(i).expect("member");
         let mut s = String::new();
         f.read_to_string(&mut s).expect("UTF-8 member");
-        roxmltree::Document::parse(&s).unwrap_or_else(|e| panic!("{}: {e}", f.name().unwrap_or("?")));
+        roxmltree::Document::parse(&s).unwrap_or_else(|e| panic!("BCF member {i}: {e}"));
     }
 }
 

@@ -355,6 +355,8 @@ fn shared_mask(i: [u32; 3], o: [u32; 3]) -> usize {
 const SHARED: [usize; 8] = [0, 0, 1, 0, 2, 0, 0, 0];
 /// For a mask with two bits set: the corner not set.
 const UNSHARED: [usize; 8] = [0, 0, 0, 2, 0, 1, 0, 0];
+/// For a mask with two bits set: those two corners.
+const SHARED_PAIR: [(usize, usize); 8] = [(0, 0), (0, 0), (0, 0), (0, 1), (0, 0), (0, 2), (1, 2), (0, 0)];
 /// The corner after (in the winding) each corner.
 const NEXT: [usize; 3] = [1, 2, 0];
 
@@ -553,6 +555,10 @@ pub fn self_pairs_with(
     drop(walked);
     let is_certified = |v: u32| certified[v as usize / 64] >> (v % 64) & 1 != 0;
     let shared = common_certified(&nodes, &slots, &is_certified);
+    let walked_mask = copies.as_ref().map(|c| c.walked.as_slice());
+    let edges = certified_edges(mesh, tris, fans, walked_mask, &is_certified);
+    let shared_edges = common_edges(&nodes, &slots, &edges);
+    let is_certified_edge = |a: u32, b: u32| edges.binary_search(&edge_key(a, b)).is_ok();
     let tree_ms = t0.elapsed().as_secs_f64() * 1e3;
     let t1 = std::time::Instant::now();
     let tri = |s: &Slot| Tri { p: corners(s.k as usize), ids: s.ids, t: tris[s.k as usize] };
@@ -567,6 +573,12 @@ pub fn self_pairs_with(
                 let mx = shared_mask(x.ids, y.ids);
                 if mx & cx != 0 {
                     continue;
+                }
+                if !edges.is_empty() && mx.count_ones() == 2 {
+                    let (p, q) = (x.ids[SHARED_PAIR[mx].0], x.ids[SHARED_PAIR[mx].1]);
+                    if p != q && is_certified_edge(p, q) {
+                        continue;
+                    }
                 }
                 let (tx, bx, fx) = full.get_or_insert_with(|| {
                     let t = tri(x);
@@ -587,7 +599,12 @@ pub fn self_pairs_with(
     };
     let mut pairs = self_walk(
         &nodes,
-        |i, j| certified_in_common(&shared[i as usize], &shared[j as usize]),
+        |i, j| {
+            certified_in_common(&shared[i as usize], &shared[j as usize])
+                || shared_edges
+                    .get(i as usize)
+                    .is_some_and(|&e| e != u64::MAX && shared_edges[j as usize] == e)
+        },
         |leaf, out| {
             let leaf = &slots[leaf];
             for (k, x) in leaf.iter().enumerate() {
@@ -682,6 +699,167 @@ impl Copies {
             }
         }
     }
+}
+
+/// Vertices with at least this many triangles whose fan is not certified are searched for
+/// edges shared by three or more triangles (books), to certify ([`certified_edges`]).
+const BOOK_VERTEX_MIN: usize = 16;
+
+/// The key of the edge between vertex numbers `a` and `b` (either order).
+#[inline]
+fn edge_key(a: u32, b: u32) -> u64 {
+    (a.min(b) as u64) << 32 | a.max(b) as u64
+}
+
+/// The edges (keys, ascending) shared by three or more walked triangles around which every
+/// pair sharing the edge is proven to meet only in it, so the walk may skip those pairs (and
+/// nodes whose triangles all hold one such edge: [`common_edges`]).
+///
+/// Two triangles sharing exactly the edge `[u, w]` (copies are walked once: [`Copies`]), with
+/// third vertices `a` and `b`, clash iff both are proper and `a`, `b` lie in one half-plane
+/// bounded by the line `uw`, or both are on that line beyond the same end (the edge rule of
+/// the module docs). Sorting the proper pages around the edge (exactly: the side of the plane
+/// through `u, w` and a first page, then `orient3d` within each open side) puts pages in one
+/// half-plane next to each other: the edge is certified when no two neighbours are in one
+/// half-plane and at most one collinear page extends beyond each end. Only edges at
+/// vertices with [`BOOK_VERTEX_MIN`] or more triangles and an uncertified fan are searched (a
+/// surface has none).
+fn certified_edges(
+    mesh: &Mesh,
+    tris: &[u32],
+    fans: &Fans,
+    walked: Option<&[bool]>,
+    vertex_certified: &impl Fn(u32) -> bool,
+) -> Vec<u64> {
+    let walks = |k: usize| walked.is_none_or(|w| w[k]);
+    let candidates: Vec<u32> = (0..fans.vertices() as u32)
+        .filter(|&v| fans.group(v as usize).len() >= BOOK_VERTEX_MIN && !vertex_certified(v))
+        .collect();
+    let mut out: Vec<u64> = candidates
+        .par_iter()
+        .flat_map_iter(|&u| {
+            // Pages by their other vertex w (each edge once: from its lower end).
+            let mut by_w: Vec<(u32, u32)> = Vec::new();
+            for &e in fans.group(u as usize) {
+                let (k, c) = (e as usize / 3, e as usize % 3);
+                if !walks(k) {
+                    continue;
+                }
+                let ids = fans.ids[k];
+                for w in [ids[(c + 1) % 3], ids[(c + 2) % 3]] {
+                    if w > u {
+                        by_w.push((w, e));
+                    }
+                }
+            }
+            by_w.sort_unstable();
+            by_w.dedup();
+            let mut found = Vec::new();
+            let mut i = 0;
+            while i < by_w.len() {
+                let j = i + by_w[i..].iter().take_while(|p| p.0 == by_w[i].0).count();
+                if j - i >= 3 && book_is_clean(mesh, tris, fans, u, by_w[i].0, &by_w[i..j]) {
+                    found.push(edge_key(u, by_w[i].0));
+                }
+                i = j;
+            }
+            found
+        })
+        .collect();
+    out.sort_unstable();
+    out
+}
+
+/// Exact, for the pages `pages` (corners `3k + c` at `u`, each triangle holding `u` and `w`):
+/// does every pair of them meet only in the edge? See [`certified_edges`].
+fn book_is_clean(mesh: &Mesh, tris: &[u32], fans: &Fans, u: u32, w: u32, pages: &[(u32, u32)]) -> bool {
+    let point = |k: usize, c: usize| mesh.positions[mesh.triangles[tris[k] as usize][c] as usize];
+    let (mut pu, mut pw) = (None, None);
+    let mut thirds: Vec<DVec3> = Vec::with_capacity(pages.len());
+    for &(_, e) in pages {
+        let k = e as usize / 3;
+        let ids = fans.ids[k];
+        let mut third = None;
+        for (c, &id) in ids.iter().enumerate() {
+            match id {
+                x if x == u => pu = Some(point(k, c)),
+                x if x == w => pw = Some(point(k, c)),
+                _ => third = Some(point(k, c)),
+            }
+        }
+        // No third vertex: the segment uw itself, which meets every page in the edge only.
+        thirds.extend(third);
+    }
+    let (Some(u), Some(w)) = (pu, pw) else { return false };
+    let (mut proper, mut beyond_u, mut beyond_w) = (Vec::new(), 0, 0);
+    let k = (0..3).find(|&k| u[k] != w[k]).expect("u != w");
+    for a in thirds {
+        if pr::collinear(u, w, a) {
+            // Beyond u: on the far side of u from w along axis k (the order on the line).
+            if (a[k] < u[k]) == (u[k] < w[k]) && a[k] != u[k] {
+                beyond_u += 1;
+            } else if (a[k] > w[k]) == (u[k] < w[k]) && a[k] != w[k] {
+                beyond_w += 1;
+            }
+        } else {
+            proper.push(a);
+        }
+    }
+    if beyond_u > 1 || beyond_w > 1 {
+        return false;
+    }
+    let Some(&a0) = proper.first() else { return true };
+    let axis = pr::projection_axis(u, w, a0).expect("proper page");
+    let side0 = pr::orient2d(u, w, a0, axis);
+    // 0: a0's half-plane, 1: one open side, 2: the opposite half-plane, 3: the other side.
+    let half = |a: DVec3| match pr::orient3d(u, w, a0, a) {
+        1 => 1u8,
+        -1 => 3,
+        _ if pr::orient2d(u, w, a, axis) == side0 => 0,
+        _ => 2,
+    };
+    let mut keyed: Vec<(u8, DVec3)> = proper.iter().map(|&a| (half(a), a)).collect();
+    let cmp = |x: &(u8, DVec3), y: &(u8, DVec3)| {
+        x.0.cmp(&y.0).then_with(|| {
+            if x.0 % 2 == 1 {
+                0.cmp(&pr::orient3d(u, w, x.1, y.1))
+            } else {
+                std::cmp::Ordering::Equal
+            }
+        })
+    };
+    keyed.sort_by(cmp);
+    keyed.windows(2).all(|p| cmp(&p[0], &p[1]) != std::cmp::Ordering::Equal)
+}
+
+/// Per node of the self tree: a certified edge every triangle under it holds (`u64::MAX`:
+/// none), as [`common_certified`] does for vertices.
+fn common_edges(nodes: &[SNode], slots: &[Slot], edges: &[u64]) -> Vec<u64> {
+    let none = u64::MAX;
+    if edges.is_empty() {
+        return Vec::new();
+    }
+    let holds = |s: &Slot, e: u64| {
+        let i = s.ids;
+        [edge_key(i[0], i[1]), edge_key(i[1], i[2]), edge_key(i[0], i[2])].contains(&e)
+    };
+    let mut out = vec![none; nodes.len()];
+    for i in (0..nodes.len()).rev() {
+        let n = &nodes[i];
+        out[i] = if n.is_leaf() {
+            let items = &slots[n.a as usize..(n.a + n.count) as usize];
+            let i0 = items[0].ids;
+            [edge_key(i0[0], i0[1]), edge_key(i0[1], i0[2]), edge_key(i0[0], i0[2])]
+                .into_iter()
+                .find(|&e| edges.binary_search(&e).is_ok() && items.iter().all(|s| holds(s, e)))
+                .unwrap_or(none)
+        } else if out[i + 1] == out[n.a as usize] {
+            out[i + 1]
+        } else {
+            none
+        };
+    }
+    out
 }
 
 /// Up to three certified vertices that every triangle under a node has (ascending, then

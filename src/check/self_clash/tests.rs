@@ -624,3 +624,70 @@ fn hostile_constructions_match_the_brute_force() {
     let t: Vec<[u32; 3]> = (0..n as u32).map(|i| [i, i + 2, i + 5]).collect();
     assert!(!pairs(&mesh(&p, &t)).is_empty());
 }
+
+/// `pages` triangles on the edge (0,0,0)-(0,0,1), third vertices `thirds`.
+fn book(thirds: &[[f64; 3]]) -> Mesh {
+    let mut p = vec![[0.0, 0.0, 0.0], [0.0, 0.0, 1.0]];
+    p.extend_from_slice(thirds);
+    let t: Vec<[u32; 3]> =
+        (0..thirds.len() as u32).map(|i| if i % 2 == 0 { [0, 1, 2 + i] } else { [1, 0, 2 + i] }).collect();
+    mesh(&p, &t)
+}
+
+fn book_edges(m: &Mesh) -> usize {
+    let (merged, _) = crate::scene::bodies::merge_vertices(&m.positions);
+    let all: Vec<u32> = (0..m.triangles.len() as u32).collect();
+    let fans = Fans::new(m, &merged, &all);
+    let bits = certified_fans(m, &all, &fans, None);
+    certified_edges(m, &all, &fans, None, &|v: u32| bits[v as usize / 64] >> (v % 64) & 1 != 0).len()
+}
+
+#[test]
+fn books_of_pages_on_one_edge_are_certified_exactly_when_no_two_pages_fold() {
+    // 40 pages at distinct angles, plus collinear pages beyond each end: certified, no pair.
+    let mut thirds = circle(40, 1000.0, |i| (i % 5) as f64 * 0.25);
+    thirds.extend([[0.0, 0.0, -3.0], [0.0, 0.0, 5.0], [0.0, 0.0, 0.5]]);
+    let clean = book(&thirds);
+    assert_eq!(book_edges(&clean), 1);
+    assert!(pairs(&clean).is_empty());
+    // A page at twice the distance of another (one half-plane): a fold, not certified.
+    let mut folded = thirds.clone();
+    folded.push([2.0 * thirds[3][0], 2.0 * thirds[3][1], 0.7]);
+    let m = book(&folded);
+    assert_eq!(book_edges(&m), 0);
+    assert!(!pairs(&m).is_empty());
+    // Two collinear pages beyond one end: they overlap, not certified.
+    let mut two_beyond = thirds.clone();
+    two_beyond.push([0.0, 0.0, 7.0]);
+    let m = book(&two_beyond);
+    assert_eq!(book_edges(&m), 0);
+    assert!(!pairs(&m).is_empty());
+}
+
+/// Books of 16 to 40 pages with random integer third vertices (many in one half-plane, on
+/// the edge's line, opposite each other): certified or not, the walk gives the brute force.
+fn random_book() -> impl Strategy<Value = Mesh> {
+    prop::collection::vec(prop::array::uniform3(-3i32..4), 16..40)
+        .prop_map(|t| book(&t.iter().map(|v| v.map(|c| c as f64)).collect::<Vec<_>>()))
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig { cases: 200, ..ProptestConfig::default() })]
+
+    #[test]
+    fn book_certificates_lose_no_pair(m in random_book()) {
+        pairs(&m);
+    }
+
+    #[test]
+    fn book_certificates_lose_no_pair_among_distinct_angles(
+        angles in prop::collection::btree_set(0u32..720, 16..60), beyond in 0usize..3
+    ) {
+        let mut thirds: Vec<[f64; 3]> = angles.iter().map(|&d| {
+            let a = (d as f64).to_radians() / 2.0;
+            [(1e3 * a.cos()).round(), (1e3 * a.sin()).round(), 0.5]
+        }).collect();
+        thirds.extend([[0.0, 0.0, 2.0], [0.0, 0.0, 3.0]].iter().take(beyond));
+        pairs(&book(&thirds));
+    }
+}
