@@ -369,11 +369,8 @@ pub fn argv(c: &CheckSpec, dir: &Path, run: &ClashSetArgs) -> std::result::Resul
 /// turned into its command line and validated into a [`config::Config`]. Any problem is an
 /// [`Error::Input`] naming the file and the check.
 pub fn load(file: &Path, run: &ClashSetArgs) -> Result<Vec<Check>> {
-    let bytes = std::fs::read(file).map_err(|e| {
-        let problem =
-            InputProblem::Unreadable { reading: Reading::ClashSet, kind: e.kind(), reason: e.to_string() };
-        Error::in_file(file, problem)
-    })?;
+    let bytes =
+        meshclash::load::read_small_file(file, Reading::ClashSet, meshclash::load::MAX_SMALL_FILE_BYTES)?;
     let text =
         String::from_utf8(bytes).map_err(|_| Error::in_file(file, InputProblem::NotUtf8 { byte: None }))?;
     parse(file, &text, run)

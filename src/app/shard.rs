@@ -300,7 +300,7 @@ pub fn shard_index(shard: Option<&str>, shards: Option<usize>) -> Result<(usize,
 }
 
 fn read_plan(path: &Path) -> Result<(Plan, String)> {
-    let bytes = std::fs::read(path).map_err(|e| unreadable(path, Reading::Plan, &e))?;
+    let bytes = meshclash::load::read_small_file(path, Reading::Plan, meshclash::load::MAX_SMALL_FILE_BYTES)?;
     let plan = Plan::parse(&bytes).map_err(|m| invalid(path, m))?;
     Ok((plan, sha256::hex(&bytes)))
 }
@@ -393,7 +393,8 @@ fn run_shard(a: &RunArgs, plan: &Plan, plan_hash: &str, i: usize, n: usize) -> R
 }
 
 fn read_shard(path: &Path) -> Result<ShardReport> {
-    let bytes = std::fs::read(path).map_err(|e| unreadable(path, Reading::ShardReport, &e))?;
+    let bytes =
+        meshclash::load::read_small_file(path, Reading::ShardReport, meshclash::load::MAX_SMALL_FILE_BYTES)?;
     let v: serde_json::Value = serde_json::from_slice(&bytes)
         .map_err(|e| invalid(path, format!("shard report is not JSON: {e}")))?;
     if v.get("schema").and_then(|s| s.as_str()) != Some(SHARD_SCHEMA) {

@@ -571,7 +571,7 @@ pub fn run(req: &Request, progress: &(dyn Fn(Phase) + Sync)) -> Result<Outcome> 
     req.validate()?;
     // Read the baseline first: a bad one costs nothing, and it is read before any output is
     // written (so `--baseline r.json -o r.json` updates a baseline in place).
-    let base = req.baseline.as_deref().map(baseline::read).transpose()?;
+    let base = req.baseline.as_deref().map(read_baseline).transpose()?;
     progress(Phase::Load);
     let t0 = Instant::now();
     let inputs = if req.selection.scene {
@@ -683,6 +683,15 @@ pub fn run(req: &Request, progress: &(dyn Fn(Phase) + Sync)) -> Result<Outcome> 
         times: (!req.deterministic).then(|| (load_ms, t0.elapsed().as_secs_f64() * 1e3)),
         inputs,
     })
+}
+
+/// Read a baseline report: a regular file of bounded size (never blocking on a FIFO), parsed
+/// for what a comparison needs.
+fn read_baseline(path: &Path) -> Result<Baseline> {
+    use crate::error::Reading;
+    let bytes = crate::load::read_small_file(path, Reading::Baseline, crate::load::MAX_SMALL_FILE_BYTES)?;
+    baseline::parse(&path.display().to_string(), &bytes)
+        .map_err(|msg| Error::in_file(path, InputProblem::Invalid(msg)))
 }
 
 /// Compare every finding of this run (`all`, in pair order) with a complete baseline.

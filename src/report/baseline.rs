@@ -22,13 +22,11 @@
 //! same). New touching or clearance pairs are listed but do not fail it.
 
 use crate::check::query::{PairFinding, PairKind};
-use crate::error::{Error, InputProblem, Reading, Result};
 use crate::report::{ReportContainment, UnlistedFindings};
 use crate::scene::mesh::Mesh;
 use serde::de::{self, Deserializer, IgnoredAny, Visitor};
 use serde::{Deserialize, Serialize};
 use std::collections::{BTreeSet, HashMap, HashSet};
-use std::path::Path;
 
 /// The `baseline` block of a report written with `--baseline`.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize, schemars::JsonSchema)]
@@ -112,18 +110,6 @@ pub fn unlisted(all: &[Finding], listed: &[usize]) -> UnlistedFindings {
     }
     let list = |s: BTreeSet<&str>| s.into_iter().map(str::to_string).collect();
     UnlistedFindings { crossing_ids: list(crossing), other_ids: list(other) }
-}
-
-/// Read a baseline report (any `meshclash.report/*` written with finding ids; unknown fields
-/// are ignored so that reports of later versions can serve as baselines).
-pub fn read(path: &Path) -> Result<Baseline> {
-    let bytes = std::fs::read(path).map_err(|e| {
-        Error::in_file(
-            path,
-            InputProblem::Unreadable { reading: Reading::Baseline, kind: e.kind(), reason: e.to_string() },
-        )
-    })?;
-    parse(&path.display().to_string(), &bytes).map_err(|msg| Error::in_file(path, InputProblem::Invalid(msg)))
 }
 
 /// A finding id as read from a baseline (16 hex digits; None when malformed).
