@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""python-fcl (FCL's OBBRSS trees) on the issue-12 tori, as an outside reference for meshclash.
+"""python-fcl (FCL's OBBRSS trees) on the benchmark tori, as an outside reference for meshclash.
 
 Setup (once):   python3 -m venv /tmp/fcl-venv
                 /tmp/fcl-venv/bin/pip install python-fcl trimesh numpy

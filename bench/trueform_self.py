@@ -1,5 +1,5 @@
 """Time trueform's self-intersection on an OBJ (the same file `meshclash self` reads), for a
-same-run ratio with `meshclash-bench self` (issue 16).
+same-run ratio with `meshclash-bench self`.
 
     python3 bench/trueform_self.py FILE.obj [--reps 3]
 

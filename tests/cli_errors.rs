@@ -1,4 +1,4 @@
-//! Issue 13 (typed errors): the one-line messages of the command line, byte for byte, through
+//! Typed errors: the one-line messages of the command line, byte for byte, through
 //! the real binary. The errors became data (path, location, problem); what a user reads did not
 //! change. Each case: exit code 2 and exactly `meshclash: error: {message}\n` on stderr.
 

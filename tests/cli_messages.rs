@@ -1,4 +1,4 @@
-//! Issue 10 item 6, through the real binary: a selection problem names the file of the side
+//! through the real binary: a selection problem names the file of the side
 //! that has it.
 
 use assert_cmd::Command;

@@ -366,7 +366,7 @@ fn buffer_uris_outside_the_directory_are_refused() {
         std::fs::write(&f, doc(uri)).unwrap();
         rejects(&f, &[&format!("glTF buffer 0 URI '{uri}' is refused: {why}")]);
     }
-    // Issue 11 item 6: a symlink inside the folder pointing outside it was read.
+    // a symlink inside the folder pointing outside it was read.
     std::os::unix::fs::symlink("../outside.bin", dir.path().join("model/link.bin")).unwrap();
     std::fs::write(&f, doc("link.bin")).unwrap();
     rejects(&f, &["glTF buffer 0 URI 'link.bin' is refused: it resolves (through a symlink) outside"]);

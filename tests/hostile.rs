@@ -572,7 +572,7 @@ fn regression_gltf_instanced_triangle_count_is_bounded() {
     );
 }
 
-/// Issue 11 item 10: a one-line face of 24 MB (12 million indices) reached gigabytes and
+/// a one-line face of 24 MB (12 million indices) reached gigabytes and
 /// aborted with no file name; it is refused at the polygon cap, naming the file and line.
 #[test]
 fn regression_obj_huge_face_line_is_refused_naming_file_and_line() {

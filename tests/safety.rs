@@ -1,4 +1,4 @@
-//! Issue 11 through the real binary: never lose a file (outputs naming inputs, all or nothing
+//! Through the real binary: never lose a file (outputs naming inputs, all or nothing
 //! across outputs, a closed or full stdout), never exhaust memory (hostile inputs under a memory
 //! limit, the report streamed instead of held as text).
 
@@ -274,7 +274,7 @@ fn hostile_inputs_under_a_memory_limit_exit_2_not_abort() {
         return;
     }
     let d = tree();
-    // Issue 11 item 10: one face line of 24 MB (12 million indices).
+    // one face line of 24 MB (12 million indices).
     let mut face = b"v 0 0 0\nv 1 0 0\nv 0 1 0\nf".to_vec();
     for _ in 0..12_000_000 {
         face.extend_from_slice(b" 1");
@@ -282,7 +282,7 @@ fn hostile_inputs_under_a_memory_limit_exit_2_not_abort() {
     face.push(b'\n');
     let huge_face = d.path().join("huge_face.obj");
     std::fs::write(&huge_face, &face).unwrap();
-    // Issue 11 item 5 under the limit: /dev/zero behind a mesh name is refused up front.
+    // /dev/zero behind a mesh name is refused up front.
     let zero = d.path().join("zero.obj");
     std::os::unix::fs::symlink("/dev/zero", &zero).unwrap();
     let good = root().join("meshes/fcl_rob.obj");
@@ -367,7 +367,7 @@ fn report_is_streamed_not_held_as_text() {
     }
 }
 
-/// Issue 11 item 7: a scene of thousands of one-triangle parts stacked in one place made every
+/// a scene of thousands of one-triangle parts stacked in one place made every
 /// pair of them a candidate, collected into one vector first (2^20 such nodes needed 4 GiB and
 /// aborted). Beyond `MAX_CANDIDATE_PART_PAIRS` the scene is refused with exit 2 naming the file,
 /// before any pair is collected; under the cap the same construction runs.
@@ -414,7 +414,7 @@ fn stacked_parts_beyond_the_candidate_pair_cap_are_refused_not_collected() {
     assert_eq!(out.status.code(), Some(0), "{}", String::from_utf8_lossy(&out.stderr));
 }
 
-/// Issue 11 item 9: a small glTF placing one mesh on many nodes asked for more memory than the
+/// a small glTF placing one mesh on many nodes asked for more memory than the
 /// machine has (one 1M-triangle mesh on 250 nodes: 249.9M triangles, within the triangle cap)
 /// and aborted. The loader now estimates what the check of the scene needs after instancing
 /// (`load::CHECK_BYTES_PER_TRIANGLE`) against the memory this process may use and refuses

@@ -1,4 +1,4 @@
-//! Issue 14: `meshclash plan` → `run --shard I/N` (separate processes) → `merge` writes the
+//! `meshclash plan` → `run --shard I/N` (separate processes) → `merge` writes the
 //! report of the unsharded check byte for byte (`--no-timings`), with its JUnit file and exit
 //! code; the engines' shard variables; every refusal (missing, duplicate, failed, foreign
 //! shard; inputs changed since the plan); `--allow-partial` and the baseline that refuses it.

@@ -1,4 +1,4 @@
-//! Regressions from issue 10 (trust): each test is named after what it caught.
+//! Regressions found by trying the tool as a user would: each test is named after what it caught.
 
 use assert_cmd::Command;
 

@@ -1,9 +1,9 @@
-//! The issue-12 cases: `meshclash-bench gen DIR` writes the inputs (generated spheres and tori,
+//! The benchmark cases: `meshclash-bench gen DIR` writes the inputs (generated spheres and tori,
 //! the shipped 2CylinderEngine and grids of its instances), `meshclash-bench cases DIR` times
 //! them, in one process and one run, through the meshclash library and parry3d (f64 and f32),
 //! phase by phase, with same-run ratios.
 //!
-//! Inputs (issue 12, "Inputs, so you can rebuild them"):
+//! Inputs ("Inputs, so you can rebuild them"):
 //!
 //! * `spheres_a.obj`, `spheres_b.obj`: icospheres subdivided 7 times (327,680 triangles),
 //!   radius 1, A at the origin, B centred at (1.2, 0.1, 0.05); coordinates rounded to f32 and
@@ -55,7 +55,7 @@ pub struct GenArgs {
     /// The 2CylinderEngine GLB to copy and instance (engine cases are skipped without it).
     #[arg(long, value_name = "FILE.glb")]
     pub engine: Option<PathBuf>,
-    /// Also write `engine_grid1000.glb` (1,000 instances, for issue 14).
+    /// Also write `engine_grid1000.glb` (1,000 instances, for sharding).
     #[arg(long)]
     pub grid1000: bool,
 }

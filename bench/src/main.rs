@@ -1,6 +1,6 @@
 //! The `meshclash-bench` binary: parse, run, print. Without a subcommand it runs the phase
 //! tables of the library ([`meshclash_bench::run_command`], what `meshclash bench` used to be);
-//! `gen DIR` writes the issue-12 inputs and `cases DIR` times them.
+//! `gen DIR` writes the benchmark inputs and `cases DIR` times them.
 
 use clap::Parser;
 use meshclash_bench::cases::{self, CasesArgs, GenArgs};
@@ -22,12 +22,12 @@ struct Cli {
 
 #[derive(Debug, clap::Subcommand)]
 enum Command {
-    /// Write the issue-12 inputs (spheres, tori, engine grids) into a directory.
+    /// Write the benchmark inputs (spheres, tori, engine grids) into a directory.
     Gen(GenArgs),
-    /// Time the issue-12 cases in a directory written by `gen`: meshclash against parry3d f64
+    /// Time the benchmark cases in a directory written by `gen`: meshclash against parry3d f64
     /// and f32, phase by phase, with same-run ratios.
     Cases(CasesArgs),
-    /// Self-clash and mesh health (issue 16) on a generated folded torus (1M triangles) and on
+    /// Self-clash and mesh health on a generated folded torus (1M triangles) and on
     /// given files, phase by phase.
     #[command(name = "self")]
     SelfCase(SelfCaseArgs),

@@ -1,4 +1,4 @@
-//! `meshclash-bench self`: self-clash and mesh health (issue 16) on a generated folded torus
+//! `meshclash-bench self`: self-clash and mesh health on a generated folded torus
 //! (default 1M triangles: [`meshclash::check::self_clash::gen::folded_torus`]) and on given
 //! files, phase by phase.
 //!

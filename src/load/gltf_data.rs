@@ -436,7 +436,7 @@ fn read_external(path: &Path, i: usize, uri: &str, declared: usize) -> Result<Ve
     let cannot = |e: std::io::Error| {
         Error::at(path, at.clone(), unreadable(Reading::ExternalBuffer(shown.clone()), &e))
     };
-    // The text checks above cannot see symlinks: resolve both ends and compare (issue 11 item 6).
+    // The text checks above cannot see symlinks: resolve both ends and compare.
     let real = file.canonicalize().map_err(cannot)?;
     let base = path.parent().filter(|d| !d.as_os_str().is_empty()).unwrap_or(Path::new("."));
     let base = base.canonicalize().map_err(cannot)?;

@@ -139,7 +139,7 @@ fn strips_fans_and_skipped_modes() {
       "nodes":[{"mesh":0}],"scenes":[{"nodes":[0]}]"#;
     let l = ok(&gltf(&pos, body));
     // The strip and the fan use one POSITION accessor: its 5 vertices are placed once and both
-    // index them (issue 10 item 6: `inputs.*.vertices` counted a shared accessor once per
+    // index them (`inputs.*.vertices` counted a shared accessor once per
     // primitive, 10 here).
     let strip = [[0, 1, 2], [1, 3, 2], [2, 3, 4]];
     let fan = [[0, 1, 2], [0, 2, 3], [0, 3, 4]];
@@ -1011,7 +1011,7 @@ fn node_transforms_are_read_as_f64_not_f32() {
 
 #[test]
 fn infinite_position_without_bounds_is_refused_for_the_coordinate() {
-    // Issue 10 item 6: POSITION holds +inf and its accessor has no min/max (which the spec
+    // POSITION holds +inf and its accessor has no min/max (which the spec
     // requires): the error names the non-finite position, not the missing bounds.
     let mut bin = f32s(&[0.0, 0.0, 0.0, f32::INFINITY, 0.0, 0.0, 0.0, 1.0, 0.0]);
     for i in [0u16, 1, 2, 0] {

@@ -121,7 +121,7 @@ impl Format {
 /// A missing or unreadable file is an [`Error::Input`] naming the path. A path that is not a
 /// regular file (a FIFO, a device such as `/dev/zero`, a socket, a directory) is refused before
 /// it is opened, so a FIFO cannot block the run and a device cannot stream without end
-/// (issue 11, item 5). Symlinks are followed: the link's target must be a regular file.
+///. Symlinks are followed: the link's target must be a regular file.
 pub fn load_path(path: &Path) -> Result<(Loaded, Format)> {
     let bytes = read_regular_file(path, Reading::File, u64::MAX)?;
     let format = detect_format(path, &bytes)?;
@@ -397,21 +397,29 @@ pub(crate) fn drop_empty_objects(mesh: &mut crate::scene::mesh::Mesh) {
     }
 }
 
-/// Locates a file of the shared test corpus (`../shared/meshes` next to the crate, else
-/// `/work/shared/meshes`); `None` (test should skip) when it is absent.
+/// Locates a test mesh: the repository's own copies (`meshes/`, `tests/data/meshes/`) first, then
+/// the corpus in `$MESHCLASH_SHARED_MESHES` or `../shared/meshes` next to the crate; `None` (the
+/// test skips, saying so) when it is nowhere. With `CI` set and the corpus present, a missing
+/// file is a failure, not a skip.
 #[cfg(test)]
 pub(crate) fn shared(name: &str) -> Option<std::path::PathBuf> {
-    let candidates = [
-        std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../shared/meshes"),
-        std::path::PathBuf::from("/work/shared/meshes"),
-    ];
+    let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR"));
+    let corpus = std::env::var_os("MESHCLASH_SHARED_MESHES")
+        .map(std::path::PathBuf::from)
+        .unwrap_or_else(|| root.join("../shared/meshes"));
+    let candidates = [root.join("meshes"), root.join("tests/data/meshes"), corpus.clone()];
     for dir in candidates {
         let p = dir.join(name);
         if p.is_file() {
             return Some(p);
         }
     }
-    eprintln!("skipping: shared mesh {name} not found");
+    assert!(
+        !(std::env::var_os("CI").is_some() && corpus.is_dir()),
+        "{name} is missing from the corpus at {}",
+        corpus.display()
+    );
+    eprintln!("skipping: test mesh {name} not found (set MESHCLASH_SHARED_MESHES to the corpus)");
     None
 }
 
@@ -476,7 +484,7 @@ mod tests {
 
     #[test]
     fn fifo_input_is_refused_without_hanging() {
-        // Before issue 11 item 5 this opened the FIFO and blocked forever with no writer.
+        // Before the non-blocking open, this opened the FIFO and blocked forever with no writer.
         let dir = tempfile::tempdir().unwrap();
         let fifo = dir.path().join("f.obj");
         let status = std::process::Command::new("mkfifo").arg(&fifo).status().unwrap();

@@ -656,7 +656,7 @@ mod tests {
 
     #[test]
     fn regression_huge_face_is_refused_naming_line_and_limit() {
-        // Issue 11 item 10: one `f` line with tens of millions of indices reached 3.5 GB.
+        // one `f` line with tens of millions of indices reached 3.5 GB.
         let mut src = b"v 0 0 0\nv 1 0 0\nv 0 1 0\n# big\nf".to_vec();
         for _ in 0..MAX_FACE_VERTICES {
             src.extend_from_slice(b" 1");

@@ -1,4 +1,4 @@
-//! The one place outputs reach the file system (issue 11).
+//! The one place outputs reach the file system.
 //!
 //! Rules, for every output (`-o`, `--junit`, `--export-glb`, and any added later):
 //! - **checked before any work** ([`check_outputs`]): an output that is one of the inputs (the

@@ -499,6 +499,15 @@ pub fn ray_parity(p: &P, d: &P, tris: &[[DVec3; 3]]) -> Option<bool> {
     Some(odd)
 }
 
+/// Is the exact centroid of `t` strictly inside the closed surface `tris`? (False when it lies
+/// on the surface: every ray from a point on a triangle is refused by [`ray_parity`].)
+pub fn centroid_strictly_inside(t: &[DVec3; 3], tris: &[[DVec3; 3]]) -> bool {
+    let third = Q::new(1.into(), 3.into());
+    let c = mul(&add(&add(&pt(t[0]), &pt(t[1])), &pt(t[2])), &third);
+    let dirs = [[1.0, 0.3719, 0.1234], [-0.4321, 1.0, 0.2718], [0.1414, -0.5772, -1.0], [0.7, 0.6, 0.5]];
+    dirs.iter().filter_map(|d| ray_parity(&c, &[q(d[0]), q(d[1]), q(d[2])], tris)).next().unwrap_or(false)
+}
+
 /// Is `p` (not on the surface) inside the closed surface `tris` (odd crossing parity)?
 pub fn inside(p: DVec3, tris: &[[DVec3; 3]]) -> bool {
     let dirs = [[1.0, 0.3719, 0.1234], [-0.4321, 1.0, 0.2718], [0.1414, -0.5772, -1.0], [0.7, 0.6, 0.5]];
