@@ -14,6 +14,8 @@ mod bodies_penetration;
 mod brute_force;
 #[path = "clash_set.rs"]
 mod clash_set;
+#[path = "cache.rs"]
+mod cache;
 #[path = "cli.rs"]
 mod cli;
 #[path = "cli_errors.rs"]
