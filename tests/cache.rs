@@ -29,14 +29,7 @@ fn cube(name: &str, min: [f64; 3], s: f64, base: usize) -> String {
         out += &format!("v {} {} {}\n", min[0] + x, min[1] + y, min[2] + z);
     }
     // Outward-wound faces of the unit cube (corner i has bits x, y, z).
-    let faces = [
-        [0, 2, 3, 1],
-        [4, 5, 7, 6],
-        [0, 1, 5, 4],
-        [2, 6, 7, 3],
-        [0, 4, 6, 2],
-        [1, 3, 7, 5],
-    ];
+    let faces = [[0, 2, 3, 1], [4, 5, 7, 6], [0, 1, 5, 4], [2, 6, 7, 3], [0, 4, 6, 2], [1, 3, 7, 5]];
     for f in faces {
         let v = f.map(|i| i + base + 1);
         out += &format!("f {} {} {}\nf {} {} {}\n", v[0], v[1], v[2], v[0], v[2], v[3]);

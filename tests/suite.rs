@@ -12,10 +12,10 @@ mod bench_cmd;
 mod bodies_penetration;
 #[path = "brute_force.rs"]
 mod brute_force;
-#[path = "clash_set.rs"]
-mod clash_set;
 #[path = "cache.rs"]
 mod cache;
+#[path = "clash_set.rs"]
+mod clash_set;
 #[path = "cli.rs"]
 mod cli;
 #[path = "cli_errors.rs"]
