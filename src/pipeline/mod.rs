@@ -579,8 +579,9 @@ pub fn run(req: &Request, progress: &(dyn Fn(Phase) + Sync)) -> Result<Outcome> 
     // Read the baseline first: a bad one costs nothing, and it is read before any output is
     // written (so `--baseline r.json -o r.json` updates a baseline in place).
     let base = req.baseline.as_deref().map(baseline::read).transpose()?;
-    let store = req.cache.as_ref().map(|c| crate::cache::Store::open(&c.dir, c.max_bytes)).transpose()?;
     progress(Phase::Load);
+    // A cache directory that cannot be used is refused before anything is loaded.
+    let store = req.cache.as_ref().map(|c| crate::cache::Store::open(&c.dir, c.max_bytes)).transpose()?;
     let t0 = Instant::now();
     let inputs = if req.selection.scene {
         let one = std::sync::Arc::new(load_input(req, 0, "--units-a")?);
