@@ -14,6 +14,8 @@ mod bench_cmd;
 mod bodies_penetration;
 #[path = "brute_force.rs"]
 mod brute_force;
+#[path = "cache.rs"]
+mod cache;
 #[path = "clash_set.rs"]
 mod clash_set;
 #[path = "cli.rs"]

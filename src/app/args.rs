@@ -159,6 +159,16 @@ pub struct CheckArgs {
     /// degenerate, winding, touching, self-clash.
     #[arg(long, value_enum, value_delimiter = ',', value_name = "WHAT", requires = "self_check")]
     pub self_fail_on: Vec<SelfFailOnArg>,
+    /// Reuse results stored in the cache directory DIR (created when missing) and store new
+    /// ones: a check whose inputs (every placed vertex, triangle and object) and settings are
+    /// unchanged is not run again. The report is the same as without the cache but for an added
+    /// `cache` block. Default: the MESHCLASH_CACHE environment variable when set and not empty.
+    #[arg(long, value_name = "DIR")]
+    pub cache: Option<PathBuf>,
+    /// Bound of the cache directory in bytes: past it, the least recently used entries are
+    /// removed.
+    #[arg(long, value_name = "N", default_value_t = meshclash::cache::DEFAULT_MAX_BYTES)]
+    pub cache_max_bytes: u64,
     /// Output flags: --format, --junit, --baseline, --export-glb.
     #[command(flatten)]
     pub outputs: OutputArgs,

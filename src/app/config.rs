@@ -236,6 +236,11 @@ impl CheckArgs {
             }),
             baseline: self.outputs.baseline.clone(),
             missing_shards: Vec::new(),
+            cache: self
+                .cache
+                .clone()
+                .or_else(|| std::env::var_os("MESHCLASH_CACHE").filter(|v| !v.is_empty()).map(PathBuf::from))
+                .map(|dir| meshclash::cache::CacheConfig { dir, max_bytes: self.cache_max_bytes }),
         };
         request.validate()?;
         Ok(Config {

@@ -21,6 +21,7 @@ pub const TOOL_VERSION: &str = env!("CARGO_PKG_VERSION");
 const PART_TAG: &[u8] = b"meshclash.cache.part\0";
 const SETTINGS_TAG: &[u8] = b"meshclash.cache.settings\0";
 const PAIR_TAG: &[u8] = b"meshclash.cache.pair\0";
+const MESH_TAG: &[u8] = b"meshclash.cache.mesh\0";
 
 /// A SHA-256 digest, the 32 bytes of every key.
 pub type Digest = [u8; 32];
@@ -86,6 +87,67 @@ impl PartKey {
     pub fn of_parts(mesh: &Mesh, parts: &[Part]) -> Vec<PartKey> {
         use rayon::prelude::*;
         parts.par_iter().map(|p| PartKey::of_mesh_part(&p.name, mesh, &p.triangles)).collect()
+    }
+
+    /// The key of a whole input mesh in world space (placed, in the run's units): everything
+    /// it holds, so everything a check of it can depend on — its triangle numbering (findings
+    /// name triangles by index), its vertex sharing (closedness), its objects with their names,
+    /// glTF meshes and world matrices (parts and instance sharing), and every vertex.
+    ///
+    /// The SHA-256 input, every integer little-endian, every f64 as `to_bits`: the tag
+    /// `meshclash.cache.mesh` and a zero byte; the vertex count (u64) and each vertex's x, y,
+    /// z; the triangle count (u64) and each triangle's three vertex indices (u32) and object
+    /// index (u32); the object count (u64) and for each object its name's length (u64), the
+    /// name, a byte `0`/`1` for its glTF mesh then that index (u32), a byte `0`/`1` for its
+    /// world matrix then its 16 entries in column-major order.
+    pub fn of_mesh(mesh: &Mesh) -> PartKey {
+        let mut sha = Sha256::default();
+        sha.update(MESH_TAG);
+        let mut buf: Vec<u8> = Vec::with_capacity(1 << 16);
+        let flush = |sha: &mut Sha256, buf: &mut Vec<u8>, force: bool| {
+            if force || buf.len() >= 1 << 16 {
+                sha.update(buf);
+                buf.clear();
+            }
+        };
+        put_len(&mut sha, mesh.positions.len());
+        for p in &mesh.positions {
+            for c in p.to_array() {
+                buf.extend(c.to_bits().to_le_bytes());
+            }
+            flush(&mut sha, &mut buf, false);
+        }
+        flush(&mut sha, &mut buf, true);
+        put_len(&mut sha, mesh.triangles.len());
+        for (t, o) in mesh.triangles.iter().zip(&mesh.tri_object) {
+            for v in t.iter().chain(std::iter::once(o)) {
+                buf.extend(v.to_le_bytes());
+            }
+            flush(&mut sha, &mut buf, false);
+        }
+        flush(&mut sha, &mut buf, true);
+        put_len(&mut sha, mesh.objects.len());
+        for o in &mesh.objects {
+            put_len(&mut sha, o.name.len());
+            sha.update(o.name.as_bytes());
+            match o.gltf_mesh {
+                Some(m) => {
+                    sha.update(&[1]);
+                    sha.update(&m.to_le_bytes());
+                }
+                None => sha.update(&[0]),
+            }
+            match o.world {
+                Some(w) => {
+                    sha.update(&[1]);
+                    for c in w.to_cols_array() {
+                        sha.update(&c.to_bits().to_le_bytes());
+                    }
+                }
+                None => sha.update(&[0]),
+            }
+        }
+        PartKey(finish(sha))
     }
 
     /// The 32 digest bytes.

@@ -66,7 +66,8 @@ pub struct Stats {
 }
 
 /// The report's `cache` block.
-#[derive(Debug, Clone, PartialEq, Eq, serde::Serialize, schemars::JsonSchema)]
+#[derive(Debug, Clone, PartialEq, Eq, serde::Serialize, serde::Deserialize, schemars::JsonSchema)]
+#[serde(deny_unknown_fields)]
 pub struct CacheSummary {
     /// Candidate part pairs whose stored result was reused.
     pub part_pairs_reused: u64,
@@ -255,7 +256,8 @@ impl Store {
         self.warn(format!("cache: ignored entry {}: {why}", path.display()));
     }
 
-    fn warn(&self, w: String) {
+    /// Add a warning (the caller's, about an entry it could not use).
+    pub(crate) fn warn(&self, w: String) {
         self.warnings.lock().unwrap_or_else(|p| p.into_inner()).push(w);
     }
 

@@ -671,3 +671,106 @@ fn decode_checks_what_check_header_checks_and_the_sum() {
         }
     }
 }
+
+fn one_triangle(name: &str) -> Mesh {
+    Mesh {
+        positions: vec![DVec3::ZERO, DVec3::X, DVec3::Y],
+        triangles: vec![[0, 1, 2]],
+        tri_object: vec![0],
+        objects: vec![crate::scene::mesh::Object { name: name.into(), ..Default::default() }],
+    }
+}
+
+// Computed independently with Python's hashlib over the layout of `PartKey::of_mesh`.
+#[test]
+fn mesh_key_test_vector() {
+    assert_eq!(
+        PartKey::of_mesh(&one_triangle("p")).hex(),
+        "10f294393e6a77142d2a7a46d7f005fd8722d5c1c380ef61f19b70a7cccbbf10"
+    );
+}
+
+#[test]
+fn mesh_key_sees_numbering_sharing_and_objects() {
+    let base = one_triangle("p");
+    let k = PartKey::of_mesh(&base);
+    // The same triangle, its corners numbered from another vertex.
+    let rotated = Mesh { triangles: vec![[1, 2, 0]], ..base.clone() };
+    assert_ne!(PartKey::of_mesh(&rotated), k);
+    // The same coordinates, one vertex duplicated instead of shared.
+    let unshared = Mesh {
+        positions: vec![DVec3::ZERO, DVec3::X, DVec3::Y, DVec3::ZERO],
+        triangles: vec![[3, 1, 2]],
+        ..base.clone()
+    };
+    assert_ne!(PartKey::of_mesh(&unshared), k);
+    assert_ne!(PartKey::of_mesh(&one_triangle("q")), k);
+    let mut instanced = base.clone();
+    instanced.objects[0].gltf_mesh = Some(0);
+    assert_ne!(PartKey::of_mesh(&instanced), k);
+    let mut placed = base.clone();
+    placed.objects[0].world = Some(glam::DMat4::IDENTITY);
+    assert_ne!(PartKey::of_mesh(&placed), k);
+    assert_eq!(PartKey::of_mesh(&base.clone()), k);
+}
+
+#[test]
+fn check_fingerprint_changes_with_every_setting() {
+    use crate::check::assembly::Selection;
+    use crate::check::query::{Detail, Mode, Settings};
+    let s = Settings::default();
+    let sel = Selection::default();
+    let fp =
+        |s: &Settings, sel: &Selection, split: bool, pen: bool| hook::check_fingerprint(s, sel, split, pen);
+    let base = fp(&s, &sel, false, false);
+    assert_eq!(fp(&s, &sel, false, false), base);
+    let mut variants = Vec::new();
+    let mut t = s;
+    t.tolerances.touch = 1e-9;
+    variants.push(fp(&t, &sel, false, false));
+    let mut t = s;
+    t.tolerances.clearance = 1.0;
+    variants.push(fp(&t, &sel, false, false));
+    let mut t = s;
+    t.tolerances.touch = -0.0;
+    variants.push(fp(&t, &sel, false, false));
+    let mut t = s;
+    t.mode = Mode::Fast;
+    variants.push(fp(&t, &sel, false, false));
+    let mut t = s;
+    t.first_hit = true;
+    variants.push(fp(&t, &sel, false, false));
+    let mut t = s;
+    t.detail = Detail::Parts;
+    variants.push(fp(&t, &sel, false, false));
+    let mut t = s;
+    t.bvh.leaf_size += 1;
+    variants.push(fp(&t, &sel, false, false));
+    let mut t = s;
+    t.bvh.strategy = crate::bvh::Strategy::Median;
+    variants.push(fp(&t, &sel, false, false));
+    let mut t = s;
+    t.distance_error.rel = 0.1;
+    variants.push(fp(&t, &sel, false, false));
+    let mut t = s;
+    t.distance_error.abs = 0.1;
+    variants.push(fp(&t, &sel, false, false));
+    variants.push(fp(&s, &sel, true, false));
+    variants.push(fp(&s, &sel, false, true));
+    let with = |f: fn(&mut Selection)| {
+        let mut x = Selection::default();
+        f(&mut x);
+        fp(&s, &x, false, false)
+    };
+    variants.push(with(|x| x.scene = true));
+    variants.push(with(|x| x.select_a = vec!["a*".into()]));
+    variants.push(with(|x| x.select_b = vec!["a*".into()]));
+    variants.push(with(|x| x.exclude = vec!["a*".into()]));
+    // Globs are length-prefixed: ["a,b"] and ["a", "b"] differ.
+    variants.push(with(|x| x.exclude = vec!["a,b".into()]));
+    variants.push(with(|x| x.exclude = vec!["a".into(), "b".into()]));
+    let mut all = variants.clone();
+    all.push(base);
+    let distinct: std::collections::HashSet<_> = all.iter().map(|f| f.hex()).collect();
+    assert_eq!(distinct.len(), all.len());
+}

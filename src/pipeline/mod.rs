@@ -345,6 +345,8 @@ pub struct Request {
     pub baseline: Option<PathBuf>,
     /// Shards a partial merge is missing ("1/3", ...): such a run never passes.
     pub missing_shards: Vec<String>,
+    /// `--cache DIR`: reuse a stored outcome of the same check ([`crate::cache::hook`]).
+    pub cache: Option<crate::cache::CacheConfig>,
 }
 
 impl Request {
@@ -475,6 +477,11 @@ pub struct Outcome {
     pub failed: bool,
     /// Load and total times in ms (None in deterministic mode).
     pub times: Option<(f64, f64)>,
+    /// The report's `cache` block (`--cache`).
+    pub cache: Option<crate::cache::CacheSummary>,
+    /// What the cache has to say (entries ignored, results not stored): for stderr, never the
+    /// report (a report is the same with or without the cache).
+    pub cache_warnings: Vec<String>,
 }
 
 impl Outcome {
@@ -573,6 +580,8 @@ pub fn run(req: &Request, progress: &(dyn Fn(Phase) + Sync)) -> Result<Outcome> 
     // written (so `--baseline r.json -o r.json` updates a baseline in place).
     let base = req.baseline.as_deref().map(read_baseline).transpose()?;
     progress(Phase::Load);
+    // A cache directory that cannot be used is refused before anything is loaded.
+    let store = req.cache.as_ref().map(|c| crate::cache::Store::open(&c.dir, c.max_bytes)).transpose()?;
     let t0 = Instant::now();
     let inputs = if req.selection.scene {
         let one = std::sync::Arc::new(load_input(req, 0, "--units-a")?);
@@ -591,9 +600,21 @@ pub fn run(req: &Request, progress: &(dyn Fn(Phase) + Sync)) -> Result<Outcome> 
         return Err(Error::usage(UsageProblem::ToleranceOverflow));
     }
     progress(Phase::Check);
-    let outcome = assembly::run(&a.mesh, &b.mesh, &req.selection, &settings).map_err(|e| {
-        Error::in_file(req.inputs[problem_side(req, &a.mesh)].path(), InputProblem::Selection(e))
-    })?;
+    let cache = store.map(|s| {
+        let fp = crate::cache::hook::check_fingerprint(
+            &settings,
+            &req.selection,
+            req.split_bodies,
+            req.penetration,
+        );
+        let active = req.selection.hook.is_none() && !req.cross_check;
+        std::sync::Arc::new(crate::cache::WholeCheck::new(std::sync::Arc::new(s), fp, active))
+    });
+    let selection = cache.as_ref().map(|c| c.selection(&req.selection));
+    let outcome = assembly::run(&a.mesh, &b.mesh, selection.as_ref().unwrap_or(&req.selection), &settings)
+        .map_err(|e| {
+            Error::in_file(req.inputs[problem_side(req, &a.mesh)].path(), InputProblem::Selection(e))
+        })?;
     let cross_check = if req.cross_check {
         progress(Phase::CrossCheck);
         let p = crate::check::cross_check::parry_f64(&a.mesh, &b.mesh, true)
@@ -670,7 +691,6 @@ pub fn run(req: &Request, progress: &(dyn Fn(Phase) + Sync)) -> Result<Outcome> 
     };
     Ok(Outcome {
         settings: settings_report,
-        assembly: outcome,
         cross_check,
         regions,
         listed,
@@ -681,6 +701,9 @@ pub fn run(req: &Request, progress: &(dyn Fn(Phase) + Sync)) -> Result<Outcome> 
         missing_shards: req.missing_shards.clone(),
         failed,
         times: (!req.deterministic).then(|| (load_ms, t0.elapsed().as_secs_f64() * 1e3)),
+        cache: cache.as_ref().map(|c| c.summary(&outcome)),
+        cache_warnings: cache.as_ref().map_or_else(Vec::new, |c| c.take_warnings()),
+        assembly: outcome,
         inputs,
     })
 }

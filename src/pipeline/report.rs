@@ -142,6 +142,7 @@ pub fn build(o: &Outcome) -> Report {
         }),
         baseline: o.comparison.as_ref().map(|c| c.block.clone()),
         self_check: o.self_check.clone(),
+        cache: o.cache.clone(),
     }
 }
 

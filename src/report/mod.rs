@@ -307,6 +307,11 @@ pub struct Report {
     /// [`self_report::SceneSelfReport`]); absent otherwise.
     #[serde(rename = "self", default, skip_serializing_if = "Option::is_none")]
     pub self_check: Option<self_report::SceneSelfReport>,
+    /// The result cache (`--cache DIR`): how many candidate part pairs reused a stored result
+    /// and how many were checked; absent without `--cache`. Everything else in the report is
+    /// the same with or without the cache.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub cache: Option<crate::cache::CacheSummary>,
 }
 
 /// The finding ids a cut `pairs` list does not show.

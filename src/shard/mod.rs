@@ -291,7 +291,7 @@ impl PartsHook for MergeHook {
 
 /// Every triangle index of a shard's outcome names a triangle of its mesh (a shard report is data
 /// from a file).
-fn in_range(o: &Outcome, meshes: [&Mesh; 2]) -> Result<(), String> {
+pub(crate) fn in_range(o: &Outcome, meshes: [&Mesh; 2]) -> Result<(), String> {
     let n = [meshes[0].triangles.len(), meshes[1].triangles.len()];
     let check = |side: usize, t: u32| {
         if (t as usize) < n[side] {

@@ -196,6 +196,13 @@ impl WireOutcome {
         }
     }
 
+    /// The same outcome with its build and query times set to zero (they are not part of the
+    /// answer).
+    pub fn without_timings(mut self) -> WireOutcome {
+        self.timings = [0.0f64.to_bits(); 2];
+        self
+    }
+
     /// Back to an [`Outcome`], without its parts (the caller has them: `n` of them). Errors
     /// name the bad field.
     pub fn outcome(&self, n: usize) -> Result<Outcome, String> {

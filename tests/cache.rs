@@ -1,0 +1,296 @@
+//! The result cache (`--cache DIR`) through the real binary: a report with the cache is the
+//! report without it, byte for byte, but for the added `cache` block; a moved part, a changed
+//! setting, a corrupt entry, concurrent runs and a baseline comparison change nothing else.
+
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output};
+
+fn bin(dir: &Path) -> Command {
+    let mut c = Command::new(env!("CARGO_BIN_EXE_meshclash"));
+    c.current_dir(dir).env_remove("MESHCLASH_CACHE");
+    c
+}
+
+fn run(dir: &Path, args: &[&str]) -> Output {
+    let o = bin(dir).args(args).output().unwrap();
+    assert!(matches!(o.status.code(), Some(0 | 1)), "{args:?}: {}", String::from_utf8_lossy(&o.stderr));
+    o
+}
+
+fn text(o: &Output) -> String {
+    String::from_utf8(o.stdout.clone()).unwrap()
+}
+
+/// An axis-aligned cube of edge `s` at `min`, as OBJ lines (vertices numbered from `base`).
+fn cube(name: &str, min: [f64; 3], s: f64, base: usize) -> String {
+    let mut out = format!("o {name}\n");
+    for i in 0..8 {
+        let [x, y, z] = [i & 1, (i >> 1) & 1, (i >> 2) & 1].map(|b| b as f64 * s);
+        out += &format!("v {} {} {}\n", min[0] + x, min[1] + y, min[2] + z);
+    }
+    // Outward-wound faces of the unit cube (corner i has bits x, y, z).
+    let faces = [[0, 2, 3, 1], [4, 5, 7, 6], [0, 1, 5, 4], [2, 6, 7, 3], [0, 4, 6, 2], [1, 3, 7, 5]];
+    for f in faces {
+        let v = f.map(|i| i + base + 1);
+        out += &format!("f {} {} {}\nf {} {} {}\n", v[0], v[1], v[2], v[0], v[2], v[3]);
+    }
+    out
+}
+
+/// A row of cubes in one OBJ, one `o` group each.
+fn row(cubes: &[(&str, [f64; 3])]) -> String {
+    cubes.iter().enumerate().map(|(i, (n, m))| cube(n, *m, 1.0, 8 * i)).collect()
+}
+
+/// Overlapping (a, b), close (b, c: 0.05 apart), far (d).
+fn scene_cubes() -> Vec<(&'static str, [f64; 3])> {
+    vec![("a", [0.0; 3]), ("b", [0.5, 0.0, 0.0]), ("c", [1.55, 0.0, 0.0]), ("d", [10.0, 0.0, 0.0])]
+}
+
+fn write(dir: &Path, name: &str, s: &str) -> PathBuf {
+    let p = dir.join(name);
+    std::fs::write(&p, s).unwrap();
+    p
+}
+
+/// The report without its `cache` block (the last member), and the block's three values.
+fn split(report: &str) -> (String, (u64, u64, String)) {
+    let i = report.rfind(",\n  \"cache\": {").expect("a cache block");
+    let end = i + report[i..].find("\n  }").unwrap() + 4;
+    let v: serde_json::Value = serde_json::from_str(report).unwrap();
+    let c = &v["cache"];
+    let counts = (
+        c["part_pairs_reused"].as_u64().unwrap(),
+        c["part_pairs_checked"].as_u64().unwrap(),
+        c["dir"].as_str().unwrap().to_string(),
+    );
+    (format!("{}{}", &report[..i], &report[end..]), counts)
+}
+
+fn candidates(report: &str) -> u64 {
+    let v: serde_json::Value = serde_json::from_str(report).unwrap();
+    v["assembly"]["candidate_part_pairs"].as_u64().expect("assembly.candidate_part_pairs")
+}
+
+const SCENE: [&str; 5] = ["scene", "row.obj", "--no-timings", "--clearance", "0.1"];
+
+fn with(base: &[&str], more: &[&str]) -> Vec<String> {
+    base.iter().chain(more).map(|s| s.to_string()).collect()
+}
+
+fn run_s(dir: &Path, args: &[String]) -> String {
+    text(&run(dir, &args.iter().map(String::as_str).collect::<Vec<_>>()))
+}
+
+#[test]
+fn warm_run_equals_cold_and_reuses_every_candidate_pair() {
+    let d = tempfile::tempdir().unwrap();
+    write(d.path(), "row.obj", &row(&scene_cubes()));
+    let cold = run_s(d.path(), &with(&SCENE, &[]));
+    assert!(!cold.contains("\"cache\""), "no block without --cache");
+    let n = candidates(&cold);
+    assert!(n >= 2, "the scene has candidate pairs: {n}");
+    let first = run_s(d.path(), &with(&SCENE, &["--cache", "c"]));
+    let (body, counts) = split(&first);
+    assert_eq!(body, cold);
+    assert_eq!(counts, (0, n, "c".to_string()));
+    let warm = run_s(d.path(), &with(&SCENE, &["--cache", "c"]));
+    let (body, counts) = split(&warm);
+    assert_eq!(body, cold);
+    assert_eq!(counts, (n, 0, "c".to_string()));
+}
+
+#[test]
+fn two_file_check_warm_equals_cold() {
+    let d = tempfile::tempdir().unwrap();
+    let cubes = scene_cubes();
+    write(d.path(), "a.obj", &row(&cubes[..2]));
+    write(d.path(), "b.obj", &row(&cubes[2..]));
+    let args = ["a.obj", "b.obj", "--no-timings", "--clearance", "0.1"];
+    let cold = run_s(d.path(), &with(&args, &[]));
+    let first = split(&run_s(d.path(), &with(&args, &["--cache", "c"])));
+    let warm = split(&run_s(d.path(), &with(&args, &["--cache", "c"])));
+    assert_eq!(first.0, cold);
+    assert_eq!(warm.0, cold);
+    assert_eq!(warm.1 .1, 0, "nothing checked on a warm run");
+    assert_eq!(warm.1 .0, first.1 .1, "what was checked is reused");
+}
+
+#[test]
+fn environment_variable_names_the_cache() {
+    let d = tempfile::tempdir().unwrap();
+    write(d.path(), "row.obj", &row(&scene_cubes()));
+    let o = bin(d.path()).args(SCENE).env("MESHCLASH_CACHE", "envcache").output().unwrap();
+    assert_eq!(split(&text(&o)).1 .2, "envcache");
+    assert!(d.path().join("envcache/CACHEDIR.TAG").is_file());
+    let o = bin(d.path()).args(SCENE).env("MESHCLASH_CACHE", "").output().unwrap();
+    assert!(!text(&o).contains("\"cache\""), "an empty variable is no cache");
+}
+
+#[test]
+fn moved_part_gives_the_cold_report_of_the_edited_file() {
+    let d = tempfile::tempdir().unwrap();
+    let mut cubes = scene_cubes();
+    write(d.path(), "row.obj", &row(&cubes));
+    run_s(d.path(), &with(&SCENE, &["--cache", "c"]));
+    // Move c so that it touches b exactly.
+    cubes[2].1 = [1.5, 0.0, 0.0];
+    write(d.path(), "row.obj", &row(&cubes));
+    let cold = run_s(d.path(), &with(&SCENE, &[]));
+    let (body, (reused, checked, _)) = split(&run_s(d.path(), &with(&SCENE, &["--cache", "c"])));
+    assert_eq!(body, cold);
+    assert_eq!((reused, checked), (0, candidates(&cold)), "the edited inputs are a new key");
+    assert!(cold.contains("\"touching\""), "the move changed the answer");
+}
+
+#[test]
+fn changed_setting_reuses_nothing() {
+    let d = tempfile::tempdir().unwrap();
+    write(d.path(), "row.obj", &row(&scene_cubes()));
+    run_s(d.path(), &with(&SCENE, &["--cache", "c"]));
+    for extra in [
+        &["--touch-tolerance", "0.01"][..],
+        &["--leaf-size", "2"],
+        &["--mode", "fast"],
+        &["--detail", "parts"],
+        &["--exclude", "d"],
+        &["--penetration"],
+    ] {
+        let args = with(&SCENE, extra);
+        let cold = run_s(d.path(), &args);
+        let mut cached = args.clone();
+        cached.extend(["--cache".to_string(), "c".to_string()]);
+        let (body, (reused, _, _)) = split(&run_s(d.path(), &cached));
+        assert_eq!(body, cold, "{extra:?}");
+        assert_eq!(reused, 0, "{extra:?} changes the key");
+    }
+}
+
+#[test]
+fn corrupt_entry_is_ignored_with_a_warning_and_recomputed() {
+    let d = tempfile::tempdir().unwrap();
+    let file = write(d.path(), "row.obj", &row(&scene_cubes()));
+    let cold = run_s(d.path(), &with(&SCENE, &[]));
+    run_s(d.path(), &with(&SCENE, &["--cache", "c"]));
+    let mut flipped = 0;
+    for sub in std::fs::read_dir(d.path().join("c")).unwrap() {
+        let sub = sub.unwrap().path();
+        if sub.is_dir() {
+            for e in std::fs::read_dir(&sub).unwrap() {
+                let p = e.unwrap().path();
+                let mut b = std::fs::read(&p).unwrap();
+                let mid = b.len() / 2;
+                b[mid] ^= 0x20;
+                std::fs::write(&p, b).unwrap();
+                flipped += 1;
+            }
+        }
+    }
+    assert_eq!(flipped, 1, "one whole-check entry");
+    // Through the library, where the warning is handed over.
+    let mut req = meshclash::pipeline::Request::scene(&file);
+    req.deterministic = true;
+    req.clearance = meshclash::pipeline::Tolerance::Abs(0.1);
+    req.cache = Some(meshclash::cache::CacheConfig {
+        dir: d.path().join("c"),
+        max_bytes: meshclash::cache::DEFAULT_MAX_BYTES,
+    });
+    let o = meshclash::pipeline::run(&req, &|_| {}).unwrap();
+    assert_eq!(o.cache_warnings.len(), 1, "{:?}", o.cache_warnings);
+    assert!(o.cache_warnings[0].contains("ignored entry"), "{:?}", o.cache_warnings);
+    assert_eq!(o.cache.as_ref().unwrap().part_pairs_reused, 0);
+    // Recomputed and stored again: the binary now reuses it and writes the cold report.
+    let (body, (reused, checked, _)) = split(&run_s(d.path(), &with(&SCENE, &["--cache", "c"])));
+    assert_eq!(body, cold);
+    assert_eq!((reused, checked), (candidates(&cold), 0));
+}
+
+#[test]
+fn concurrent_runs_share_one_directory() {
+    let d = tempfile::tempdir().unwrap();
+    write(d.path(), "row.obj", &row(&scene_cubes()));
+    let cold = run_s(d.path(), &with(&SCENE, &[]));
+    let args = with(&SCENE, &["--cache", "c"]);
+    let children: Vec<_> = (0..4)
+        .map(|_| bin(d.path()).args(&args).stdout(std::process::Stdio::piped()).spawn().unwrap())
+        .collect();
+    for c in children {
+        let o = c.wait_with_output().unwrap();
+        assert!(matches!(o.status.code(), Some(0 | 1)));
+        assert_eq!(split(&text(&o)).0, cold);
+    }
+    let (body, (_, checked, _)) = split(&run_s(d.path(), &args));
+    assert_eq!((body, checked), (cold, 0));
+}
+
+#[test]
+fn baseline_comparison_on_a_warm_run_equals_the_cold_one() {
+    let d = tempfile::tempdir().unwrap();
+    let mut cubes = scene_cubes();
+    write(d.path(), "row.obj", &row(&cubes));
+    let base = run(d.path(), &["scene", "row.obj", "--no-timings", "--clearance", "0.1", "-o", "base.json"]);
+    assert!(base.stdout.is_empty());
+    // The overlap goes away, a touch appears.
+    cubes[1].1 = [1.0, 0.0, 0.0];
+    cubes[2].1 = [2.0, 0.0, 0.0];
+    write(d.path(), "row.obj", &row(&cubes));
+    let args = with(&SCENE, &["--baseline", "base.json", "--fail-on", "never"]);
+    let cold = run_s(d.path(), &args);
+    assert!(cold.contains("\"resolved\""), "the baseline block is there");
+    let mut cached = args.clone();
+    cached.extend(["--cache".to_string(), "c".to_string()]);
+    let first = split(&run_s(d.path(), &cached));
+    let warm = split(&run_s(d.path(), &cached));
+    assert_eq!(first.0, cold);
+    assert_eq!(warm.0, cold, "a reused result compares as a checked one");
+    assert_eq!(warm.1 .1, 0);
+}
+
+/// The report's closest pair: the objects and the distance.
+fn closest_parts(report: &str) -> (u64, u64, f64) {
+    let v: serde_json::Value = serde_json::from_str(report).unwrap();
+    let c = &v["closest"];
+    (c["a"]["object"].as_u64().unwrap(), c["b"]["object"].as_u64().unwrap(), c["distance"].as_f64().unwrap())
+}
+
+#[test]
+fn closest_clear_pair_changes_when_one_part_moves_away() {
+    let d = tempfile::tempdir().unwrap();
+    // All apart, within the clearance: c-d are the closest (0.2), a-b next (0.5).
+    let mut cubes =
+        vec![("a", [0.0, 0.0, 0.0]), ("b", [1.5, 0.0, 0.0]), ("c", [5.0, 0.0, 0.0]), ("d", [6.2, 0.0, 0.0])];
+    let args = ["scene", "row.obj", "--no-timings", "--clearance", "1"];
+    write(d.path(), "row.obj", &row(&cubes));
+    let cold = run_s(d.path(), &with(&args, &[]));
+    assert_eq!(split(&run_s(d.path(), &with(&args, &["--cache", "c"]))).0, cold);
+    // d moves away: the closest pair is now a-b, which did not change.
+    cubes[3].1 = [9.0, 0.0, 0.0];
+    write(d.path(), "row.obj", &row(&cubes));
+    let cold_moved = run_s(d.path(), &with(&args, &[]));
+    let before = closest_parts(&cold);
+    let after = closest_parts(&cold_moved);
+    assert_eq!((before.0, before.1), (2, 3), "c-d first: {before:?}");
+    assert_eq!((after.0, after.1), (0, 1), "then a-b: {after:?}");
+    assert!(before.2 < after.2, "{before:?} {after:?}");
+    let warm = split(&run_s(d.path(), &with(&args, &["--cache", "c"])));
+    assert_eq!(warm.0, cold_moved);
+    assert_eq!(closest_parts(&warm.0), after);
+}
+
+#[test]
+fn engine_scene_warm_equals_cold() {
+    let engine = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../shared/meshes/2CylinderEngine.glb");
+    if !engine.is_file() {
+        println!("skipped: {} is absent", engine.display());
+        return;
+    }
+    let d = tempfile::tempdir().unwrap();
+    std::fs::copy(&engine, d.path().join("engine.glb")).unwrap();
+    let args = ["scene", "engine.glb", "--no-timings", "--detail", "parts"];
+    let cold = run_s(d.path(), &with(&args, &[]));
+    let first = split(&run_s(d.path(), &with(&args, &["--cache", "c"])));
+    let warm = split(&run_s(d.path(), &with(&args, &["--cache", "c"])));
+    assert_eq!(first.0, cold);
+    assert_eq!(warm.0, cold);
+    assert_eq!((warm.1 .0, warm.1 .1), (candidates(&cold), 0));
+}
