@@ -74,6 +74,11 @@ pub fn check(cfg: &Config, progress: &(dyn Fn(Phase) + Sync)) -> Result<(report:
     let rep = meshclash::pipeline::report::build(&outcome);
     let mut staged = Staged::new();
     meshclash::output::stage_files(&cfg.outputs, &rep, &outcome, &mut staged)?;
+    // A cache problem (a damaged entry, an unwritable directory) never fails a run and never
+    // changes the report: it is said on stderr.
+    for w in &outcome.cache_warnings {
+        eprintln!("meshclash: warning: {w}");
+    }
     Ok((rep, staged))
 }
 

@@ -1,4 +1,4 @@
-//! Past one machine (issue 14): `plan`, `run --shard I/N`, `merge`.
+//! Past one machine: `plan`, `run --shard I/N`, `merge`.
 //!
 //! A *plan* is the work list of one check: its arguments, its inputs with their SHA-256, and
 //! every candidate part pair the part-level broad phase leaves (no triangle tree is built to
