@@ -224,7 +224,7 @@ fn usage_and_output_messages_are_unchanged() {
     let baseline = dir.path().join("base.json").display().to_string();
     assert_eq!(
         error_of(&[&a, &b, "--baseline", &baseline]),
-        line(&format!("{baseline}: cannot read baseline: No such file or directory (os error 2)"))
+        line(&format!("{baseline}: cannot read baseline: No such file or directory"))
     );
 }
 
