@@ -1563,6 +1563,16 @@ impl From<ExitCode> for std::process::ExitCode {
 /// Shorthand for results in this crate.
 pub type Result<T, E = Error> = std::result::Result<T, E>;
 
+/// Shortens `s` to at most `max` characters for a message, adding `…` when cut; control
+/// characters (NUL, tabs, …) are shown as `?` so the message stays one printable line.
+pub(crate) fn clip(s: &str, max: usize) -> String {
+    let mut out: String = s.chars().take(max).map(|c| if c.is_control() { '?' } else { c }).collect();
+    if s.chars().nth(max).is_some() {
+        out.push('…');
+    }
+    out
+}
+
 #[cfg(test)]
 mod tests {
     //! The errors as data: each case checks the structured fields (path, location, problem)

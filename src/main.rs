@@ -102,12 +102,7 @@ fn main() -> ExitCode {
             if text_out && color.enabled(stdout_tty) {
                 out.stdout = Some(text::render(&out.report, true));
             }
-            let written = match (&out.stdout, out.json_stdout) {
-                (Some(text), _) => write::to_stdout(|w| w.write_all(text.as_bytes())),
-                (None, true) => write::to_stdout(|w| meshclash::output::write_report_json(w, &out.report)),
-                (None, false) => Ok(true),
-            };
-            if let Err(e) = written {
+            if let Err(e) = out.write_stdout() {
                 // All or nothing: the staged files are dropped unwritten.
                 eprintln!("meshclash: error: cannot write to stdout: {e}");
                 return Code::Error.into();

@@ -29,6 +29,19 @@ pub struct Outcome {
     pub staged: Staged,
 }
 
+impl Outcome {
+    /// Write what goes to stdout: the text, or the JSON report streamed
+    /// ([`meshclash::output::write::to_stdout`]: `Ok(false)` when the reader went away).
+    pub fn write_stdout(&self) -> std::io::Result<bool> {
+        use meshclash::output::write;
+        match (&self.stdout, self.json_stdout) {
+            (Some(text), _) => write::to_stdout(|w| w.write_all(text.as_bytes())),
+            (None, true) => write::to_stdout(|w| meshclash::output::write_report_json(w, &self.report)),
+            (None, false) => Ok(true),
+        }
+    }
+}
+
 /// Do the whole job for a validated config (without progress).
 #[cfg(test)]
 pub fn run(cfg: &Config) -> Result<Outcome> {

@@ -526,12 +526,7 @@ fn merge_cmd(a: MergeArgs) -> Result<u8> {
     write::check_outputs(&outputs, &inputs)?;
     let out = cli::run_with_progress(&cfg, &|_| {})?;
     warn(a.quiet, &out.warnings);
-    let written = match (&out.stdout, out.json_stdout) {
-        (Some(text), _) => write::to_stdout(|w| w.write_all(text.as_bytes())),
-        (None, true) => write::to_stdout(|w| meshclash::output::write_report_json(w, &out.report)),
-        (None, false) => Ok(true),
-    };
-    written.map_err(|e| usage(format!("cannot write to stdout: {e}")))?;
+    out.write_stdout().map_err(|e| usage(format!("cannot write to stdout: {e}")))?;
     out.staged.commit()?;
     if partial && !a.quiet {
         eprintln!(

@@ -19,18 +19,18 @@ pub struct Int {
     mag: Vec<u32>,
 }
 
-fn trim(mut m: Vec<u32>) -> Vec<u32> {
+pub(crate) fn trim(mut m: Vec<u32>) -> Vec<u32> {
     while m.last() == Some(&0) {
         m.pop();
     }
     m
 }
 
-fn cmp_mag(a: &[u32], b: &[u32]) -> Ordering {
+pub(crate) fn cmp_mag(a: &[u32], b: &[u32]) -> Ordering {
     a.len().cmp(&b.len()).then_with(|| a.iter().rev().cmp(b.iter().rev()))
 }
 
-fn add_mag(a: &[u32], b: &[u32]) -> Vec<u32> {
+pub(crate) fn add_mag(a: &[u32], b: &[u32]) -> Vec<u32> {
     let (long, short) = if a.len() >= b.len() { (a, b) } else { (b, a) };
     let mut out = Vec::with_capacity(long.len() + 1);
     let mut carry = 0u64;
@@ -46,7 +46,7 @@ fn add_mag(a: &[u32], b: &[u32]) -> Vec<u32> {
 }
 
 /// `a - b` for `|a| >= |b|`.
-fn sub_mag(a: &[u32], b: &[u32]) -> Vec<u32> {
+pub(crate) fn sub_mag(a: &[u32], b: &[u32]) -> Vec<u32> {
     let mut out = Vec::with_capacity(a.len());
     let mut borrow = 0i64;
     for (i, &x) in a.iter().enumerate() {
@@ -58,7 +58,7 @@ fn sub_mag(a: &[u32], b: &[u32]) -> Vec<u32> {
     trim(out)
 }
 
-fn mul_mag(a: &[u32], b: &[u32]) -> Vec<u32> {
+pub(crate) fn mul_mag(a: &[u32], b: &[u32]) -> Vec<u32> {
     if a.is_empty() || b.is_empty() {
         return Vec::new();
     }

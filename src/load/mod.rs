@@ -360,15 +360,7 @@ pub(crate) fn io_message(e: &std::io::Error) -> String {
     }
 }
 
-/// Shortens `s` to at most `max` characters for a message, adding `…` when cut; control
-/// characters (NUL, tabs, …) are shown as `?` so the message stays one printable line.
-pub(crate) fn clip(s: &str, max: usize) -> String {
-    let mut out: String = s.chars().take(max).map(|c| if c.is_control() { '?' } else { c }).collect();
-    if s.chars().nth(max).is_some() {
-        out.push('…');
-    }
-    out
-}
+pub(crate) use crate::error::clip;
 
 /// Drops objects without triangles and renumbers `tri_object`, keeping first-appearance order.
 pub(crate) fn drop_empty_objects(mesh: &mut crate::scene::mesh::Mesh) {

@@ -634,24 +634,13 @@ pub fn run(req: &Request, progress: &(dyn Fn(Phase) + Sync)) -> Result<Outcome> 
     let cut = listed.len() < result.pairs.len();
     // Every finding's id when the list is cut (the report records the unlisted ones) or a
     // baseline compares; else only the listed pairs'.
-    let all: Option<Vec<Finding>> =
-        (cut || base.is_some()).then(|| baseline::findings(&result.pairs, &a.mesh, &b.mesh));
-    let listed_ids: Vec<String> = match &all {
-        Some(f) => listed.iter().map(|&i| f[i].id.clone()).collect(),
-        None => {
-            let pairs: Vec<PairFinding> = listed.iter().map(|&i| result.pairs[i]).collect();
-            baseline::findings(&pairs, &a.mesh, &b.mesh).into_iter().map(|f| f.id).collect()
-        }
-    };
-    let unlisted = match (&all, cut) {
-        (Some(f), true) => Some(baseline::unlisted(f, &listed)),
-        _ => None,
-    };
+    // Every finding's id: an uncut list shows them all, a cut one records the rest under
+    // `unlisted`, and a baseline compares them all.
+    let all: Vec<Finding> = baseline::findings(&result.pairs, &a.mesh, &b.mesh);
+    let listed_ids: Vec<String> = listed.iter().map(|&i| all[i].id.clone()).collect();
+    let unlisted = cut.then(|| baseline::unlisted(&all, &listed));
     let contained = crate::report::ReportContainment::of(&result.containment);
-    let comparison = match (&base, &all) {
-        (Some(base), Some(all)) => Some(compare(base, all, &listed, contained)),
-        _ => None,
-    };
+    let comparison = base.as_ref().map(|base| compare(base, &all, &listed, contained));
     let self_check = req.self_check.as_ref().map(|fail_on| {
         self_block::scene_self_block(
             &a.mesh,

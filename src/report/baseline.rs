@@ -221,13 +221,7 @@ pub fn parse(path: &str, bytes: &[u8]) -> std::result::Result<Baseline, String> 
             } else {
                 ""
             };
-            // At most 60 characters, control characters shown as `?` (one printable line).
-            let mut shown: String =
-                s.chars().take(60).map(|c| if c.is_control() { '?' } else { c }).collect();
-            if s.chars().nth(60).is_some() {
-                shown.push('…');
-            }
-            let s = shown;
+            let s = crate::error::clip(s, 60);
             return Err(format!("baseline is not a meshclash report: its schema is '{s}'{hint}"));
         }
         Some(_) => return Err("baseline is not a meshclash report: its \"schema\" is not a string".into()),

@@ -3,6 +3,7 @@
 //! penetration depth for the few comparisons its float filter cannot decide; small and slow on
 //! purpose (schoolbook multiplication on base-2^32 limbs).
 
+use crate::geom::exact::{add_mag, cmp_mag, mul_mag, sub_mag, trim};
 use std::cmp::Ordering;
 
 /// `(-1)^neg · mag · 2^exp`, `mag` little-endian base-2^32 limbs without trailing zero limbs
@@ -12,64 +13,6 @@ pub struct Dyadic {
     neg: bool,
     mag: Vec<u32>,
     exp: i64,
-}
-
-fn trim(mut m: Vec<u32>) -> Vec<u32> {
-    while m.last() == Some(&0) {
-        m.pop();
-    }
-    m
-}
-
-fn cmp_mag(a: &[u32], b: &[u32]) -> Ordering {
-    a.len().cmp(&b.len()).then_with(|| a.iter().rev().cmp(b.iter().rev()))
-}
-
-fn add_mag(a: &[u32], b: &[u32]) -> Vec<u32> {
-    let (long, short) = if a.len() >= b.len() { (a, b) } else { (b, a) };
-    let mut out = Vec::with_capacity(long.len() + 1);
-    let mut carry = 0u64;
-    for (i, &x) in long.iter().enumerate() {
-        let s = x as u64 + short.get(i).copied().unwrap_or(0) as u64 + carry;
-        out.push(s as u32);
-        carry = s >> 32;
-    }
-    if carry > 0 {
-        out.push(carry as u32);
-    }
-    out
-}
-
-/// `a - b` for `|a| >= |b|`.
-fn sub_mag(a: &[u32], b: &[u32]) -> Vec<u32> {
-    let mut out = Vec::with_capacity(a.len());
-    let mut borrow = 0i64;
-    for (i, &x) in a.iter().enumerate() {
-        let mut d = x as i64 - b.get(i).copied().unwrap_or(0) as i64 - borrow;
-        borrow = (d < 0) as i64;
-        if d < 0 {
-            d += 1 << 32;
-        }
-        out.push(d as u32);
-    }
-    trim(out)
-}
-
-fn mul_mag(a: &[u32], b: &[u32]) -> Vec<u32> {
-    if a.is_empty() || b.is_empty() {
-        return Vec::new();
-    }
-    let mut out = vec![0u32; a.len() + b.len()];
-    for (i, &x) in a.iter().enumerate() {
-        let mut carry = 0u64;
-        for (j, &y) in b.iter().enumerate() {
-            let t = out[i + j] as u64 + x as u64 * y as u64 + carry;
-            out[i + j] = t as u32;
-            carry = t >> 32;
-        }
-        out[i + b.len()] = carry as u32;
-    }
-    trim(out)
 }
 
 fn shl_mag(a: &[u32], bits: u64) -> Vec<u32> {
