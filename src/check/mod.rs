@@ -10,6 +10,7 @@ pub mod cross_check;
 pub mod fans;
 pub mod finding_id;
 pub mod health;
+pub mod overlap;
 pub mod query;
 pub mod regions;
 pub mod self_clash;

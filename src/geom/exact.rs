@@ -142,6 +142,23 @@ impl Int {
         (m, 32 * n.saturating_sub(3) as i64)
     }
 
+    /// `self · 2^bits`.
+    pub fn shl(&self, bits: u32) -> Int {
+        if self.mag.is_empty() {
+            return Int::default();
+        }
+        let (limbs, rest) = ((bits / 32) as usize, bits % 32);
+        let mut mag = vec![0u32; limbs];
+        let mut carry = 0u32;
+        for &l in &self.mag {
+            let wide = (l as u64) << rest;
+            mag.push(wide as u32 | carry);
+            carry = (wide >> 32) as u32;
+        }
+        mag.push(carry);
+        Int::new(self.neg, mag)
+    }
+
     /// Numeric order.
     pub fn cmp_value(&self, o: &Int) -> Ordering {
         match (self.neg, o.neg) {
@@ -248,6 +265,107 @@ pub fn weighted_sum(terms: impl IntoIterator<Item = (i64, Int)>) -> Int {
     terms.into_iter().fold(Int::default(), |s, (w, x)| s.add(&Int::from_i64(w).mul(&x)))
 }
 
+/// A rational `num / den · 2^base` (`den > 0`): a coordinate of a point computed exactly in a
+/// [`Frame`] (`base` is the frame's, times the degree of the expression).
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct Ratio {
+    /// Numerator.
+    pub num: Int,
+    /// Denominator (positive).
+    pub den: Int,
+}
+
+impl Ratio {
+    /// `num / den`; `den` must not be zero (its sign is moved to the numerator).
+    pub fn new(num: Int, den: Int) -> Ratio {
+        debug_assert!(den.signum() != 0, "zero denominator");
+        if den.signum() < 0 {
+            Ratio { num: num.neg(), den: den.neg() }
+        } else {
+            Ratio { num, den }
+        }
+    }
+
+    /// The integer `v`.
+    pub fn int(v: Int) -> Ratio {
+        Ratio { num: v, den: Int::from_i64(1) }
+    }
+
+    /// Numeric order (both at the same scale).
+    pub fn cmp_value(&self, o: &Ratio) -> Ordering {
+        self.num.mul(&o.den).cmp_value(&o.num.mul(&self.den))
+    }
+
+    /// `self · 2^base` rounded once to the nearest f64 (ties to even): the correctly rounded
+    /// value. `self · 2^base` must lie within the finite f64 range.
+    pub fn round(&self, base: i32) -> f64 {
+        if self.num.signum() == 0 {
+            return 0.0;
+        }
+        let ((mn, en), (md, ed)) = (self.num.approx(), self.den.approx());
+        // An estimate within a few units in the last place, then corrected exactly.
+        let mut x = ldexp(mn / md, en - ed + base as i64);
+        for _ in 0..4096 {
+            let (down, up) = (x.next_down(), x.next_up());
+            let above = self.cmp_dyadic(base, &Dyadic::mid(x, up));
+            let below = self.cmp_dyadic(base, &Dyadic::mid(down, x));
+            x = match (above, below) {
+                (Ordering::Greater, _) => up,
+                (_, Ordering::Less) => down,
+                (Ordering::Equal, _) if x.to_bits() & 1 == 1 => up,
+                (_, Ordering::Equal) if x.to_bits() & 1 == 1 => down,
+                _ => return x,
+            };
+        }
+        x
+    }
+
+    /// Compare `self · 2^base` with a dyadic value.
+    fn cmp_dyadic(&self, base: i32, d: &Dyadic) -> Ordering {
+        let low = base.min(d.exp);
+        let lhs = self.num.shl((base - low) as u32);
+        let rhs = d.mant.mul(&self.den).shl((d.exp - low) as u32);
+        lhs.cmp_value(&rhs)
+    }
+}
+
+/// `mant · 2^exp`, exactly.
+#[derive(Clone, Debug)]
+struct Dyadic {
+    mant: Int,
+    exp: i32,
+}
+
+impl Dyadic {
+    fn of(x: f64) -> Dyadic {
+        let (neg, m, e) = decompose(x);
+        Dyadic { mant: Int::from_parts(neg, m, 0), exp: e }
+    }
+
+    /// The exact midpoint of two finite values (an infinite one counts as the other plus its
+    /// distance to its neighbour, so the midpoint stays beyond every finite value between).
+    fn mid(x: f64, y: f64) -> Dyadic {
+        let finite = |v: f64, other: f64| if v.is_finite() { v } else { other + (other - other.next_down()) };
+        let (x, y) = (finite(x, y), finite(y, x));
+        let (dx, dy) = (Dyadic::of(x), Dyadic::of(y));
+        let low = dx.exp.min(dy.exp);
+        let sum = dx.mant.shl((dx.exp - low) as u32).add(&dy.mant.shl((dy.exp - low) as u32));
+        Dyadic { mant: sum, exp: low - 1 }
+    }
+}
+
+/// `m · 2^e` in f64 (an estimate: each step rounds), saturating to 0 or infinity.
+fn ldexp(m: f64, e: i64) -> f64 {
+    let mut x = m;
+    let mut e = e.clamp(-4000, 4000) as i32;
+    while e != 0 {
+        let step = e.clamp(-1000, 1000);
+        x *= 2f64.powi(step);
+        e -= step;
+    }
+    x
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -315,5 +433,36 @@ mod tests {
                 assert_eq!(orient2d(&f, p[0], p[1], p[2], k).signum(), pr::orient2d(p[0], p[1], p[2], k));
             }
         }
+    }
+
+    #[test]
+    fn ratios_round_correctly() {
+        let mut s = 0x9e37_79b9_7f4a_7c15u64;
+        let mut rnd = || {
+            s ^= s << 13;
+            s ^= s >> 7;
+            s ^= s << 17;
+            s
+        };
+        for _ in 0..5000 {
+            // Operands exact in f64, so one IEEE division is the correctly rounded quotient.
+            let n = (rnd() >> 11) as i64 * if rnd() & 1 == 0 { 1 } else { -1 };
+            let d = ((rnd() >> (11 + rnd() % 50)) as i64).max(1);
+            let base = (rnd() % 40) as i32 - 20;
+            let r = Ratio::new(Int::from_i64(n), Int::from_i64(d));
+            let want = n as f64 / d as f64 * 2f64.powi(base);
+            assert_eq!(r.round(base), want, "{n}/{d} · 2^{base}");
+            let neg = Ratio::new(Int::from_i64(n), Int::from_i64(-d));
+            assert_eq!(neg.round(base), -want);
+        }
+        // Ties go to even: (2^53 + 1) / 1 lies halfway between 2^53 and 2^53 + 2.
+        let tie = Ratio::int(Int::from_i64((1 << 53) + 1));
+        assert_eq!(tie.round(0), 9_007_199_254_740_992.0);
+        let tie = Ratio::int(Int::from_i64((1 << 53) + 3));
+        assert_eq!(tie.round(0), 9_007_199_254_740_996.0);
+        assert_eq!(
+            Ratio::new(Int::from_i64(1), Int::from_i64(3)).cmp_value(&Ratio::int(Int::default())),
+            Ordering::Greater
+        );
     }
 }

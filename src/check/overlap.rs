@@ -1,0 +1,433 @@
+//! The exact overlap box of two clashing closed parts: the axis-aligned box of the solid
+//! intersection A ∩ B.
+//!
+//! A ∩ B of two closed polyhedral solids is a closed polyhedral set; each extreme of it along
+//! an axis is reached at one of its vertices, and every vertex of A ∩ B is
+//!
+//! * a vertex of A inside (or on) B, or a vertex of B inside (or on) A, or
+//! * a point where an edge of one part meets a face (triangle) of the other: a crossing point,
+//!   or — for an edge lying in the face's plane — an end of the piece of the edge inside the
+//!   triangle (where the edge meets the other part's edges, or its own ends).
+//!
+//! The box of those points is therefore the box of A ∩ B. Each point is computed exactly: f64
+//! coordinates are integers in a common [`Frame`], an edge `p q` meets the plane of a triangle
+//! at `p + t (q - p)` with `t` a ratio of two orientation determinants (for an edge in the
+//! plane, `t` is a ratio of two 2D determinants), so every coordinate is a [`Ratio`] of
+//! integers. Extremes are compared exactly and each bound is rounded once, to the nearest f64
+//! ([`Ratio::round`]). The box depends only on the two solids, not on how they are tessellated.
+//!
+//! Edge–face candidates come from the other part's tree (triangles whose boxes meet the edge's
+//! box), so the cost follows the contact, not the product of the sizes. A vertex strictly
+//! inside the box found so far cannot move it and costs no point query. Only closed parts have
+//! an inside: [`overlap_box`] is for closed parts (the pipeline asks only for those). When the
+//! exact point-in-solid test cannot decide a vertex (every ray direction it tries meets an edge
+//! exactly), there is no box rather than a doubtful one.
+
+use crate::bvh::traverse::{self, Tree};
+use crate::check::containment::{self, Inside};
+use crate::geom::exact::{self, Frame, Int, Ratio};
+use crate::geom::predicates as pr;
+use crate::geom::{Aabb, DVec3};
+use crate::narrow::tri_tri::Shape;
+use crate::scene::mesh::TriMesh;
+
+/// The box of A ∩ B, each bound correctly rounded to f64.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Overlap {
+    /// Lower corner.
+    pub min: DVec3,
+    /// Upper corner.
+    pub max: DVec3,
+}
+
+impl Overlap {
+    /// `max - min` per axis (f64 differences of the rounded bounds).
+    pub fn extent(&self) -> DVec3 {
+        self.max - self.min
+    }
+
+    /// As an [`Aabb`].
+    pub fn aabb(&self) -> Aabb {
+        Aabb { min: self.min, max: self.max }
+    }
+}
+
+/// A point with exact rational coordinates in the frame (all three over one denominator).
+struct Point {
+    num: [Int; 3],
+    den: Int,
+}
+
+/// The exact box of the candidate points seen so far, with f64 bounds that let most vertices
+/// be skipped without exact arithmetic.
+struct ExactBox {
+    frame: Frame,
+    lo: [Option<Ratio>; 3],
+    hi: [Option<Ratio>; 3],
+    /// Per axis, a value at or above `lo` and one at or below `hi` (the rounded bounds moved
+    /// one step inwards): a vertex strictly between them is strictly inside the box.
+    inner: [(f64, f64); 3],
+}
+
+impl ExactBox {
+    fn new(frame: Frame) -> ExactBox {
+        ExactBox {
+            frame,
+            lo: [None, None, None],
+            hi: [None, None, None],
+            inner: [(f64::INFINITY, f64::NEG_INFINITY); 3],
+        }
+    }
+
+    fn add(&mut self, p: Point) {
+        for k in 0..3 {
+            let r = || Ratio::new(p.num[k].clone(), p.den.clone());
+            let mut changed = false;
+            if self.lo[k].as_ref().is_none_or(|lo| r().cmp_value(lo).is_lt()) {
+                self.lo[k] = Some(r());
+                changed = true;
+            }
+            if self.hi[k].as_ref().is_none_or(|hi| r().cmp_value(hi).is_gt()) {
+                self.hi[k] = Some(r());
+                changed = true;
+            }
+            if changed {
+                let base = self.frame.base();
+                let lo = self.lo[k].as_ref().map_or(f64::INFINITY, |r| r.round(base).next_up());
+                let hi = self.hi[k].as_ref().map_or(f64::NEG_INFINITY, |r| r.round(base).next_down());
+                self.inner[k] = (lo, hi);
+            }
+        }
+    }
+
+    fn add_vertex(&mut self, v: DVec3) {
+        let num = self.frame.point(v);
+        self.add(Point { num, den: Int::from_i64(1) });
+    }
+
+    /// True if `v` is strictly inside the box (so it cannot move it).
+    fn strictly_inside(&self, v: DVec3) -> bool {
+        (0..3).all(|k| self.inner[k].0 <= v[k] && v[k] <= self.inner[k].1)
+    }
+
+    fn finish(&self) -> Option<Overlap> {
+        let base = self.frame.base();
+        let bound = |r: &Option<Ratio>| r.as_ref().map(|r| r.round(base));
+        let mut min = DVec3::ZERO;
+        let mut max = DVec3::ZERO;
+        for k in 0..3 {
+            min[k] = bound(&self.lo[k])?;
+            max[k] = bound(&self.hi[k])?;
+        }
+        Some(Overlap { min, max })
+    }
+}
+
+/// The undirected edges (vertex index pairs) of the proper triangles of `m`.
+fn edges<M: TriMesh + ?Sized>(m: &M) -> Vec<(u32, u32)> {
+    let mut out = Vec::with_capacity(m.triangle_count() * 3);
+    for t in 0..m.triangle_count() as u32 {
+        if Shape::of(&m.triangle(t)).is_degenerate() {
+            continue;
+        }
+        let v = m.indices(t);
+        for k in 0..3 {
+            let (a, b) = (v[k], v[(k + 1) % 3]);
+            out.push((a.min(b), a.max(b)));
+        }
+    }
+    out.sort_unstable();
+    out.dedup();
+    out
+}
+
+/// The point `p + t (q - p)` for `t = n / d` (`d != 0`).
+fn along(f: &Frame, p: DVec3, q: DVec3, n: &Int, d: &Int) -> Point {
+    let (ip, iq) = (f.point(p), f.point(q));
+    let num = [0, 1, 2].map(|k| ip[k].mul(d).add(&n.mul(&iq[k].sub(&ip[k]))));
+    Point { num, den: d.clone() }
+}
+
+/// Add to `acc` the points of segment `p q` ∩ closed triangle `tri` that can be vertices of
+/// the intersection: the crossing point, or the ends of the piece inside a coplanar triangle.
+fn edge_face(acc: &mut ExactBox, p: DVec3, q: DVec3, tri: [DVec3; 3]) {
+    let [a, b, c] = tri;
+    let (sp, sq) = (pr::orient3d(a, b, c, p), pr::orient3d(a, b, c, q));
+    if sp * sq > 0 {
+        return;
+    }
+    let f = acc.frame;
+    if sp == 0 && sq == 0 {
+        coplanar(acc, p, q, tri);
+        return;
+    }
+    // The line crosses the plane once: inside the closed triangle iff the three orientations
+    // of the line against the triangle's edges have no two opposite signs.
+    let s = [pr::orient3d(p, q, a, b), pr::orient3d(p, q, b, c), pr::orient3d(p, q, c, a)];
+    if s.contains(&1) && s.contains(&-1) {
+        return;
+    }
+    let point = match (sp, sq) {
+        (0, _) => Point { num: f.point(p), den: Int::from_i64(1) },
+        (_, 0) => Point { num: f.point(q), den: Int::from_i64(1) },
+        _ => {
+            let vp = exact::orient3d(&f, a, b, c, p);
+            let vq = exact::orient3d(&f, a, b, c, q);
+            let d = vp.sub(&vq);
+            along(&f, p, q, &vp, &d)
+        }
+    };
+    acc.add(point);
+}
+
+/// Segment `p q` in the plane of the proper triangle `tri`: clip it to the triangle in the
+/// projection that drops an axis the triangle is not parallel to, and add the ends.
+fn coplanar(acc: &mut ExactBox, p: DVec3, q: DVec3, tri: [DVec3; 3]) {
+    let f = acc.frame;
+    let Some(axis) = (0..3).find(|&k| pr::orient2d(tri[0], tri[1], tri[2], k) != 0) else {
+        return;
+    };
+    let s = pr::orient2d(tri[0], tri[1], tri[2], axis);
+    // t in [lo, hi], as ratios n / d with d > 0.
+    let (zero, one) = (Int::default(), Int::from_i64(1));
+    let mut lo = Ratio::new(zero.clone(), one.clone());
+    let mut hi = Ratio::new(one.clone(), one.clone());
+    for k in 0..3 {
+        let (u, v) = (tri[k], tri[(k + 1) % 3]);
+        // g(t) = s · orient2d(u, v, p + t (q - p)) = gp + t (gq - gp) must be >= 0.
+        let sign = Int::from_i64(s as i64);
+        let gp = exact::orient2d(&f, u, v, p, axis).mul(&sign);
+        let gq = exact::orient2d(&f, u, v, q, axis).mul(&sign);
+        let slope = gq.sub(&gp);
+        match slope.signum() {
+            0 => {
+                if gp.signum() < 0 {
+                    return;
+                }
+            }
+            1 => {
+                // t >= -gp / slope
+                let t = Ratio::new(gp.neg(), slope);
+                if t.cmp_value(&lo).is_gt() {
+                    lo = t;
+                }
+            }
+            _ => {
+                let t = Ratio::new(gp.neg(), slope);
+                if t.cmp_value(&hi).is_lt() {
+                    hi = t;
+                }
+            }
+        }
+    }
+    if lo.cmp_value(&hi).is_gt() {
+        return;
+    }
+    for t in [lo, hi] {
+        acc.add(along(&f, p, q, &t.num, &t.den));
+    }
+}
+
+/// Is `v` inside or on the closed part `m` (tree `t`)? None when undecided.
+fn inside_or_on<M: TriMesh + ?Sized, T: Tree + ?Sized>(v: DVec3, m: &M, t: &T) -> Option<bool> {
+    if !t.root_box().contains(&Aabb { min: v, max: v }) {
+        return Some(false);
+    }
+    if containment::on_surface(v, m, t) {
+        return Some(true);
+    }
+    match containment::point_in_closed_mesh(v, m, t) {
+        Inside::Yes => Some(true),
+        Inside::No => Some(false),
+        Inside::Undecided => None,
+    }
+}
+
+/// The exact box of A ∩ B for two closed parts `a` and `b` with trees `ta` and `tb` over their
+/// triangles; None when they do not overlap (not even touch), or when a vertex's inside test
+/// cannot be decided. See the module docs.
+pub fn overlap_box<A, TA, B, TB>(a: &A, ta: &TA, b: &B, tb: &TB) -> Option<Overlap>
+where
+    A: TriMesh + ?Sized,
+    TA: Tree + ?Sized,
+    B: TriMesh + ?Sized,
+    TB: Tree + ?Sized,
+{
+    if !ta.root_box().overlaps(&tb.root_box()) {
+        return None;
+    }
+    let frame = Frame::of_points(a.positions().iter().chain(b.positions().iter()));
+    let mut acc = ExactBox::new(frame);
+    edges_against(&mut acc, a, b, tb);
+    edges_against(&mut acc, b, a, ta);
+    vertices_inside(&mut acc, a, b, tb)?;
+    vertices_inside(&mut acc, b, a, ta)?;
+    acc.finish()
+}
+
+/// The points where the edges of `m` meet the faces of `other` (tree `tree`).
+fn edges_against<M, O, T>(acc: &mut ExactBox, m: &M, other: &O, tree: &T)
+where
+    M: TriMesh + ?Sized,
+    O: TriMesh + ?Sized,
+    T: Tree + ?Sized,
+{
+    let other_box = tree.root_box();
+    for (i, j) in edges(m) {
+        let (p, q) = (m.vertex(i), m.vertex(j));
+        let seg = Aabb { min: p.min(q), max: p.max(q) };
+        if !seg.overlaps(&other_box) {
+            continue;
+        }
+        traverse::any_in_box(tree, &seg, |t| {
+            let tri = other.triangle(t);
+            if !Shape::of(&tri).is_degenerate() {
+                edge_face(acc, p, q, tri);
+            }
+            false
+        });
+    }
+}
+
+/// The vertices of `m` (of its proper triangles) inside or on `other`; None when one cannot be
+/// decided.
+fn vertices_inside<M, O, T>(acc: &mut ExactBox, m: &M, other: &O, tree: &T) -> Option<()>
+where
+    M: TriMesh + ?Sized,
+    O: TriMesh + ?Sized,
+    T: Tree + ?Sized,
+{
+    let mut used = vec![false; m.vertex_count()];
+    for t in 0..m.triangle_count() as u32 {
+        if !Shape::of(&m.triangle(t)).is_degenerate() {
+            m.indices(t).iter().for_each(|&v| used[v as usize] = true);
+        }
+    }
+    for v in (0..used.len()).filter(|&v| used[v]) {
+        let p = m.vertex(v as u32);
+        if acc.strictly_inside(p) {
+            continue;
+        }
+        if inside_or_on(p, other, tree)? {
+            acc.add_vertex(p);
+        }
+    }
+    Some(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::bvh::{BuildOptions, Bvh};
+    use crate::scene::mesh::{Mesh, Object};
+
+    /// An axis-aligned box with each face cut into `n × n` squares of two triangles, outward.
+    fn grid_box(min: DVec3, max: DVec3, n: usize) -> Mesh {
+        let mut positions = Vec::new();
+        let mut triangles = Vec::new();
+        for axis in 0..3 {
+            for side in 0..2 {
+                let (i, j) = ((axis + 1) % 3, (axis + 2) % 3);
+                let at = |u: usize, v: usize| {
+                    let mut p = DVec3::ZERO;
+                    p[axis] = if side == 0 { min[axis] } else { max[axis] };
+                    // Ends exact; inner points rounded within the face's plane (same solid).
+                    let lerp = |k: usize, w: usize| {
+                        if w == n {
+                            max[k]
+                        } else {
+                            min[k] + (max[k] - min[k]) * w as f64 / n as f64
+                        }
+                    };
+                    p[i] = lerp(i, u);
+                    p[j] = lerp(j, v);
+                    p
+                };
+                let start = positions.len() as u32;
+                for u in 0..=n {
+                    for v in 0..=n {
+                        positions.push(at(u, v));
+                    }
+                }
+                let id = |u: usize, v: usize| start + (u * (n + 1) + v) as u32;
+                for u in 0..n {
+                    for v in 0..n {
+                        let (a, b, c, d) = (id(u, v), id(u + 1, v), id(u + 1, v + 1), id(u, v + 1));
+                        if side == 1 {
+                            triangles.extend([[a, b, c], [a, c, d]]);
+                        } else {
+                            triangles.extend([[a, c, b], [a, d, c]]);
+                        }
+                    }
+                }
+            }
+        }
+        let t = triangles.len();
+        Mesh { positions, triangles, tri_object: vec![0; t], objects: vec![Object::default()] }
+    }
+
+    fn boxed(a: &Mesh, b: &Mesh) -> Option<Overlap> {
+        let (ta, tb) = (Bvh::build(a, BuildOptions::default()), Bvh::build(b, BuildOptions::default()));
+        overlap_box(a, &ta, b, &tb)
+    }
+
+    fn v(x: f64, y: f64, z: f64) -> DVec3 {
+        DVec3::new(x, y, z)
+    }
+
+    #[test]
+    fn boxes_overlap_in_their_common_box_at_every_tessellation() {
+        for n in [1, 2, 3, 5] {
+            for m in [1, 4] {
+                let a = grid_box(v(0.0, 0.0, 0.0), v(2.0, 1.0, 1.0), n);
+                let b = grid_box(v(0.5, 0.4, -1.0), v(3.0, 0.7, 0.6), m);
+                let want = Overlap { min: v(0.5, 0.4, 0.0), max: v(2.0, 0.7, 0.6) };
+                assert_eq!(boxed(&a, &b), Some(want), "n={n} m={m}");
+                assert_eq!(boxed(&b, &a), Some(want), "n={n} m={m}");
+            }
+        }
+    }
+
+    #[test]
+    fn nested_touching_and_apart() {
+        let outer = grid_box(v(0.0, 0.0, 0.0), v(4.0, 4.0, 4.0), 2);
+        let inner = grid_box(v(1.0, 1.5, 1.0), v(2.0, 2.0, 3.0), 3);
+        let want = Overlap { min: v(1.0, 1.5, 1.0), max: v(2.0, 2.0, 3.0) };
+        assert_eq!(boxed(&outer, &inner), Some(want));
+        assert_eq!(boxed(&inner, &outer), Some(want));
+        // Face to face: A ∩ B is the shared square (flat).
+        let side = grid_box(v(4.0, 1.0, 1.0), v(5.0, 2.0, 2.0), 1);
+        assert_eq!(boxed(&outer, &side), Some(Overlap { min: v(4.0, 1.0, 1.0), max: v(4.0, 2.0, 2.0) }));
+        let apart = grid_box(v(5.0, 1.0, 1.0), v(6.0, 2.0, 2.0), 1);
+        assert_eq!(boxed(&outer, &apart), None);
+    }
+
+    #[test]
+    fn tilted_crossing_points_are_rounded_once() {
+        // A box against a tetrahedron whose edges cross the box's faces at thirds.
+        let a = grid_box(v(0.0, 0.0, 0.0), v(1.0, 1.0, 1.0), 1);
+        let b = Mesh {
+            positions: vec![v(0.5, 0.5, 0.5), v(3.5, 0.5, 0.5), v(0.5, 2.0, 0.5), v(0.5, 0.5, 1.25)],
+            triangles: vec![[0, 2, 1], [0, 1, 3], [0, 3, 2], [1, 2, 3]],
+            tri_object: vec![0; 4],
+            objects: vec![Object::default()],
+        };
+        // The tetrahedron has its right-angle corner at (0.5, 0.5, 0.5) and reaches past the
+        // box on every axis there, so A ∩ B spans [0.5, 1]³.
+        let o = boxed(&a, &b).unwrap();
+        assert_eq!(o, Overlap { min: v(0.5, 0.5, 0.5), max: v(1.0, 1.0, 1.0) });
+        let inv = Mesh { triangles: b.triangles.iter().map(|t| [t[0], t[2], t[1]]).collect(), ..b.clone() };
+        assert_eq!(boxed(&inv, &a), Some(o));
+        // A tetrahedron sliced by a slab 1 <= x <= 2: the y extremes are crossings at thirds.
+        let t = Mesh {
+            positions: vec![v(0.0, 0.0, 0.0), v(3.0, 1.0, 0.0), v(3.0, -1.0, 0.0), v(0.0, 0.0, 3.0)],
+            triangles: vec![[0, 2, 1], [0, 1, 3], [0, 3, 2], [1, 2, 3]],
+            tri_object: vec![0; 4],
+            objects: vec![Object::default()],
+        };
+        let slab = grid_box(v(1.0, -5.0, -5.0), v(2.0, 5.0, 5.0), 2);
+        let want = Overlap { min: v(1.0, -2.0 / 3.0, 0.0), max: v(2.0, 2.0 / 3.0, 2.0) };
+        assert_eq!(boxed(&t, &slab), Some(want));
+        assert_eq!(boxed(&slab, &t), Some(want));
+    }
+}
