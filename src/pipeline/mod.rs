@@ -458,6 +458,10 @@ pub struct Outcome {
     pub cross_check: Option<CrossCheckReport>,
     /// Connected interferences (with penetration estimates when asked).
     pub regions: Vec<crate::check::regions::Region>,
+    /// The exact box of A ∩ B per part pair (same order as `assembly.part_pairs`): for each pair
+    /// whose verdict is clash and whose two parts are closed ([`crate::check::overlap`]); None
+    /// for the others.
+    pub overlaps: Vec<Option<crate::check::overlap::Overlap>>,
     /// Indices into `assembly.result.pairs` of the pairs the report lists: all of them, or when
     /// there are more than `max_pairs`, the worst (crossing, then touching, then within the
     /// touch tolerance, then clearance by distance), sorted by (a, b).
@@ -630,6 +634,7 @@ pub fn run(req: &Request, progress: &(dyn Fn(Phase) + Sync)) -> Result<Outcome> 
         let opts = BuildOptions::default();
         crate::check::regions::estimate_penetration(&mut regions, &result.pairs, &a.mesh, &b.mesh, opts);
     }
+    let overlaps = overlaps(&outcome, &a.mesh, &b.mesh, req.selection.scene, req.settings.bvh);
     let listed = listed_pairs(&result.pairs, req.max_pairs);
     let cut = listed.len() < result.pairs.len();
     // Every finding's id when the list is cut (the report records the unlisted ones) or a
@@ -682,6 +687,7 @@ pub fn run(req: &Request, progress: &(dyn Fn(Phase) + Sync)) -> Result<Outcome> 
         settings: settings_report,
         cross_check,
         regions,
+        overlaps,
         listed,
         listed_ids,
         unlisted,
@@ -695,6 +701,51 @@ pub fn run(req: &Request, progress: &(dyn Fn(Phase) + Sync)) -> Result<Outcome> 
         assembly: outcome,
         inputs,
     })
+}
+
+/// The exact overlap box of every clashing part pair of two closed parts (None for the other
+/// pairs). Each part involved is copied and gets a tree once, however many pairs it is in; parts
+/// and pairs run in parallel, and the answer does not depend on the thread count.
+fn overlaps(
+    o: &assembly::Outcome,
+    a: &Mesh,
+    b: &Mesh,
+    scene: bool,
+    opts: BuildOptions,
+) -> Vec<Option<crate::check::overlap::Overlap>> {
+    use rayon::prelude::*;
+    let clashing = |pp: &&assembly::PartPairSummary| pp.verdict == query::Verdict::Clash;
+    let mut wanted: Vec<usize> = o.part_pairs.iter().filter(clashing).flat_map(|pp| [pp.a, pp.b]).collect();
+    wanted.sort_unstable();
+    wanted.dedup();
+    let solids: std::collections::HashMap<usize, Option<(Mesh, crate::bvh::Bvh)>> = wanted
+        .par_iter()
+        .map(|&i| {
+            let part = &o.parts[i];
+            let m = if part.input == 0 || scene { a } else { b };
+            let mesh = m.sub_mesh(&part.triangles);
+            let closed = crate::check::containment::topology(&mesh).closed;
+            (
+                i,
+                closed.then(|| {
+                    let tree = crate::bvh::Bvh::build(&mesh, opts);
+                    (mesh, tree)
+                }),
+            )
+        })
+        .collect();
+    o.part_pairs
+        .par_iter()
+        .map(|pp| {
+            if pp.verdict != query::Verdict::Clash {
+                return None;
+            }
+            let (Some(Some((ma, ta))), Some(Some((mb, tb)))) = (solids.get(&pp.a), solids.get(&pp.b)) else {
+                return None;
+            };
+            crate::check::overlap::overlap_box(ma, ta, mb, tb)
+        })
+        .collect()
 }
 
 /// Read a baseline report: a regular file of bounded size (never blocking on a FIFO), parsed

@@ -64,7 +64,11 @@ pub fn build(o: &Outcome) -> Report {
     let r = &o.assembly.result;
     let (infa, infb) = (MeshInfo::of(&ia.input.mesh), MeshInfo::of(&ib.input.mesh));
     let (oa, ob) = (&ia.input.mesh.tri_object, &ib.input.mesh.tri_object);
-    let (assembly, parts, part_pairs) = assembly_view(&o.assembly, o.settings.max_pairs);
+    let (assembly, parts, mut part_pairs) = assembly_view(&o.assembly, o.settings.max_pairs);
+    for (pp, ov) in part_pairs.iter_mut().zip(&o.overlaps) {
+        pp.overlap = ov.as_ref().map(OverlapReport::of);
+    }
+    let region_overlap = region_overlaps(o);
     let pairs = o
         .listed
         .iter()
@@ -114,7 +118,8 @@ pub fn build(o: &Outcome) -> Report {
         regions: o
             .regions
             .iter()
-            .map(|g| RegionReport {
+            .zip(region_overlap)
+            .map(|(g, overlap)| RegionReport {
                 a_name: ia.input.mesh.objects[g.objects.0 as usize].name.clone(),
                 b_name: ib.input.mesh.objects[g.objects.1 as usize].name.clone(),
                 id: g.id.clone(),
@@ -131,6 +136,7 @@ pub fn build(o: &Outcome) -> Report {
                     side: if p.side == 0 { "a_in_b" } else { "b_in_a" }.to_string(),
                     samples: p.samples,
                 }),
+                overlap,
             })
             .collect(),
         warnings: o.warnings(),
@@ -144,6 +150,37 @@ pub fn build(o: &Outcome) -> Report {
         self_check: o.self_check.clone(),
         cache: o.cache.clone(),
     }
+}
+
+/// Per region, its part pair's overlap box when the region is that pair's only one.
+fn region_overlaps(o: &Outcome) -> Vec<Option<OverlapReport>> {
+    use std::collections::HashMap;
+    let asm = &o.assembly;
+    let scene = std::sync::Arc::ptr_eq(&o.inputs[0], &o.inputs[1]);
+    // (object of A, object of B) -> part pair index; in scene mode both orders.
+    let mut by_objects: HashMap<(u32, u32), usize> = HashMap::new();
+    for (i, pp) in asm.part_pairs.iter().enumerate() {
+        if o.overlaps.get(i).is_none_or(Option::is_none) {
+            continue;
+        }
+        let (x, y) = (asm.parts[pp.a].object, asm.parts[pp.b].object);
+        by_objects.insert((x, y), i);
+        if scene {
+            by_objects.insert((y, x), i);
+        }
+    }
+    let mut regions_of: HashMap<usize, usize> = HashMap::new();
+    let pair_of: Vec<Option<usize>> = o.regions.iter().map(|g| by_objects.get(&g.objects).copied()).collect();
+    for i in pair_of.iter().flatten() {
+        *regions_of.entry(*i).or_default() += 1;
+    }
+    pair_of
+        .iter()
+        .map(|p| {
+            let i = (*p)?;
+            (regions_of[&i] == 1).then(|| o.overlaps[i].as_ref().map(OverlapReport::of)).flatten()
+        })
+        .collect()
 }
 
 impl From<crate::narrow::tri_tri::Contact> for ReportContact {

@@ -370,6 +370,31 @@ pub struct RegionReport {
     /// closed): see [`crate::regions::estimate_penetration`].
     #[serde(default)]
     pub penetration: Option<PenetrationReport>,
+    /// The exact box of A ∩ B when this region is its part pair's only region and the pair
+    /// has one (see [`PartPairReport::overlap`]); absent otherwise (a share of a part pair's
+    /// overlap among several regions would not be exact).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub overlap: Option<OverlapReport>,
+}
+
+/// The exact axis-aligned box of the intersection A ∩ B of two clashing closed parts (see
+/// [`crate::check::overlap`]): the same at every tessellation of the same solids.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, schemars::JsonSchema)]
+#[serde(deny_unknown_fields)]
+pub struct OverlapReport {
+    /// Lower corner; each coordinate the exact extreme rounded once to the nearest f64.
+    pub min: [f64; 3],
+    /// Upper corner, rounded the same way.
+    pub max: [f64; 3],
+    /// `max - min` per axis (in f64).
+    pub extent: [f64; 3],
+}
+
+impl OverlapReport {
+    /// The report block of an overlap box.
+    pub fn of(o: &crate::check::overlap::Overlap) -> OverlapReport {
+        OverlapReport { min: v3(o.min), max: v3(o.max), extent: v3(o.extent()) }
+    }
 }
 
 /// The `assembly` block (v2).
@@ -448,6 +473,10 @@ pub struct PartPairReport {
     /// More triangle pairs than listed (the counts stay complete).
     #[serde(default)]
     pub pairs_truncated: bool,
+    /// The exact box of the intersection of the two parts, for a clashing pair of closed
+    /// parts; absent otherwise.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub overlap: Option<OverlapReport>,
 }
 
 /// Build the v2 part view from an assembly outcome.
@@ -490,6 +519,7 @@ pub fn assembly_view(
             }),
             pairs: pp.pairs.iter().take(max_pairs).map(|&(x, y)| [x, y]).collect(),
             pairs_truncated: pp.pairs.len() > max_pairs || (pp.pairs.is_empty() && pp.counts.total() > 0),
+            overlap: None,
         })
         .collect();
     let i = &o.info;
