@@ -58,6 +58,8 @@ mod never_lose;
 mod obj_vs_tobj;
 #[path = "outputs.rs"]
 mod outputs;
+#[path = "overlap.rs"]
+mod overlap;
 #[path = "parry_oracle.rs"]
 mod parry_oracle;
 #[path = "part_pairs.rs"]

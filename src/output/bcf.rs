@@ -158,6 +158,10 @@ pub fn export(
             (None, Some(d)) if d > 0.0 => format!(", distance {} {units}", crate::output::text::num(d)),
             _ => String::new(),
         };
+        let measure = match &r0.overlap {
+            Some(e) => format!("{measure}, {} {units}", crate::output::text::overlap_text(e)),
+            None => measure,
+        };
         let title = format!(
             "#{} {} {} \u{d7} {}{}",
             n + 1,

@@ -69,6 +69,10 @@ pub struct Row {
     pub distance: Option<f64>,
     /// Penetration estimate, when computed.
     pub penetration: Option<f64>,
+    /// Extent of the exact overlap box of the two parts (clashing closed parts; a region only
+    /// when it is its part pair's only region), else absent.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub overlap: Option<[f64; 3]>,
     /// `new`, `persistent`, or null (no baseline, or no listed pair in the row).
     pub status: Option<String>,
     /// Box of the clash (world, relative to the page centre).
@@ -213,6 +217,7 @@ pub fn clashes(rep: &Report, result: &ClashResult, a: &Mesh, b: &Mesh) -> Clashe
             crossing: g.crossing as u64,
             distance,
             penetration: gr.penetration.as_ref().map(|p| p.depth),
+            overlap: gr.overlap.as_ref().map(|o| o.extent),
             status,
             bounds: [rel(g.bounds.min), rel(g.bounds.max)],
             segments,
@@ -264,6 +269,7 @@ pub fn clashes(rep: &Report, result: &ClashResult, a: &Mesh, b: &Mesh) -> Clashe
             crossing: pp.crossing_pairs,
             distance: pp.min_distance,
             penetration: None,
+            overlap: pp.overlap.as_ref().map(|o| o.extent),
             status: None,
             bounds,
             segments: Vec::new(),
@@ -297,6 +303,7 @@ pub fn clashes(rep: &Report, result: &ClashResult, a: &Mesh, b: &Mesh) -> Clashe
                 crossing: 0,
                 distance: Some(c.distance),
                 penetration: None,
+                overlap: None,
                 status: None,
                 bounds: [rel(p.min(q)), rel(p.max(q))],
                 segments: Vec::new(),
@@ -501,6 +508,7 @@ pub fn export_self(rep: &SelfReport, mesh: &Mesh, z_up: bool) -> String {
             crossing: f.crossing,
             distance: is_clash.then_some(0.0),
             penetration: None,
+            overlap: None,
             status: None,
             bounds,
             segments: flat(&segments),

@@ -193,7 +193,14 @@ fn part_pairs(s: &mut String, c: &Paint, r: &Report) {
     let multi = r.inputs.a.objects.len() > 1 || r.inputs.b.objects.len() > 1 || r.assembly.mode == "parts";
     let mut clashing: Vec<&crate::report::PartPairReport> =
         r.part_pairs.iter().filter(|p| p.verdict == ReportVerdict::Clash).collect();
-    if !multi || clashing.is_empty() {
+    if !multi {
+        // One part each: the exact overlap box on its own line.
+        if let Some(o) = clashing.first().and_then(|p| p.overlap.as_ref()) {
+            let _ = writeln!(s, "  {}, from {} to {}", overlap_text(&o.extent), point(&o.min), point(&o.max));
+        }
+        return;
+    }
+    if clashing.is_empty() {
         return;
     }
     clashing.sort_by(|x, y| y.crossing_pairs.cmp(&x.crossing_pairs).then((x.a, x.b).cmp(&(y.a, y.b))));
@@ -213,8 +220,16 @@ fn part_pairs(s: &mut String, c: &Paint, r: &Report) {
         if let Some(ct) = p.contained {
             let _ = write!(what, ", {}", ct.name());
         }
+        if let Some(o) = &p.overlap {
+            let _ = write!(what, ", {}", overlap_text(&o.extent));
+        }
         let _ = writeln!(s, "    {} x {}  ({what})", shown(&p.a_name), shown(&p.b_name));
     }
+}
+
+/// "overlap 1.5 × 0.6 × 0.6": the extent of an exact overlap box.
+pub fn overlap_text(extent: &[f64; 3]) -> String {
+    format!("overlap {} \u{d7} {} \u{d7} {}", num(extent[0]), num(extent[1]), num(extent[2]))
 }
 
 /// The summary, several lines ending in a newline; coloured with ANSI escapes if `color`.

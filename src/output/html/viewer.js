@@ -37,9 +37,10 @@
   var sortKey = 'rank', sortDir = 1, selected = -1;
 
   function measureText(r) {
-    if (r.penetration !== null) return 'depth ' + fmt(r.penetration) + unit();
-    if (r.distance === null) return '';
-    return (r.distance === 0 ? 'contact' : 'd ' + fmt(r.distance) + unit());
+    var o = r.overlap ? ', overlap ' + r.overlap.map(fmt).join(' \u00d7 ') + unit() : '';
+    if (r.penetration !== null) return 'depth ' + fmt(r.penetration) + unit() + o;
+    if (r.distance === null) return o.slice(2);
+    return (r.distance === 0 ? 'contact' : 'd ' + fmt(r.distance) + unit()) + o;
   }
   function cell(tr, text, cls) {
     var td = document.createElement('td');
