@@ -354,3 +354,118 @@ fn non_uniform_scaled_instance_touches_exactly_and_misses_by_one_ulp() {
     assert!(m.pairs.iter().all(|p| p.distance == ulp));
     assert_eq!(counted(&pairs), whole_by_name(&mesh, &wide));
 }
+
+/// An OBJ with one `o` per box (min, max), 12 triangles each, then one `o` per flat fan of `n`
+/// triangles around the origin in the plane z = 0 (radius 1 + the fan's index).
+fn boxes_and_fans_obj(boxes: &[([f64; 3], [f64; 3])], fans: &[usize]) -> String {
+    use std::fmt::Write;
+    let mut s = String::new();
+    let mut base = 1;
+    for (k, (lo, hi)) in boxes.iter().enumerate() {
+        writeln!(s, "o box{k}").unwrap();
+        for i in 0..8 {
+            let c = |d: usize| if i >> d & 1 == 1 { hi[d] } else { lo[d] };
+            writeln!(s, "v {} {} {}", c(0), c(1), c(2)).unwrap();
+        }
+        for q in [[0, 2, 3, 1], [4, 5, 7, 6], [0, 1, 5, 4], [2, 6, 7, 3], [0, 4, 6, 2], [1, 3, 7, 5]] {
+            let v = q.map(|x| x + base);
+            writeln!(s, "f {} {} {}\nf {} {} {}", v[0], v[1], v[2], v[0], v[2], v[3]).unwrap();
+        }
+        base += 8;
+    }
+    for (k, &n) in fans.iter().enumerate() {
+        writeln!(s, "o fan{k}\nv 0 0 0").unwrap();
+        let r = 1.0 + k as f64;
+        for i in 0..=n {
+            let t = i as f64 / n as f64 * 3.0;
+            writeln!(s, "v {} {} 0", r * t.cos(), r * t.sin()).unwrap();
+        }
+        for i in 0..n {
+            writeln!(s, "f {} {} {}", base, base + 1 + i, base + 2 + i).unwrap();
+        }
+        base += n + 2;
+    }
+    s
+}
+
+/// A report without its triangle-pair lists and regions (what `--detail parts` leaves out).
+fn listless(mut r: serde_json::Value) -> serde_json::Value {
+    use serde_json::Value;
+    let o = r.as_object_mut().unwrap();
+    for k in ["pairs", "pairs_truncated", "regions", "unlisted"] {
+        o.remove(k);
+    }
+    let settings = o["settings"].as_object_mut().unwrap();
+    settings.remove("detail");
+    settings.remove("max_pairs");
+    for p in o["part_pairs"].as_array_mut().unwrap() {
+        let p = p.as_object_mut().unwrap();
+        p.remove("pairs");
+        p.remove("pairs_truncated");
+    }
+    Value::Object(o.clone())
+}
+
+#[test]
+fn detail_parts_tallies_give_the_listed_report_without_the_lists() {
+    let dir = std::env::temp_dir().join(format!("meshclash-tally-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    // Boxes at pseudo-random small-integer corners: crossing, coincident (closed, face to face),
+    // nested, touching and near pairs; and coincident open fans that all meet at their apex.
+    let mut seed = 0x2545_f491_4f6c_dd1du64;
+    let mut next = |m: u64| {
+        seed ^= seed << 13;
+        seed ^= seed >> 7;
+        seed ^= seed << 17;
+        seed % m
+    };
+    let mut scenes = Vec::new();
+    for _ in 0..4 {
+        let boxes: Vec<([f64; 3], [f64; 3])> = (0..5)
+            .map(|_| {
+                let lo = [0, 1, 2].map(|_| next(4) as f64 * 0.5);
+                let hi = lo.map(|x| x + 0.5 + next(3) as f64 * 0.5);
+                (lo, hi)
+            })
+            .collect();
+        scenes.push((boxes, vec![]));
+    }
+    let unit = ([0.0; 3], [1.0; 3]);
+    scenes.push((vec![unit, unit, ([0.25; 3], [0.75; 3]), ([1.0, 0.0, 0.0], [2.0, 1.0, 1.0])], vec![40, 40]));
+    scenes.push((vec![], vec![60, 60, 60]));
+    for (k, (boxes, fans)) in scenes.iter().enumerate() {
+        let (one, two) = (dir.join(format!("s{k}a.obj")), dir.join(format!("s{k}b.obj")));
+        let (half, rest) = boxes.split_at(boxes.len() / 2);
+        std::fs::write(&one, boxes_and_fans_obj(half, &fans[..fans.len().min(1)])).unwrap();
+        std::fs::write(&two, boxes_and_fans_obj(rest, &fans[fans.len().min(1)..])).unwrap();
+        let all = dir.join(format!("s{k}.obj"));
+        std::fs::write(&all, boxes_and_fans_obj(boxes, fans)).unwrap();
+        let (one, two, all) = (one.to_str().unwrap(), two.to_str().unwrap(), all.to_str().unwrap());
+        let mut cases: Vec<Vec<&str>> = vec![vec!["scene", all], vec!["scene", all, "--clearance", "0.3"]];
+        if !half.is_empty() || !fans.is_empty() {
+            cases.push(vec![one, two]);
+            cases.push(vec![one, two, "--clearance", "0.3", "--touch-tolerance", "0.01"]);
+            cases.push(vec![all, all]);
+        }
+        for case in cases {
+            let run = |extra: &[&str]| {
+                let out = std::process::Command::new(env!("CARGO_BIN_EXE_meshclash"))
+                    .args(&case)
+                    .args(extra)
+                    .args(["--no-timings", "--threads", "2"])
+                    .output()
+                    .unwrap();
+                let code = out.status.code().unwrap();
+                assert!(code < 2, "{case:?}: {}", String::from_utf8_lossy(&out.stderr));
+                (code, serde_json::from_slice::<serde_json::Value>(&out.stdout).unwrap())
+            };
+            let (full_code, full) = run(&[]);
+            let (parts_code, parts) = run(&["--detail", "parts", "--max-pairs", "0"]);
+            assert_eq!(full_code, parts_code, "{case:?}");
+            assert_eq!(parts["pairs"].as_array().map(Vec::len), Some(0), "{case:?}");
+            let (full, parts) = (listless(full).to_string(), listless(parts).to_string());
+            assert!(full == parts, "{case:?}\n{full}\n{parts}");
+        }
+    }
+    std::fs::remove_dir_all(&dir).ok();
+}

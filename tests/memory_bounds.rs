@@ -156,3 +156,46 @@ fn self_on_100k_triangles_around_one_vertex_or_edge_finishes() {
         assert_eq!(self_within(f, Duration::from_secs(120)), Some(0), "{}", f.display());
     }
 }
+
+/// A flat fan of `n` triangles around the origin as OBJ object `name`, its vertices numbered
+/// from `base` (1-based).
+fn fan_obj(name: &str, n: usize, base: usize) -> String {
+    let mut s = format!("o {name}\nv 0 0 0\n");
+    for i in 0..=n {
+        let t = i as f64 / n as f64 * 3.0;
+        s.push_str(&format!("v {} {} 0\n", t.cos(), t.sin()));
+    }
+    for i in 0..n {
+        s.push_str(&format!("f {} {} {}\n", base, base + 1 + i, base + 2 + i));
+    }
+    s
+}
+
+#[test]
+fn detail_parts_on_coincident_fans_runs_in_memory_that_does_not_grow_with_their_pairs() {
+    if !cfg!(target_os = "linux") {
+        return;
+    }
+    // Two coincident fans of 1,500 triangles: every one of the 2,250,000 triangle pairs touches
+    // (all share the apex). Collecting them took about 220 MB; a tally per part pair needs a
+    // few MB, so 120 MB of address space is plenty, files mode and scene mode alike.
+    let n = 1500usize;
+    let d = tempfile::tempdir().unwrap();
+    let one = d.path().join("fan.obj");
+    std::fs::write(&one, fan_obj("fan", n, 1)).unwrap();
+    let two = d.path().join("fans.obj");
+    std::fs::write(&two, fan_obj("a", n, 1) + &fan_obj("b", n, n + 3)).unwrap();
+    let out = d.path().join("r.json");
+    let (f1, f2, o) = (one.to_str().unwrap(), two.to_str().unwrap(), out.to_str().unwrap());
+    for args in [vec![f1, f1], vec!["scene", f2]] {
+        let args: Vec<&str> =
+            args.into_iter().chain(["--detail", "parts", "--max-pairs", "0", "-o", o]).collect();
+        let (code, err) = under_limit(120_000, &args);
+        assert_eq!(code, Some(0), "{args:?} under ulimit -v 120 MB: {err}");
+        let r: serde_json::Value = serde_json::from_slice(&std::fs::read(&out).unwrap()).unwrap();
+        assert_eq!(r["summary"]["touching_pairs"], (n * n) as u64, "{args:?}");
+        assert_eq!(r["part_pairs"][0]["touching_pairs"], (n * n) as u64, "{args:?}");
+        assert_eq!(r["verdict"], "touching");
+        std::fs::remove_file(&out).unwrap();
+    }
+}

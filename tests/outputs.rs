@@ -408,3 +408,78 @@ fn subcommand_names_are_files_once_a_mesh_is_given() {
     assert_eq!(out.status.code(), Some(2));
     assert!(String::from_utf8_lossy(&out.stderr).starts_with("meshclash: error: schema: "));
 }
+
+/// Two crossing triangles in a glTF whose two nodes (and meshes) are named `na` and `nb`.
+fn named_gltf(na: &str, nb: &str) -> String {
+    use base64::Engine;
+    let positions: [f32; 18] =
+        [0., 0., 0., 2., 0., 0., 0., 2., 0., 0.5, 0.5, -1., 0.5, 0.5, 1., 1.5, 0.5, 1.];
+    let bytes: Vec<u8> = positions.iter().flat_map(|x| x.to_le_bytes()).collect();
+    let b64 = base64::engine::general_purpose::STANDARD.encode(bytes);
+    serde_json::json!({
+        "asset": {"version": "2.0"}, "scene": 0, "scenes": [{"nodes": [0, 1]}],
+        "nodes": [{"name": na, "mesh": 0}, {"name": nb, "mesh": 1}],
+        "meshes": [{"name": na, "primitives": [{"attributes": {"POSITION": 0}}]},
+                   {"name": nb, "primitives": [{"attributes": {"POSITION": 1}}]}],
+        "buffers": [{"byteLength": 72, "uri": format!("data:application/octet-stream;base64,{b64}")}],
+        "bufferViews": [{"buffer": 0, "byteLength": 36}, {"buffer": 0, "byteOffset": 36, "byteLength": 36}],
+        "accessors": [
+            {"bufferView": 0, "componentType": 5126, "count": 3, "type": "VEC3", "min": [0, 0, 0], "max": [2, 2, 0]},
+            {"bufferView": 1, "componentType": 5126, "count": 3, "type": "VEC3", "min": [0.5, 0.5, -1], "max": [1.5, 0.5, 1]}
+        ]
+    })
+    .to_string()
+}
+
+#[test]
+fn every_output_is_written_and_well_formed_for_names_with_every_control_character() {
+    use std::io::Read;
+    let dir = tempfile::tempdir().unwrap();
+    let controls: String =
+        (0u32..32).chain([0x7f, 0x85, 0x2028, 0xfffe]).filter_map(char::from_u32).collect();
+    let cases = [("a\0b", "c"), ("\0", "\u{1}\u{1f}"), (controls.as_str(), "<&>\"'\u{7f}]]>")];
+    for (k, (na, nb)) in cases.into_iter().enumerate() {
+        let input = dir.path().join(format!("names{k}.gltf"));
+        std::fs::write(&input, named_gltf(na, nb)).unwrap();
+        let out = |ext: &str| dir.path().join(format!("w{k}.{ext}"));
+        for version in ["2.1", "3.0"] {
+            let run = bin()
+                .arg("scene")
+                .arg(&input)
+                .args(["--no-timings", "--threads", "1", "--bcf-version", version, "-o"])
+                .arg(out("json"))
+                .arg("--junit")
+                .arg(out("xml"))
+                .arg("--bcf")
+                .arg(out("bcfzip"))
+                .arg("--html")
+                .arg(out("html"))
+                .arg("--export-glb")
+                .arg(out("glb"))
+                .output()
+                .unwrap();
+            assert_eq!(run.status.code(), Some(1), "{na:?}: {}", String::from_utf8_lossy(&run.stderr));
+            let json: serde_json::Value =
+                serde_json::from_slice(&std::fs::read(out("json")).unwrap()).unwrap();
+            let names: Vec<&str> =
+                json["parts"].as_array().unwrap().iter().map(|p| p["name"].as_str().unwrap()).collect();
+            assert_eq!(names, [na, nb], "names round-trip through the JSON report");
+            let junit = std::fs::read_to_string(out("xml")).unwrap();
+            roxmltree::Document::parse(&junit).unwrap_or_else(|e| panic!("{na:?}: JUnit: {e}"));
+            let mut z = zip::ZipArchive::new(std::fs::File::open(out("bcfzip")).unwrap()).unwrap();
+            assert!(z.len() > 1, "a BCF with its topic");
+            for i in 0..z.len() {
+                let mut f = z.by_index(i).unwrap();
+                let mut s = String::new();
+                f.read_to_string(&mut s).unwrap();
+                roxmltree::Document::parse(&s).unwrap_or_else(|e| panic!("{na:?}: BCF member {i}: {e}"));
+            }
+            let html = std::fs::read_to_string(out("html")).unwrap();
+            assert!(!html.contains('\0'), "no raw NUL in the HTML");
+            assert_eq!(&std::fs::read(out("glb")).unwrap()[..4], b"glTF");
+            for ext in ["json", "xml", "bcfzip", "html", "glb"] {
+                std::fs::remove_file(out(ext)).unwrap();
+            }
+        }
+    }
+}

@@ -85,6 +85,12 @@ fn run_args(args: &[&std::ffi::OsStr]) -> Option<meshclash::report::Report> {
             let json = meshclash::report::to_json(&out.report);
             let back: meshclash::report::Report = serde_json::from_str(&json).expect("report round-trips");
             assert_eq!(back.verdict, out.report.verdict);
+            // The staged output files are written only on commit, as the binary does after
+            // stdout; a refusal here is one line, like any other error.
+            if let Err(e) = out.staged.commit() {
+                one_line(&e);
+                return None;
+            }
             Some(*out.report)
         }
         Err(e) => {
@@ -315,6 +321,10 @@ pub fn writers(data: &[u8]) {
     let input = dir.join("names.gltf");
     std::fs::write(&input, gltf.to_string()).expect("scratch write");
     let out = |n: &str| dir.join(n).into_os_string();
+    // Nothing left over from the previous input can pass for this one's output.
+    for n in ["w.json", "w.xml", "w.bcfzip", "w.html", "w.glb"] {
+        let _ = std::fs::remove_file(dir.join(n));
+    }
     let version = if data[0] & 1 == 0 { "2.1" } else { "3.0" };
     let args: Vec<std::ffi::OsString> = vec![
         "meshclash".into(),

@@ -242,6 +242,45 @@ where
     parts.into_iter().flatten().collect()
 }
 
+/// As [`collect_pairs`], folding instead of collecting: every leaf pair whose boxes pass
+/// `boxes_meet` is handed to `leaf` with a state made by `init`, one state per independent
+/// sub-walk, and the states are combined by `merge` in seed order. Memory is one state per
+/// sub-walk, whatever the number of pairs the leaves produce; with a `merge` that is associative
+/// and commutative the result does not depend on the thread count.
+pub fn fold_pairs<S, A, B, M, I, L, G>(ta: &A, tb: &B, boxes_meet: M, init: I, leaf: L, merge: G) -> S
+where
+    S: Send,
+    A: Tree + ?Sized,
+    B: Tree + ?Sized,
+    M: Fn(&Aabb, &Aabb) -> bool + Sync,
+    I: Fn() -> S + Sync,
+    L: Fn(&[u32], &[u32], &mut S) + Sync,
+    G: Fn(S, S) -> S,
+{
+    let seeds = seed(ta, tb, &boxes_meet);
+    let states: Vec<S> = seeds
+        .par_iter()
+        .map(|s| {
+            let mut state = init();
+            let mut stack = vec![*s];
+            while let Some(e) = stack.pop() {
+                match children(ta, tb, &e) {
+                    None => leaf(ta.leaf_prims(e.0), tb.leaf_prims(e.1), &mut state),
+                    Some(kids) => {
+                        for k in kids.iter().rev() {
+                            if boxes_meet(&k.2, &k.3) {
+                                stack.push(*k);
+                            }
+                        }
+                    }
+                }
+            }
+            state
+        })
+        .collect();
+    states.into_iter().fold(init(), merge)
+}
+
 /// One-tree walk: call `visit` on every triangle in a leaf whose box overlaps `query` (exact
 /// closed overlap), stopping early — and returning true — as soon as `visit` returns true.
 pub fn any_in_box<T: Tree + ?Sized>(tree: &T, query: &Aabb, visit: impl FnMut(u32) -> bool) -> bool {
@@ -459,6 +498,63 @@ mod tests {
                 Aabb { min: DVec3::new(x, 0.0, 0.0), max: DVec3::new(x + 1.0, 1.0, 1.0) }
             })
             .collect()
+    }
+
+    #[test]
+    fn folding_walk_sees_the_same_pairs_as_the_collecting_walk() {
+        let a = unit_boxes(300, 0.0);
+        let b = unit_boxes(200, 1.0);
+        for leaf_size in [1, 4] {
+            let opts = BuildOptions { leaf_size, ..BuildOptions::default() };
+            let (ta, tb) = (Bvh::build_from_boxes(&a, opts), Bvh::build_from_boxes(&b, opts));
+            let each = |la: &[u32], lb: &[u32], f: &mut dyn FnMut(u32, u32)| {
+                for &i in la {
+                    for &j in lb {
+                        if a[i as usize].overlaps(&b[j as usize]) {
+                            f(i, j);
+                        }
+                    }
+                }
+            };
+            let mut listed = collect_pairs(
+                &ta,
+                &tb,
+                |x, y| x.overlaps(y),
+                |la, lb, out| each(la, lb, &mut |i, j| out.push((i, j))),
+            );
+            listed.sort();
+            // Count, smallest and largest pair, and a order-free checksum, folded.
+            type State = (usize, Option<(u32, u32)>, Option<(u32, u32)>, u64);
+            let folded: State = fold_pairs(
+                &ta,
+                &tb,
+                |x, y| x.overlaps(y),
+                || (0, None, None, 0),
+                |la, lb, s: &mut State| {
+                    each(la, lb, &mut |i, j| {
+                        s.0 += 1;
+                        s.1 = Some(s.1.map_or((i, j), |m| m.min((i, j))));
+                        s.2 = Some(s.2.map_or((i, j), |m| m.max((i, j))));
+                        s.3 = s.3.wrapping_add((i as u64) << 32 | j as u64);
+                    })
+                },
+                |x, y| {
+                    let pick = |p: Option<(u32, u32)>, q: Option<(u32, u32)>, f: fn(_, _) -> _| match (p, q) {
+                        (Some(p), Some(q)) => Some(f(p, q)),
+                        (p, q) => p.or(q),
+                    };
+                    (
+                        x.0 + y.0,
+                        pick(x.1, y.1, std::cmp::min),
+                        pick(x.2, y.2, std::cmp::max),
+                        x.3.wrapping_add(y.3),
+                    )
+                },
+            );
+            let sum = listed.iter().fold(0u64, |s, &(i, j)| s.wrapping_add((i as u64) << 32 | j as u64));
+            assert_eq!(folded, (listed.len(), listed.first().copied(), listed.last().copied(), sum));
+            assert_eq!(listed.len(), 400);
+        }
     }
 
     #[test]

@@ -29,7 +29,8 @@ use crate::check::containment;
 use crate::check::containment::Containment;
 use crate::check::containment::Topology;
 use crate::check::query::{
-    closest_pair_within, pair_walk, ClashResult, Detail, PairFinding, PairPhase, Settings, Verdict,
+    closest_pair_within, find_pairs, pair_walk, tally_walk, ClashResult, Detail, PairFinding, PairPhase,
+    Settings, Tally, Verdict,
 };
 use crate::geom::predicates::BoxMap;
 use crate::geom::{Aabb, DVec3};
@@ -435,11 +436,13 @@ pub fn check_parts_kept(
         .par_iter()
         .map(|&(a, b)| {
             let (va, vb, ta, tb) = (view(a), view(b), tree(a), tree(b));
-            let mut phase = pair_walk(&va, &ta, &vb, &tb, settings);
+            // Without the lists (`--detail parts`) the walk keeps only a tally: memory does not
+            // grow with the pairs of a part pair.
+            let phase = match settings.detail {
+                Detail::Parts => tally_walk(&va, &ta, &vb, &tb, settings),
+                Detail::Pairs => pair_walk(&va, &ta, &vb, &tb, settings),
+            };
             let needs = phase.needs_topology(&va, &ta, &vb, &tb);
-            if settings.detail == Detail::Parts && !needs {
-                phase.forget_pairs();
-            }
             (phase, needs)
         })
         .collect();
@@ -461,7 +464,15 @@ pub fn check_parts_kept(
             let topo =
                 needs.then(|| (topology[a].as_ref().expect("wanted"), topology[b].as_ref().expect("wanted")));
             let pending = phase.closest_pending();
+            let mut phase = phase;
+            if topo.is_some_and(|(x, y)| phase.needs_pairs(x, y)) {
+                // Touching closed parts: containment reads their contacts.
+                phase.set_pairs(find_pairs(&view(a), &tree(a), &view(b), &tree(b), settings).0);
+            }
             let mut r = phase.finish(&view(a), &tree(a), &view(b), &tree(b), topo);
+            if settings.detail == Detail::Parts {
+                r.pairs = Vec::new();
+            }
             r.closed = [topology[a].as_ref().map(|t| t.closed), topology[b].as_ref().map(|t| t.closed)];
             r.timings = Default::default();
             (r, pending)
@@ -802,13 +813,21 @@ fn run_checked(a: &Mesh, b: &Mesh, sel: &Selection, settings: &Settings) -> Resu
         return o;
     }
     if !sel.by_parts() {
-        let mut result = crate::check::query::check(a, b, settings);
-        let mut part_pairs = group_by_part(&parts, a, b, &result);
+        let (mut result, mut part_pairs) = match settings.detail {
+            Detail::Pairs => {
+                let result = crate::check::query::check(a, b, settings);
+                let part_pairs = group_by_part(&parts, a, b, &result);
+                (result, part_pairs)
+            }
+            // Without the lists, each part pair's pairs are tallied as they are found.
+            Detail::Parts => {
+                let (result, tallies) = crate::check::query::check_tallied(a, b, settings, |i, j| {
+                    (a.tri_object[i as usize], b.tri_object[j as usize])
+                });
+                (result, group_tallies(&parts, a, b, tallies))
+            }
+        };
         per_part_containment(&parts, a, b, &mut result, &mut part_pairs, settings);
-        if settings.detail == Detail::Parts {
-            result.pairs = Vec::new();
-            part_pairs.iter_mut().for_each(|p| p.pairs = Vec::new());
-        }
         let info = AssemblyInfo {
             mode: "files",
             selected: [sa.len(), sb.len()],
@@ -1028,6 +1047,40 @@ fn per_part_containment(
         }
         result.verdict = Verdict::Clash;
     }
+}
+
+/// File mode without the lists: [`group_by_part`] from the tally of each part pair's pairs
+/// (keyed by the objects of A and B), giving the same summaries with empty pair lists.
+fn group_tallies(
+    parts: &[Part],
+    a: &Mesh,
+    b: &Mesh,
+    tallies: std::collections::BTreeMap<(u32, u32), Tally>,
+) -> Vec<PartPairSummary> {
+    let index: HashMap<(u8, u32), usize> =
+        parts.iter().enumerate().map(|(i, p)| ((p.input, p.object), i)).collect();
+    let mut out: Vec<PartPairSummary> = tallies
+        .into_iter()
+        .map(|((oa, ob), t)| {
+            let mut closest = t.best.map(|p| crate::check::query::pair_witness(a, b, &p));
+            if let Some(c) = closest.as_mut().filter(|c| c.distance > 0.0) {
+                let (ta, tb) = (crate::bvh::triangle(a, c.a.0), crate::bvh::triangle(b, c.b.0));
+                c.distance = crate::narrow::exact_distance::exact_distance_sq(&ta, &tb).rounded();
+            }
+            PartPairSummary {
+                a: index[&(0, oa)],
+                b: index[&(1, ob)],
+                verdict: t.verdict(),
+                counts: t.counts,
+                min_distance: closest.map(|c| c.distance),
+                containment: Containment::None,
+                closest,
+                pairs: Vec::new(),
+            }
+        })
+        .collect();
+    out.sort_by_key(|s| (s.a, s.b));
+    out
 }
 
 /// File mode: group the pairs of a whole-file check by the parts they belong to (also used by

@@ -418,30 +418,214 @@ where
         ta,
         tb,
         |x, y| !stop.load(Ordering::Relaxed) && tol.boxes_may_meet(x, y),
-        |la, lb, out| {
-            for &i in la {
-                let ti = a.triangle(i);
-                let bi = Aabb::of_triangle(&ti);
-                for &j in lb {
-                    let tj = b.triangle(j);
-                    if !tol.boxes_may_meet(&bi, &Aabb::of_triangle(&tj)) {
-                        continue;
-                    }
-                    if stop.load(Ordering::Relaxed) {
-                        return;
-                    }
-                    if let Some(f) = classify_pair(i, &ti, j, &tj, &tol, settings.mode) {
-                        if settings.first_hit && f.kind == PairKind::Crossing {
-                            stop.store(true, Ordering::Relaxed);
-                        }
-                        out.push(f);
-                    }
-                }
-            }
-        },
+        |la, lb, out| leaf_pairs(a, la, b, lb, settings, &stop, |f| out.push(f)),
     );
     pairs.par_sort_unstable_by_key(|p| (p.a, p.b));
     (pairs, stop.load(Ordering::Relaxed))
+}
+
+/// Classify every pair of triangles of two leaves whose boxes may meet, handing each finding
+/// to `found`; with `first_hit`, the first crossing raises `stop` and the rest are skipped.
+fn leaf_pairs<A, B>(
+    a: &A,
+    la: &[u32],
+    b: &B,
+    lb: &[u32],
+    settings: &Settings,
+    stop: &AtomicBool,
+    mut found: impl FnMut(PairFinding),
+) where
+    A: TriMesh + ?Sized,
+    B: TriMesh + ?Sized,
+{
+    let tol = settings.tolerances;
+    for &i in la {
+        let ti = a.triangle(i);
+        let bi = Aabb::of_triangle(&ti);
+        for &j in lb {
+            let tj = b.triangle(j);
+            if !tol.boxes_may_meet(&bi, &Aabb::of_triangle(&tj)) {
+                continue;
+            }
+            if stop.load(Ordering::Relaxed) {
+                return;
+            }
+            if let Some(f) = classify_pair(i, &ti, j, &tj, &tol, settings.mode) {
+                if settings.first_hit && f.kind == PairKind::Crossing {
+                    stop.store(true, Ordering::Relaxed);
+                }
+                found(f);
+            }
+        }
+    }
+}
+
+/// What a check keeps of a set of triangle pairs when it does not keep the pairs
+/// ([`Detail::Parts`]): everything the verdict, the counts and the witnesses read, in memory
+/// that does not grow with the number of pairs. Tallies of disjoint sets of pairs merge into
+/// the tally of their union, in any order.
+#[derive(Debug, Clone, Copy, Default, PartialEq)]
+pub struct Tally {
+    /// Counts by kind.
+    pub counts: Counts,
+    /// The exact contact with the least (a, b): the witness of a zero distance, as the first
+    /// contact of the sorted list would be.
+    pub first_contact: Option<PairFinding>,
+    /// The pair with the least (distance, a, b): the closest of the pairs, as the first of the
+    /// smallest distance in the sorted list would be.
+    pub best: Option<PairFinding>,
+    /// Some pair is a face-to-face contact ([`Contact::CoplanarArea`]).
+    pub coplanar_area: bool,
+}
+
+impl Tally {
+    /// Count one pair.
+    pub fn add(&mut self, p: PairFinding) {
+        self.counts.record(&p);
+        if p.contact.is_some() && self.first_contact.is_none_or(|f| (p.a, p.b) < (f.a, f.b)) {
+            self.first_contact = Some(p);
+        }
+        if self.best.is_none_or(|f| closer(&p, &f)) {
+            self.best = Some(p);
+        }
+        self.coplanar_area |= p.contact == Some(Contact::CoplanarArea);
+    }
+
+    /// The tally of both sets of pairs.
+    pub fn merge(mut self, o: Tally) -> Tally {
+        self.counts.merge(&o.counts);
+        if let Some(f) = o.first_contact {
+            if self.first_contact.is_none_or(|g| (f.a, f.b) < (g.a, g.b)) {
+                self.first_contact = Some(f);
+            }
+        }
+        if let Some(f) = o.best {
+            if self.best.is_none_or(|g| closer(&f, &g)) {
+                self.best = Some(f);
+            }
+        }
+        self.coplanar_area |= o.coplanar_area;
+        self
+    }
+
+    /// The verdict the pairs alone imply (as [`Counts::record`] gives pair by pair).
+    pub fn verdict(&self) -> Verdict {
+        let c = &self.counts;
+        if c.crossing > 0 {
+            Verdict::Clash
+        } else if c.touching > 0 {
+            Verdict::Touching
+        } else if c.clearance > 0 {
+            Verdict::Clearance
+        } else {
+            Verdict::Clear
+        }
+    }
+}
+
+/// Is `p` before `q` by (distance, a, b)?
+fn closer(p: &PairFinding, q: &PairFinding) -> bool {
+    p.distance < q.distance || (p.distance == q.distance && (p.a, p.b) < (q.a, q.b))
+}
+
+/// The pair walk folded into one [`Tally`] per group (`group(a, b)` names the group of a
+/// triangle pair: the part pair in a file-mode check, `()` for one part pair), without
+/// collecting the pairs; and whether `first_hit` stopped it early. Memory grows with the
+/// number of groups, not with the number of pairs.
+pub fn tally_pairs<A, TA, B, TB, K, G>(
+    a: &A,
+    ta: &TA,
+    b: &B,
+    tb: &TB,
+    settings: &Settings,
+    group: G,
+) -> (std::collections::BTreeMap<K, Tally>, bool)
+where
+    A: TriMesh + ?Sized,
+    TA: Tree + ?Sized,
+    B: TriMesh + ?Sized,
+    TB: Tree + ?Sized,
+    K: Ord + Send,
+    G: Fn(u32, u32) -> K + Sync,
+{
+    use std::collections::BTreeMap;
+    let tol = settings.tolerances;
+    let stop = AtomicBool::new(false);
+    let tallies = traverse::fold_pairs(
+        ta,
+        tb,
+        |x, y| !stop.load(Ordering::Relaxed) && tol.boxes_may_meet(x, y),
+        BTreeMap::<K, Tally>::new,
+        |la, lb, out| {
+            leaf_pairs(a, la, b, lb, settings, &stop, |f| out.entry(group(f.a, f.b)).or_default().add(f))
+        },
+        |mut x, y| {
+            for (k, t) in y {
+                let e = x.entry(k).or_default();
+                *e = e.merge(t);
+            }
+            x
+        },
+    );
+    (tallies, stop.load(Ordering::Relaxed))
+}
+
+/// As [`pair_walk`], keeping only the [`Tally`] of the pairs, not the pairs: the phase has the
+/// same counts, closest pair and topology needs, and [`PairPhase::needs_pairs`] says whether
+/// containment needs the list after all.
+pub fn tally_walk<A, TA, B, TB>(a: &A, ta: &TA, b: &B, tb: &TB, settings: &Settings) -> PairPhase
+where
+    A: TriMesh + ?Sized,
+    TA: Tree + ?Sized,
+    B: TriMesh + ?Sized,
+    TB: Tree + ?Sized,
+{
+    let started = Instant::now();
+    let (tallies, stopped) = tally_pairs(a, ta, b, tb, settings, |_, _| ());
+    let tally = tallies.into_values().next().unwrap_or_default();
+    PairPhase::of_tally(a, b, &tally, stopped, started)
+}
+
+/// [`check`] without keeping the triangle pairs ([`Detail::Parts`]): the result's pair list is
+/// empty, everything else is as [`check`] gives it; plus the [`Tally`] of each group of pairs
+/// (see [`tally_pairs`]). The pairs are walked a second time, and kept, only when containment
+/// needs them: no pair crosses, and both inputs are closed with faces or points touching.
+pub fn check_tallied<K, G>(
+    a: &Mesh,
+    b: &Mesh,
+    settings: &Settings,
+    group: G,
+) -> (ClashResult, std::collections::BTreeMap<K, Tally>)
+where
+    K: Ord + Send,
+    G: Fn(u32, u32) -> K + Sync,
+{
+    let t0 = Instant::now();
+    let (ta, tb) = rayon::join(|| LazyBvh::new(a, settings.bvh), || LazyBvh::new(b, settings.bvh));
+    let build_ms = ms(t0);
+    let started = Instant::now();
+    let (tallies, stopped) = tally_pairs(a, &ta, b, &tb, settings, group);
+    let tally = tallies.values().fold(Tally::default(), |s, t| s.merge(*t));
+    let mut phase = PairPhase::of_tally(a, b, &tally, stopped, started);
+    if phase.pending {
+        phase.closest = closest_pair(a, &ta, b, &tb, settings.distance_error);
+        phase.pending = false;
+    }
+    let mut r = if phase.needs_topology(a, &ta, b, &tb) {
+        let (topo_a, topo_b) = rayon::join(|| containment::topology(a), || containment::topology(b));
+        if phase.needs_pairs(&topo_a, &topo_b) {
+            phase.set_pairs(find_pairs(a, &ta, b, &tb, settings).0);
+        }
+        let mut r = phase.finish(a, &ta, b, &tb, Some((&topo_a, &topo_b)));
+        r.closed = [Some(topo_a.closed), Some(topo_b.closed)];
+        r
+    } else {
+        phase.finish(a, &ta, b, &tb, None)
+    };
+    r.pairs = Vec::new();
+    r.trees = [ta.stats(), tb.stats()];
+    r.timings.build_ms = build_ms;
+    (r, tallies)
 }
 
 /// As [`check`], with both trees already built. The topology of the inputs (closedness, for
@@ -472,6 +656,10 @@ where
 #[derive(Debug, Clone)]
 pub struct PairPhase {
     pairs: Vec<PairFinding>,
+    /// `pairs` is every pair (not only a [`Tally`] of them).
+    listed: bool,
+    /// Some pair is a face-to-face contact.
+    coplanar_area: bool,
     counts: Counts,
     closest: Option<Closest>,
     /// No pair met exactly and the walk ran to the end: the closest pair is still to find.
@@ -514,15 +702,49 @@ where
     }
     let closest = pairs.iter().find(|p| p.contact.is_some()).map(|p| contact_witness(a, b, p));
     let pending = closest.is_none() && !stopped;
-    PairPhase { pairs, counts, closest, pending, started }
+    let coplanar_area = pairs.iter().any(|p| p.contact == Some(Contact::CoplanarArea));
+    PairPhase { pairs, listed: true, coplanar_area, counts, closest, pending, started }
 }
 
 impl PairPhase {
+    fn of_tally<A, B>(a: &A, b: &B, t: &Tally, stopped: bool, started: Instant) -> PairPhase
+    where
+        A: TriMesh + ?Sized,
+        B: TriMesh + ?Sized,
+    {
+        let closest = t.first_contact.map(|p| contact_witness(a, b, &p));
+        PairPhase {
+            pairs: Vec::new(),
+            listed: false,
+            coplanar_area: t.coplanar_area,
+            counts: t.counts,
+            closest,
+            pending: closest.is_none() && !stopped,
+            started,
+        }
+    }
+
+    /// Does containment ([`PairPhase::finish`] with these topologies) read the pair list, and
+    /// was it not kept ([`tally_walk`])? Only touching closed parts need their contacts.
+    pub fn needs_pairs(&self, topo_a: &containment::Topology, topo_b: &containment::Topology) -> bool {
+        !self.listed
+            && self.counts.crossing == 0
+            && self.counts.touching > self.counts.within_tolerance
+            && topo_a.closed
+            && topo_b.closed
+    }
+
+    /// Put back the pair list a [`tally_walk`] did not keep (from [`find_pairs`]).
+    pub fn set_pairs(&mut self, pairs: Vec<PairFinding>) {
+        self.pairs = pairs;
+        self.listed = true;
+    }
     /// Drop the triangle-pair list (counts and the closest pair stay). Only for
     /// [`Detail::Parts`], and only once [`PairPhase::needs_topology`] has said the verdict does
     /// not need the pairs (face-to-face contact decides `volumes_overlap`).
     pub fn forget_pairs(&mut self) {
         self.pairs = Vec::new();
+        self.listed = false;
     }
 
     /// True when no pair met exactly and the walk was not cut short: the closest pair has not
@@ -541,9 +763,7 @@ impl PairPhase {
         B: TriMesh + ?Sized,
         TB: Tree + ?Sized,
     {
-        self.counts.crossing == 0
-            && (self.pairs.iter().any(|p| p.contact == Some(Contact::CoplanarArea))
-                || containment::may_nest(a, ta, b, tb))
+        self.counts.crossing == 0 && (self.coplanar_area || containment::may_nest(a, ta, b, tb))
     }
 
     /// Containment (with both topologies when [`PairPhase::needs_topology`] said so, else
