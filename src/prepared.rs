@@ -659,6 +659,51 @@ mod tests {
         assert_eq!(distance(&pbig, &small, f64::INFINITY).unwrap().distance, 1.0);
     }
 
+    /// Balls hold every vertex, their gap is a lower bound of the true distance, and apart
+    /// pairs never collide; a translated placement's topology (taken from the prepared mesh) is
+    /// the one found on its world coordinates.
+    #[test]
+    fn balls_bound_and_translated_topology_matches() {
+        let a = prepared(cube(DVec3::ZERO));
+        let placements = [
+            DMat4::IDENTITY,
+            DMat4::from_translation(DVec3::new(1.5, 0.25, -0.5)),
+            DMat4::from_translation(DVec3::new(0.1, 0.2, 0.3)),
+            DMat4::from_translation(DVec3::new(2.0, 2.0, 0.0)) * DMat4::from_rotation_z(0.7),
+            DMat4::from_translation(DVec3::new(0.9, 0.9, 0.9)) * DMat4::from_rotation_x(0.3),
+        ];
+        let placed: Vec<Placed> = placements.iter().map(|&m| a.place(m).unwrap()).collect();
+        for p in &placed {
+            let b = p.ball();
+            assert!(p.positions().iter().all(|v| (*v - b.center).length() <= b.radius));
+            // The same closedness, components and coincidences (merged ids are numbered by the
+            // coordinates' order, which a translation may change).
+            let (t, fresh) = (p.topology(), containment::topology(&p.mesh()));
+            assert_eq!(
+                (t.closed, &t.component_seeds, &t.component_of),
+                (fresh.closed, &fresh.component_seeds, &fresh.component_of)
+            );
+            let n = t.merged.len();
+            for i in 0..n {
+                for j in 0..n {
+                    assert_eq!(t.merged[i] == t.merged[j], fresh.merged[i] == fresh.merged[j]);
+                }
+            }
+        }
+        assert!(placed[0].translated() && placed[1].translated() && !placed[3].translated());
+        for x in &placed {
+            for y in &placed {
+                let gap = x.gap(y);
+                let d = distance(x, y, f64::INFINITY).unwrap().distance;
+                let c = collide(x, y, false).collides();
+                assert!(gap <= d, "{gap} > {d}");
+                if x.apart(y) {
+                    assert!(!c && d > 0.0);
+                }
+            }
+        }
+    }
+
     #[test]
     fn signed_distance_is_never_positive_for_colliding_parts() {
         let a = prepared(cube(DVec3::ZERO));
