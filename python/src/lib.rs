@@ -826,6 +826,21 @@ fn nearest(
         memo.keep_signed(key(i, j), &s);
         Some(s)
     };
+    // From the kept answers alone when they settle it: the first candidate in order known to
+    // have meeting triangles, every candidate before it known not to.
+    for &(i, j) in candidates {
+        match memo.verdict(key(i, j)) {
+            Some(v) if v.collides && v.containment.is_none() => {
+                if let Some(s) = memo.signed(key(i, j)) {
+                    return Some(near(s, i, j));
+                }
+                break;
+            }
+            Some(_) => {}
+            None if a[i].apart(&b[j]) => {}
+            None => break,
+        }
+    }
     let overlapping: Vec<(usize, usize)> =
         candidates.iter().copied().filter(|&(i, j)| !a[i].apart(&b[j])).collect();
     // Meeting triangles first (a pair known to collide without containment has them), then
