@@ -654,6 +654,8 @@ struct Verdict {
 struct Memo {
     verdicts: HashMap<(u64, u64), Verdict>,
     signed: HashMap<(u64, u64), prepared::Signed>,
+    /// Pairs known to have no meeting triangles (their containment not decided yet).
+    no_meeting: std::collections::HashSet<(u64, u64)>,
 }
 
 impl Memo {
@@ -661,6 +663,7 @@ impl Memo {
     fn forget(&mut self, id: u64) {
         self.verdicts.retain(|k, _| k.0 != id && k.1 != id);
         self.signed.retain(|k, _| k.0 != id && k.1 != id);
+        self.no_meeting.retain(|k| k.0 != id && k.1 != id);
     }
 }
 
@@ -681,6 +684,18 @@ impl Memory<'_> {
                 m.verdicts.clear();
             }
             m.verdicts.insert(k, v);
+        }
+    }
+    fn no_meeting(&self, k: (u64, u64)) -> bool {
+        self.0.is_some_and(|m| m.lock().unwrap().no_meeting.contains(&k))
+    }
+    fn keep_no_meeting(&self, k: (u64, u64)) {
+        if let Some(m) = self.0 {
+            let mut m = m.lock().unwrap();
+            if m.no_meeting.len() >= MEMO_MAX {
+                m.no_meeting.clear();
+            }
+            m.no_meeting.insert(k);
         }
     }
     fn signed(&self, k: (u64, u64)) -> Option<prepared::Signed> {
@@ -837,7 +852,7 @@ fn nearest(
                 break;
             }
             Some(_) => {}
-            None if a[i].apart(&b[j]) => {}
+            None if memo.no_meeting(key(i, j)) || a[i].apart(&b[j]) => {}
             None => break,
         }
     }
@@ -847,13 +862,16 @@ fn nearest(
     // containment: the first pair in (i, j) order of the first kind found.
     let meeting = |&(i, j): &(usize, usize)| match memo.verdict(key(i, j)) {
         Some(v) => (v.collides && v.containment.is_none()).then_some((i, j)),
+        None if memo.no_meeting(key(i, j)) => None,
         None => {
             let (x, y) = (&a[i], &b[j]);
             let m = api::meeting_pairs(&x.mesh(), &x.tree(), &y.mesh(), &y.tree(), true);
-            (!m.is_empty()).then(|| {
-                memo.keep_verdict(key(i, j), Verdict { collides: true, containment: None });
-                (i, j)
-            })
+            if m.is_empty() {
+                memo.keep_no_meeting(key(i, j));
+                return None;
+            }
+            memo.keep_verdict(key(i, j), Verdict { collides: true, containment: None });
+            Some((i, j))
         }
     };
     let contained = |&(i, j): &(usize, usize)| {
