@@ -786,13 +786,6 @@ fn collide_pairs(
                 hit(p, v)
             })
         };
-        // Deeply overlapping pairs first: they are the likeliest to cross, and any crossing
-        // answers (an order of work, not of answers).
-        let depth = |&(i, j): &(usize, usize)| {
-            let (x, y) = (a[i].ball(), b[j].ball());
-            -x.gap(&y) / x.radius.min(y.radius).max(f64::MIN_POSITIVE)
-        };
-        open.sort_by(|p, q| depth(q).total_cmp(&depth(p)));
         if let Some(h) = find_any(&open, meet) {
             return vec![h];
         }
