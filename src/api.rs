@@ -10,15 +10,18 @@
 //! output). This module only turns an embedder's options into a [`Request`].
 
 use crate::bvh::BuildOptions;
+use crate::cache::CacheConfig;
 use crate::check::assembly::Selection;
+use crate::check::query::FailOn;
 use crate::check::query::{Detail, DistanceError, Mode, Settings};
 use crate::error::{Error, InputProblem, Location, NonFinite, Result, UsageProblem};
 use crate::geom::DVec3;
-use crate::pipeline::{InputRequest, Request};
+use crate::pipeline::{Gate, InputRequest, Request, Unit, Units};
+use crate::report::self_report::{self, SelfFailOn};
 use crate::report::Report;
 use crate::scene::mesh::{Mesh, Object};
 use glam::DMat4;
-use std::path::Path;
+use std::path::{Path, PathBuf};
 
 pub use crate::pipeline::Tolerance;
 pub use crate::prepared::{collide, distance, meeting_pairs, Collision, Placed, PlacedMesh, Prepared};
@@ -53,6 +56,24 @@ pub struct Options {
     pub split_bodies: bool,
     /// `--threads` (0 = the current pool, or one per core).
     pub threads: usize,
+    /// `--units`: the report's unit (None: `units_a`, else `units_b`, else no conversion).
+    pub units: Option<Unit>,
+    /// `--units-a` (in scene mode: the file's units).
+    pub units_a: Option<Unit>,
+    /// `--units-b`.
+    pub units_b: Option<Unit>,
+    /// `--scale-a` (in scene mode: the file's scale).
+    pub scale_a: Option<f64>,
+    /// `--scale-b`.
+    pub scale_b: Option<f64>,
+    /// `--fail-on`.
+    pub gate: Gate,
+    /// `--baseline REPORT`.
+    pub baseline: Option<PathBuf>,
+    /// `scene --self` with the extra `--self-fail-on` conditions (None: no self check).
+    pub self_check: Option<Vec<SelfFailOn>>,
+    /// `--cache DIR` and `--cache-max-bytes`.
+    pub cache: Option<CacheConfig>,
 }
 
 impl Default for Options {
@@ -71,7 +92,24 @@ impl Default for Options {
             selection: Selection::default(),
             split_bodies: false,
             threads: 0,
+            units: None,
+            units_a: None,
+            units_b: None,
+            scale_a: None,
+            scale_b: None,
+            gate: Gate::default(),
+            baseline: None,
+            self_check: None,
+            cache: None,
         }
+    }
+}
+
+/// The verdict `--fail-on` gates on (`new` gates on the baseline, and on no verdict).
+fn verdict_gate(g: Gate) -> FailOn {
+    match g {
+        Gate::Verdict(f) => f,
+        Gate::New => FailOn::Never,
     }
 }
 
@@ -80,7 +118,28 @@ impl Options {
     pub fn request(&self, inputs: Vec<InputRequest>) -> Request {
         let mut selection = self.selection.clone();
         selection.scene = inputs.len() == 1;
+        // As the command line: in scene mode the one file's units and scale are A's.
+        let units = if selection.scene {
+            Units {
+                report: self.units.or(self.units_a),
+                inputs: [self.units_a, None],
+                scale: [self.scale_a, None],
+            }
+        } else {
+            Units {
+                report: self.units.or(self.units_a).or(self.units_b),
+                inputs: [self.units_a, self.units_b],
+                scale: [self.scale_a, self.scale_b],
+            }
+        };
+        let self_check =
+            self.self_check.as_ref().map(|extra| self_report::scene_fail_on(verdict_gate(self.gate), extra));
         Request {
+            units,
+            gate: self.gate,
+            baseline: self.baseline.clone(),
+            self_check,
+            cache: self.cache.clone(),
             inputs,
             touch: self.touch,
             clearance: self.clearance,
@@ -101,8 +160,14 @@ impl Options {
         }
     }
 
-    /// Reject what the command line rejects (leaf size, distance allowances).
+    /// Reject what the command line rejects (leaf size, distance allowances, scales; the
+    /// pipeline's [`Request::validate`] refuses the conflicts).
     pub fn validate(&self) -> Result<()> {
+        for (flag, v) in [("scale-a", self.scale_a), ("scale-b", self.scale_b)] {
+            if let Some(x) = v.filter(|x| !(x.is_finite() && *x > 0.0)) {
+                return Err(Error::bad_flag(flag, UsageProblem::NotPositive { value: x }));
+            }
+        }
         if !(1..=64).contains(&self.bvh.leaf_size) {
             let problem = UsageProblem::OutOfRange { value: self.bvh.leaf_size.into(), min: 1, max: 64 };
             return Err(Error::bad_flag("leaf-size", problem));

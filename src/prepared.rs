@@ -32,6 +32,7 @@ pub struct Prepared {
     pub label: PathBuf,
     surface: OnceLock<Option<Surface>>,
     convex: OnceLock<bool>,
+    topology: OnceLock<Arc<Topology>>,
 }
 
 impl Prepared {
@@ -45,6 +46,7 @@ impl Prepared {
             label: label.to_path_buf(),
             surface: OnceLock::new(),
             convex: OnceLock::new(),
+            topology: OnceLock::new(),
         })
     }
 
@@ -61,6 +63,11 @@ impl Prepared {
         })
     }
 
+    /// The closedness and components of the mesh in its own coordinates, found once.
+    fn topology(&self) -> &Arc<Topology> {
+        self.topology.get_or_init(|| Arc::new(containment::topology(&self.mesh)))
+    }
+
     /// Place the mesh: every vertex transformed in f64 (as `--transform` does; identity keeps
     /// the coordinates as they are), the tree mapped onto the result conservatively.
     pub fn place(self: &Arc<Self>, m: DMat4) -> Result<Placed> {
@@ -75,6 +82,9 @@ impl Prepared {
                 root,
                 topology: OnceLock::new(),
                 convex: OnceLock::new(),
+                translated: OnceLock::new(),
+                ball: OnceLock::new(),
+                id: next_id(),
             });
         }
         let mut world = Vec::with_capacity(local.len());
@@ -104,8 +114,17 @@ impl Prepared {
             root,
             topology: OnceLock::new(),
             convex: OnceLock::new(),
+            translated: OnceLock::new(),
+            ball: OnceLock::new(),
+            id: next_id(),
         })
     }
+}
+
+/// A fresh placement id (never reused in the process).
+fn next_id() -> u64 {
+    static NEXT: std::sync::atomic::AtomicU64 = std::sync::atomic::AtomicU64::new(0);
+    NEXT.fetch_add(1, Ordering::Relaxed)
 }
 
 /// How a placed mesh sees the prepared tree.
@@ -144,8 +163,39 @@ pub struct Placed {
     world: Option<Vec<DVec3>>,
     tree: Mapping,
     root: Aabb,
-    topology: OnceLock<Topology>,
+    topology: OnceLock<Arc<Topology>>,
     convex: OnceLock<bool>,
+    translated: OnceLock<bool>,
+    ball: OnceLock<Ball>,
+    id: u64,
+}
+
+/// A ball that holds every vertex of a placed mesh (so its convex hull, and everything the
+/// collision and distance queries look at): center and radius, the radius rounded up by the
+/// search margin of the coordinates' scale ([`predicates::distance_rounding_slack`]), so that
+/// `|v - center| <= radius` holds exactly for every vertex.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Ball {
+    /// The center (the box center).
+    pub center: DVec3,
+    /// The radius, rounded up.
+    pub radius: f64,
+    /// The search margin of the coordinates' scale.
+    pub slack: f64,
+}
+
+impl Ball {
+    /// A lower bound of the distance between any point of `self` and any point of `o`
+    /// (negative when the balls overlap): the f64 distance of the centers less both radii and
+    /// the rounding of that distance.
+    pub fn gap(&self, o: &Ball) -> f64 {
+        (self.center - o.center).length() - self.radius - o.radius - self.slack.max(o.slack)
+    }
+
+    /// Certainly apart: no point of one ball within the other.
+    pub fn apart(&self, o: &Ball) -> bool {
+        self.gap(o) > 0.0
+    }
 }
 
 /// A placed mesh as the checks read it (world coordinates; nothing copied).
@@ -214,8 +264,8 @@ impl Placed {
                 return false;
             }
             match &self.world {
+                _ if self.translated() => true,
                 None => true,
-                Some(w) if predicates::exact_translation(&p.mesh.positions, w).is_some() => true,
                 Some(w) => p.surface().is_some_and(|s| convex::is_convex(w, &p.mesh.triangles, s)),
             }
         })
@@ -230,8 +280,59 @@ impl Placed {
         Some(Polytope { positions: self.positions(), triangles: &self.prepared.mesh.triangles, surface })
     }
 
+    /// This placement's id, unique in the process: answers about a pair of placements can be
+    /// kept under the pair of ids (a placed mesh never changes; moving an object places it anew).
+    pub fn id(&self) -> u64 {
+        self.id
+    }
+
+    /// The bounding ball of the world vertices ([`Ball`]), found once.
+    pub fn ball(&self) -> Ball {
+        *self.ball.get_or_init(|| {
+            let center = self.root.center();
+            let pos = self.positions();
+            let scale = self.root.min.abs().max(self.root.max.abs()).max_element();
+            let slack = predicates::distance_rounding_slack(scale);
+            let r = pos.iter().map(|v| (*v - center).length_squared()).fold(0.0f64, f64::max).sqrt();
+            Ball { center, radius: r + slack, slack }
+        })
+    }
+
+    /// Certainly apart (by their boxes or their balls): the two can neither collide nor be
+    /// nearer than [`Placed::gap`].
+    pub fn apart(&self, o: &Placed) -> bool {
+        !self.bounds().overlaps(&o.bounds()) || self.ball().apart(&o.ball())
+    }
+
+    /// A lower bound of the distance between the two meshes: the larger of their boxes' and
+    /// their balls' gaps (0 when both overlap).
+    pub fn gap(&self, o: &Placed) -> f64 {
+        let (ba, bb) = (self.ball(), o.ball());
+        let boxes = self.bounds().distance_sq(&o.bounds()).sqrt() - ba.slack.max(bb.slack);
+        boxes.max(ba.gap(&bb)).max(0.0)
+    }
+
+    /// Exact: are the world coordinates the prepared mesh's own, or an exact translation of
+    /// them ([`predicates::exact_translation`])? Then every orientation sign, every exactly
+    /// coincident vertex pair and every degenerate triangle is the same as in the prepared
+    /// mesh, so its placement-free answers (convexity, topology) hold here. Decided once.
+    fn translated(&self) -> bool {
+        *self.translated.get_or_init(|| match &self.world {
+            None => true,
+            Some(w) => predicates::exact_translation(&self.prepared.mesh.positions, w).is_some(),
+        })
+    }
+
+    /// Closedness and components ([`containment::topology`]): the prepared mesh's when
+    /// [`Placed::translated`], else found on the world coordinates. Found once.
     fn topology(&self) -> &Topology {
-        self.topology.get_or_init(|| containment::topology(&self.mesh()))
+        self.topology.get_or_init(|| {
+            if self.translated() {
+                self.prepared.topology().clone()
+            } else {
+                Arc::new(containment::topology(&self.mesh()))
+            }
+        })
     }
 }
 
@@ -556,6 +657,51 @@ mod tests {
         assert!(c.contacts.is_empty());
         assert_eq!(c.containment, Containment::BInA);
         assert_eq!(distance(&pbig, &small, f64::INFINITY).unwrap().distance, 1.0);
+    }
+
+    /// Balls hold every vertex, their gap is a lower bound of the true distance, and apart
+    /// pairs never collide; a translated placement's topology (taken from the prepared mesh) is
+    /// the one found on its world coordinates.
+    #[test]
+    fn balls_bound_and_translated_topology_matches() {
+        let a = prepared(cube(DVec3::ZERO));
+        let placements = [
+            DMat4::IDENTITY,
+            DMat4::from_translation(DVec3::new(1.5, 0.25, -0.5)),
+            DMat4::from_translation(DVec3::new(0.1, 0.2, 0.3)),
+            DMat4::from_translation(DVec3::new(2.0, 2.0, 0.0)) * DMat4::from_rotation_z(0.7),
+            DMat4::from_translation(DVec3::new(0.9, 0.9, 0.9)) * DMat4::from_rotation_x(0.3),
+        ];
+        let placed: Vec<Placed> = placements.iter().map(|&m| a.place(m).unwrap()).collect();
+        for p in &placed {
+            let b = p.ball();
+            assert!(p.positions().iter().all(|v| (*v - b.center).length() <= b.radius));
+            // The same closedness, components and coincidences (merged ids are numbered by the
+            // coordinates' order, which a translation may change).
+            let (t, fresh) = (p.topology(), containment::topology(&p.mesh()));
+            assert_eq!(
+                (t.closed, &t.component_seeds, &t.component_of),
+                (fresh.closed, &fresh.component_seeds, &fresh.component_of)
+            );
+            let n = t.merged.len();
+            for i in 0..n {
+                for j in 0..n {
+                    assert_eq!(t.merged[i] == t.merged[j], fresh.merged[i] == fresh.merged[j]);
+                }
+            }
+        }
+        assert!(placed[0].translated() && placed[1].translated() && !placed[3].translated());
+        for x in &placed {
+            for y in &placed {
+                let gap = x.gap(y);
+                let d = distance(x, y, f64::INFINITY).unwrap().distance;
+                let c = collide(x, y, false).collides();
+                assert!(gap <= d, "{gap} > {d}");
+                if x.apart(y) {
+                    assert!(!c && d > 0.0);
+                }
+            }
+        }
     }
 
     #[test]

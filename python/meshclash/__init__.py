@@ -119,6 +119,15 @@ def check(
     leaf_size=4,
     distance_rel_err=0.0,
     distance_abs_err=0.0,
+    units=None,
+    units_a=None,
+    units_b=None,
+    scale_a=None,
+    scale_b=None,
+    fail_on="clash",
+    baseline=None,
+    cache=None,
+    cache_max_bytes=None,
 ) -> dict:
     """Check mesh ``a`` against mesh ``b``; return the report as a dict.
 
@@ -130,6 +139,13 @@ def check(
     string with a ``rel`` suffix (``"1e-6rel"``); ``mode`` ``"exact"`` or ``"fast"``;
     ``detail`` ``"pairs"`` or ``"parts"`` (``--detail``: part-pair verdicts, counts and closest points without triangle-pair lists or regions); ``threads`` 0 for one per core; ``timings=False`` is ``--no-timings`` (the same inputs then
     give the same document as ``meshclash A B --no-timings``).
+
+    The command line's report flags, with its meaning: ``units`` (``--units``: ``"um"``,
+    ``"mm"``, ``"cm"``, ``"m"``, ``"in"``, ``"ft"``, ``"yd"``), ``units_a``/``units_b``,
+    ``scale_a``/``scale_b``, ``fail_on`` (``"clash"``, ``"touching"``, ``"clearance"``,
+    ``"never"``, ``"new"``; the report's ``failed`` says whether the run fails), ``baseline``
+    (the path of an earlier report), ``cache`` (a cache directory; ``MESHCLASH_CACHE`` is not
+    read: pass it) and ``cache_max_bytes``.
 
     The result has the report's keys and schema version (``meshclash schema`` prints the
     schema): ``verdict`` (``clear``/``clearance``/``touching``/``clash``), ``summary``,
@@ -160,8 +176,28 @@ def check(
         select_a=list(select_a),
         select_b=list(select_b),
         exclude=list(exclude),
+        **_flags(units, units_a, units_b, scale_a, scale_b, fail_on, baseline, cache, cache_max_bytes),
     )
     return json.loads(doc)
+
+
+def _flags(units, units_a, units_b, scale_a, scale_b, fail_on, baseline, cache, cache_max_bytes):
+    """The units, gate, baseline and cache keywords of the native calls (None: as the command
+    line's default)."""
+    out = {"fail_on": str(fail_on)}
+    for key, value in (("units", units), ("units_a", units_a), ("units_b", units_b)):
+        if value is not None:
+            out[key] = str(value)
+    for key, value in (("scale_a", scale_a), ("scale_b", scale_b)):
+        if value is not None:
+            out[key] = float(value)
+    if baseline is not None:
+        out["baseline"] = os.fspath(baseline)
+    if cache is not None:
+        out["cache"] = os.fspath(cache)
+    if cache_max_bytes is not None:
+        out["cache_max_bytes"] = int(cache_max_bytes)
+    return out
 
 
 def scene(
@@ -184,9 +220,22 @@ def scene(
     leaf_size=4,
     distance_rel_err=0.0,
     distance_abs_err=0.0,
+    units=None,
+    file_units=None,
+    scale=None,
+    fail_on="clash",
+    baseline=None,
+    self_check=False,
+    self_fail_on=(),
+    cache=None,
+    cache_max_bytes=None,
 ) -> dict:
     """Check every part of the file at ``path`` against every other part (``meshclash scene
-    FILE``); the flags are those of :func:`check`. Returns the report as a dict."""
+    FILE``); the flags are those of :func:`check`. ``file_units`` and ``scale`` are the file's
+    units and scale (``--units-a``, ``--scale-a``); ``self_check=True`` is ``--self`` (every
+    part against itself too, a ``self`` block), ``self_fail_on`` its ``--self-fail-on``
+    conditions (``"open"``, ``"non-manifold"``, ``"duplicates"``, ``"degenerate"``,
+    ``"winding"``, ``"touching"``, ``"self-clash"``). Returns the report as a dict."""
     doc = _meshclash.scene_json(
         os.fspath(path),
         touch_tolerance=touch_tolerance,
@@ -206,6 +255,11 @@ def scene(
         select_a=list(select_a),
         select_b=list(select_b),
         exclude=list(exclude),
+        self_check=bool(self_check),
+        self_fail_on=[str(x) for x in self_fail_on],
+        **_flags(units, None, None, None, None, fail_on, baseline, cache, cache_max_bytes),
+        **({} if file_units is None else {"file_units": str(file_units)}),
+        **({} if scale is None else {"scale": float(scale)}),
     )
     return json.loads(doc)
 

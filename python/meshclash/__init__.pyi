@@ -45,6 +45,15 @@ def check(
     leaf_size: int = ...,
     distance_rel_err: float = ...,
     distance_abs_err: float = ...,
+    units: Optional[str] = ...,
+    units_a: Optional[str] = ...,
+    units_b: Optional[str] = ...,
+    scale_a: Optional[float] = ...,
+    scale_b: Optional[float] = ...,
+    fail_on: str = ...,
+    baseline: Optional[Union[str, PathLike[str]]] = ...,
+    cache: Optional[Union[str, PathLike[str]]] = ...,
+    cache_max_bytes: Optional[int] = ...,
 ) -> dict[str, Any]:
     """Check a against b; the report document (schema meshclash.report/2) as a dict."""
 
@@ -68,6 +77,15 @@ def scene(
     leaf_size: int = ...,
     distance_rel_err: float = ...,
     distance_abs_err: float = ...,
+    units: Optional[str] = ...,
+    file_units: Optional[str] = ...,
+    scale: Optional[float] = ...,
+    fail_on: str = ...,
+    baseline: Optional[Union[str, PathLike[str]]] = ...,
+    self_check: bool = ...,
+    self_fail_on: Sequence[str] = ...,
+    cache: Optional[Union[str, PathLike[str]]] = ...,
+    cache_max_bytes: Optional[int] = ...,
 ) -> dict[str, Any]:
     """Every part of the file against every other part; the report as a dict."""
 

@@ -27,7 +27,13 @@ Where FCL (python-fcl, behind trimesh) and meshclash disagree, meshclash is exac
   nothing collides; when a pair collides (triangles meet or a part lies inside another), the
   answer is that pair's signed distance, never positive: ``-depth`` when both are convex (as
   FCL's signed distance), 0 otherwise. Like FCL, a distance query stops at the first colliding
-  pair it finds; here that is the first in insertion order (deterministic), not the deepest.
+  pair it finds; here that is deterministic, not the deepest: the first pair in insertion order
+  whose triangles meet, else (no triangles meet anywhere) the first pair in insertion order
+  with one part inside the other.
+* **Answers kept until something moves**: the manager keeps each pair's verdict and signed
+  distance under the two objects' placements; ``set_transform``, ``add_object`` and
+  ``remove_object`` drop those of the object they place. Asking again about a still scene is
+  answered from them (the same exact answers).
 """
 
 from __future__ import annotations

@@ -5,11 +5,14 @@
 use glam::{DMat4, DVec3, DVec4};
 use meshclash::api::{self, Options, Placed, Prepared, Source, Tolerance};
 use meshclash::bvh::{BuildOptions, Strategy};
+use meshclash::cache::CacheConfig;
 use meshclash::check::assembly::Selection;
-use meshclash::check::containment::Containment;
+use meshclash::check::query::FailOn;
 use meshclash::check::query::{Detail, DistanceError, Mode};
 use meshclash::geom::Aabb;
+use meshclash::pipeline::{Gate, Unit};
 use meshclash::prepared;
+use meshclash::report::self_report::SelfFailOn;
 use meshclash::Error;
 use numpy::{PyReadonlyArray2, PyUntypedArrayMethods};
 use pyo3::exceptions::{PyMemoryError, PyOSError, PyValueError};
@@ -254,9 +257,71 @@ fn options(
         selection: Selection { scene: false, select_a, select_b, exclude, hook: None },
         split_bodies,
         threads,
+        ..Options::default()
     };
     o.validate().map_err(py_err)?;
     Ok(o)
+}
+
+/// The command line's units, gate, baseline, self-check and cache flags, onto `o`.
+#[allow(clippy::too_many_arguments)]
+fn flags(
+    o: &mut Options,
+    units: Option<&str>,
+    units_a: Option<&str>,
+    units_b: Option<&str>,
+    scale_a: Option<f64>,
+    scale_b: Option<f64>,
+    fail_on: &str,
+    baseline: Option<PathBuf>,
+    cache: Option<PathBuf>,
+    cache_max_bytes: u64,
+    self_fail_on: Option<Vec<String>>,
+) -> PyResult<()> {
+    let unit = |flag: &str, u: Option<&str>| -> PyResult<Option<Unit>> {
+        u.map(|name| {
+            Unit::from_name(name).ok_or_else(|| {
+                let all: Vec<&str> = Unit::ALL.iter().map(|u| u.name()).collect();
+                PyValueError::new_err(format!("{flag} must be one of {}, got '{name}'", all.join(", ")))
+            })
+        })
+        .transpose()
+    };
+    o.units = unit("units", units)?;
+    o.units_a = unit("units_a", units_a)?;
+    o.units_b = unit("units_b", units_b)?;
+    o.scale_a = scale_a;
+    o.scale_b = scale_b;
+    o.gate = match fail_on {
+        "clash" => Gate::Verdict(FailOn::Clash),
+        "touching" => Gate::Verdict(FailOn::Touching),
+        "clearance" => Gate::Verdict(FailOn::Clearance),
+        "never" => Gate::Verdict(FailOn::Never),
+        "new" => Gate::New,
+        f => {
+            return Err(PyValueError::new_err(format!(
+                "fail_on must be 'clash', 'touching', 'clearance', 'never' or 'new', got '{f}'"
+            )))
+        }
+    };
+    o.baseline = baseline;
+    o.cache = cache.map(|dir| CacheConfig { dir, max_bytes: cache_max_bytes });
+    o.self_check = self_fail_on
+        .map(|names| {
+            names
+                .iter()
+                .map(|n| {
+                    SelfFailOn::from_name(n).ok_or_else(|| {
+                        PyValueError::new_err(format!(
+                            "self_fail_on: unknown condition '{n}' (self-clash, touching, open, non-manifold, \
+                             duplicates, degenerate, winding, never)"
+                        ))
+                    })
+                })
+                .collect::<PyResult<Vec<_>>>()
+        })
+        .transpose()?;
+    o.validate().map_err(py_err)
 }
 
 /// The report of `a` against `b` as JSON text (see `meshclash.check`).
@@ -264,7 +329,9 @@ fn options(
 #[pyo3(signature = (a, b, *, transform_a=None, transform_b=None, touch_tolerance=None, clearance=None,
     max_pairs=1000, mode="exact", first_hit=false, detail="pairs", threads=0, timings=true, penetration=false,
     split_bodies=false, bvh="sah", leaf_size=4, distance_rel_err=0.0, distance_abs_err=0.0,
-    select_a=vec![], select_b=vec![], exclude=vec![]))]
+    select_a=vec![], select_b=vec![], exclude=vec![], units=None, units_a=None, units_b=None,
+    scale_a=None, scale_b=None, fail_on="clash", baseline=None, cache=None,
+    cache_max_bytes=meshclash::cache::DEFAULT_MAX_BYTES))]
 #[allow(clippy::too_many_arguments)]
 fn check_json(
     py: Python<'_>,
@@ -289,9 +356,18 @@ fn check_json(
     select_a: Vec<String>,
     select_b: Vec<String>,
     exclude: Vec<String>,
+    units: Option<&str>,
+    units_a: Option<&str>,
+    units_b: Option<&str>,
+    scale_a: Option<f64>,
+    scale_b: Option<f64>,
+    fail_on: &str,
+    baseline: Option<PathBuf>,
+    cache: Option<PathBuf>,
+    cache_max_bytes: u64,
 ) -> PyResult<String> {
     let zero = 0.0f64.into_pyobject(py)?.into_any();
-    let opts = options(
+    let mut opts = options(
         touch_tolerance.as_ref().unwrap_or(&zero),
         clearance.as_ref().unwrap_or(&zero),
         max_pairs,
@@ -309,6 +385,19 @@ fn check_json(
         select_a,
         select_b,
         exclude,
+    )?;
+    flags(
+        &mut opts,
+        units,
+        units_a,
+        units_b,
+        scale_a,
+        scale_b,
+        fail_on,
+        baseline,
+        cache,
+        cache_max_bytes,
+        None,
     )?;
     let ta = transform("transform-a", transform_a)?;
     let tb = transform("transform-b", transform_b)?;
@@ -333,7 +422,9 @@ fn check_json(
 #[pyo3(signature = (path, *, touch_tolerance=None, clearance=None, max_pairs=1000, mode="exact",
     first_hit=false, detail="pairs", threads=0, timings=true, penetration=false, split_bodies=false, bvh="sah",
     leaf_size=4, distance_rel_err=0.0, distance_abs_err=0.0, select_a=vec![], select_b=vec![],
-    exclude=vec![]))]
+    exclude=vec![], units=None, file_units=None, scale=None, fail_on="clash", baseline=None,
+    self_check=false, self_fail_on=vec![], cache=None,
+    cache_max_bytes=meshclash::cache::DEFAULT_MAX_BYTES))]
 #[allow(clippy::too_many_arguments)]
 fn scene_json(
     py: Python<'_>,
@@ -355,6 +446,15 @@ fn scene_json(
     select_a: Vec<String>,
     select_b: Vec<String>,
     exclude: Vec<String>,
+    units: Option<&str>,
+    file_units: Option<&str>,
+    scale: Option<f64>,
+    fail_on: &str,
+    baseline: Option<PathBuf>,
+    self_check: bool,
+    self_fail_on: Vec<String>,
+    cache: Option<PathBuf>,
+    cache_max_bytes: u64,
 ) -> PyResult<String> {
     let zero = 0.0f64.into_pyobject(py)?.into_any();
     let mut opts = options(
@@ -375,6 +475,24 @@ fn scene_json(
         select_a,
         select_b,
         exclude,
+    )?;
+    if !self_check && !self_fail_on.is_empty() {
+        return Err(PyValueError::new_err(
+            "self_fail_on needs self_check=True (--self-fail-on needs --self)",
+        ));
+    }
+    flags(
+        &mut opts,
+        units,
+        file_units,
+        None,
+        scale,
+        None,
+        fail_on,
+        baseline,
+        cache,
+        cache_max_bytes,
+        self_check.then_some(self_fail_on),
     )?;
     opts.selection.scene = true;
     py.detach(move || -> meshclash::Result<String> {
@@ -521,53 +639,166 @@ fn contacts(a: &Placed, b: &Placed, c: &api::Collision) -> Vec<Contact> {
         .collect()
 }
 
-/// Exact collision of every candidate pair `(i, j)` (boxes meet), sorted by (i, j). With
-/// `stop_at_first` (a yes/no question) the answer is the first colliding pair in (i, j) order:
-/// meeting triangles are looked for in every pair first (a crossing settles it), containment
-/// only when no pair has any.
+/// What a pair's exact collision test said: does it collide, and the containment name when
+/// no triangles meet.
+#[derive(Debug, Clone, Copy)]
+struct Verdict {
+    collides: bool,
+    containment: Option<&'static str>,
+}
+
+/// Answers about pairs of placements kept across queries, under the pair of placement ids
+/// ([`Placed::id`]): a placed mesh never changes and moving an object places it anew, so an
+/// entry stays true until one of the two objects moves (its entries are dropped then).
+#[derive(Default)]
+struct Memo {
+    verdicts: HashMap<(u64, u64), Verdict>,
+    signed: HashMap<(u64, u64), prepared::Signed>,
+    /// Pairs known to have no meeting triangles (their containment not decided yet).
+    no_meeting: std::collections::HashSet<(u64, u64)>,
+}
+
+impl Memo {
+    /// Forget every answer about placement `id`.
+    fn forget(&mut self, id: u64) {
+        self.verdicts.retain(|k, _| k.0 != id && k.1 != id);
+        self.signed.retain(|k, _| k.0 != id && k.1 != id);
+        self.no_meeting.retain(|k| k.0 != id && k.1 != id);
+    }
+}
+
+/// Above this many entries a memo is emptied (a bound on memory; only speed depends on it).
+const MEMO_MAX: usize = 1 << 20;
+
+/// The memo a query reads and fills (`None`: a one-off query, e.g. against a single mesh).
+struct Memory<'a>(Option<&'a Mutex<Memo>>);
+
+impl Memory<'_> {
+    fn verdict(&self, k: (u64, u64)) -> Option<Verdict> {
+        self.0.and_then(|m| m.lock().unwrap().verdicts.get(&k).copied())
+    }
+    fn keep_verdict(&self, k: (u64, u64), v: Verdict) {
+        if let Some(m) = self.0 {
+            let mut m = m.lock().unwrap();
+            if m.verdicts.len() >= MEMO_MAX {
+                m.verdicts.clear();
+            }
+            m.verdicts.insert(k, v);
+        }
+    }
+    fn no_meeting(&self, k: (u64, u64)) -> bool {
+        self.0.is_some_and(|m| m.lock().unwrap().no_meeting.contains(&k))
+    }
+    fn keep_no_meeting(&self, k: (u64, u64)) {
+        if let Some(m) = self.0 {
+            let mut m = m.lock().unwrap();
+            if m.no_meeting.len() >= MEMO_MAX {
+                m.no_meeting.clear();
+            }
+            m.no_meeting.insert(k);
+        }
+    }
+    fn signed(&self, k: (u64, u64)) -> Option<prepared::Signed> {
+        self.0.and_then(|m| m.lock().unwrap().signed.get(&k).cloned())
+    }
+    fn keep_signed(&self, k: (u64, u64), v: &prepared::Signed) {
+        if let Some(m) = self.0 {
+            let mut m = m.lock().unwrap();
+            if m.signed.len() >= MEMO_MAX {
+                m.signed.clear();
+            }
+            m.signed.insert(k, v.clone());
+        }
+    }
+}
+
+/// Run `f` on every item, in order; on the calling thread for short lists (waking the pool
+/// costs more than a few exact checks; a speed threshold, no answer depends on it).
+fn filter_map_all<T: Sync, R: Send>(items: &[T], f: impl Fn(&T) -> Option<R> + Sync + Send) -> Vec<R> {
+    if items.len() <= SEQUENTIAL_PAIRS {
+        items.iter().filter_map(f).collect()
+    } else {
+        items.par_iter().filter_map(f).collect()
+    }
+}
+
+/// Some item for which `f` answers (any: the caller needs only one).
+fn find_any<T: Sync, R: Send>(items: &[T], f: impl Fn(&T) -> Option<R> + Sync + Send) -> Option<R> {
+    if items.len() <= SEQUENTIAL_PAIRS {
+        items.iter().find_map(f)
+    } else {
+        items.par_iter().find_map_any(f)
+    }
+}
+
+/// The first item (in order) for which `f` answers.
+fn find_first<T: Sync, R: Send>(items: &[T], f: impl Fn(&T) -> Option<R> + Sync + Send) -> Option<R> {
+    if items.len() <= SEQUENTIAL_PAIRS {
+        items.iter().find_map(f)
+    } else {
+        items.par_iter().find_map_first(f)
+    }
+}
+
+/// Exact collision of every candidate pair `(i, j)`, sorted by (i, j); pairs whose boxes or
+/// bounding balls are apart are settled without a look at their triangles. With
+/// `stop_at_first` (a yes/no question) the answer is one colliding pair, any: a pair known to
+/// collide from an earlier query, else meeting triangles are looked for in every open pair
+/// first (a crossing settles it), containment only when no pair has any.
 fn collide_pairs(
     pairs: &[(usize, usize)],
     a: &[Arc<Placed>],
     b: &[Arc<Placed>],
     data: bool,
     stop_at_first: bool,
+    memo: Memory<'_>,
 ) -> Vec<Hit> {
-    let hit = |&(i, j): &(usize, usize), c: api::Collision| -> Option<Hit> {
-        if !c.collides() {
-            return None;
+    let key = |&(i, j): &(usize, usize)| (a[i].id(), b[j].id());
+    let near: Vec<(usize, usize)> = pairs.iter().copied().filter(|&(i, j)| !a[i].apart(&b[j])).collect();
+    let decide = |p: &(usize, usize)| -> Verdict {
+        if let Some(v) = memo.verdict(key(p)) {
+            return v;
         }
+        let c = api::collide(&a[p.0], &b[p.1], false);
+        let v = Verdict { collides: c.collides(), containment: c.containment.name() };
+        memo.keep_verdict(key(p), v);
+        v
+    };
+    let hit = |&(i, j): &(usize, usize), v: Verdict| -> Hit {
         let cs = if data { contacts(&a[i], &b[j], &api::collide(&a[i], &b[j], true)) } else { Vec::new() };
-        Some((i, j, cs, c.containment.name()))
+        (i, j, cs, v.containment)
     };
     if stop_at_first {
+        let mut open = Vec::with_capacity(near.len());
+        for p in &near {
+            match memo.verdict(key(p)) {
+                Some(v) if v.collides => return vec![hit(p, v)],
+                Some(_) => {}
+                None => open.push(*p),
+            }
+        }
         let meet = |p: &(usize, usize)| {
             let (x, y) = (&a[p.0], &b[p.1]);
             let m = api::meeting_pairs(&x.mesh(), &x.tree(), &y.mesh(), &y.tree(), true);
-            (!m.is_empty()).then(|| hit(p, api::Collision { contacts: m, containment: Containment::None }))?
+            (!m.is_empty()).then(|| {
+                let v = Verdict { collides: true, containment: None };
+                memo.keep_verdict(key(p), v);
+                hit(p, v)
+            })
         };
-        let found = if pairs.len() <= SEQUENTIAL_PAIRS {
-            pairs.iter().find_map(meet)
-        } else {
-            pairs.par_iter().find_map_first(meet)
-        };
-        if let Some(h) = found {
+        if let Some(h) = find_any(&open, meet) {
             return vec![h];
         }
-        let contained = |p: &(usize, usize)| hit(p, api::collide(&a[p.0], &b[p.1], false));
-        return if pairs.len() <= SEQUENTIAL_PAIRS {
-            pairs.iter().find_map(contained)
-        } else {
-            pairs.par_iter().find_map_first(contained)
-        }
-        .into_iter()
-        .collect();
+        let contained = |p: &(usize, usize)| {
+            let v = decide(p);
+            v.collides.then(|| hit(p, v))
+        };
+        return find_any(&open, contained).into_iter().collect();
     }
-    let run = |p: &(usize, usize)| hit(p, api::collide(&a[p.0], &b[p.1], false));
-    if pairs.len() <= SEQUENTIAL_PAIRS {
-        pairs.iter().filter_map(run).collect()
-    } else {
-        pairs.par_iter().filter_map(run).collect()
-    }
+    filter_map_all(&near, |p| {
+        let v = decide(p);
+        v.collides.then(|| hit(p, v))
+    })
 }
 
 /// Up to this many candidate object pairs, a query runs them on the calling thread (waking the
@@ -575,62 +806,110 @@ fn collide_pairs(
 const SEQUENTIAL_PAIRS: usize = 8;
 
 /// The closest pair over candidate object pairs: (signed distance, i, j, face i, face j, point
-/// i, point j). When some pair with meeting boxes collides, the first colliding pair in (i, j)
-/// order, with its signed distance (<= 0); otherwise the smallest gap, ties broken by (i, j),
-/// pairs whose boxes are farther apart than the best gap so far skipped.
+/// i, point j). When some pair collides, a colliding pair with its signed distance (<= 0): the
+/// first pair in (i, j) order whose triangles meet, else the first in (i, j) order with one
+/// part inside the other; otherwise the smallest gap, ties broken by (i, j), pairs whose
+/// lower bound (boxes, balls) is above the best gap so far skipped.
 type Near = (f64, usize, usize, i64, i64, [f64; 3], [f64; 3]);
 
 fn near(d: prepared::Signed, i: usize, j: usize) -> Near {
     (d.distance, i, j, d.a.0, d.b.0, d.a.1.to_array(), d.b.1.to_array())
 }
 
-fn nearest(pairs: Vec<(usize, usize)>, a: &[Arc<Placed>], b: &[Arc<Placed>]) -> Option<Near> {
-    let overlapping: Vec<(usize, usize)> =
-        pairs.iter().copied().filter(|&(i, j)| a[i].bounds().overlaps(&b[j].bounds())).collect();
-    let colliding = |&(i, j): &(usize, usize)| {
-        let c = api::collide(&a[i], &b[j], false);
-        c.collides().then(|| near(prepared::signed_distance(&a[i], &b[j], 0.0).expect("colliding"), i, j))
+/// `candidates`: the pairs whose boxes meet, sorted (only they can collide); `all`: every pair
+/// the query is about (made only when no candidate collides).
+fn nearest(
+    candidates: &[(usize, usize)],
+    all: impl FnOnce() -> Vec<(usize, usize)>,
+    a: &[Arc<Placed>],
+    b: &[Arc<Placed>],
+    memo: Memory<'_>,
+) -> Option<Near> {
+    let key = |i: usize, j: usize| (a[i].id(), b[j].id());
+    let signed = |i: usize, j: usize, bound: f64| -> Option<prepared::Signed> {
+        if let Some(s) = memo.signed(key(i, j)) {
+            return Some(s);
+        }
+        let s = prepared::signed_distance(&a[i], &b[j], bound)?;
+        memo.keep_signed(key(i, j), &s);
+        Some(s)
     };
-    let first = if overlapping.len() <= SEQUENTIAL_PAIRS {
-        overlapping.iter().find_map(colliding)
-    } else {
-        overlapping.par_iter().find_map_first(colliding)
-    };
-    if first.is_some() {
-        return first;
+    // From the kept answers alone when they settle it: the first candidate in order known to
+    // have meeting triangles, every candidate before it known not to.
+    for &(i, j) in candidates {
+        match memo.verdict(key(i, j)) {
+            Some(v) if v.collides && v.containment.is_none() => {
+                if let Some(s) = memo.signed(key(i, j)) {
+                    return Some(near(s, i, j));
+                }
+                break;
+            }
+            Some(_) => {}
+            None if memo.no_meeting(key(i, j)) || a[i].apart(&b[j]) => {}
+            None => break,
+        }
     }
-    let key = |x: &(f64, usize, usize), y: &(f64, usize, usize)| {
+    let overlapping: Vec<(usize, usize)> =
+        candidates.iter().copied().filter(|&(i, j)| !a[i].apart(&b[j])).collect();
+    // Meeting triangles first (a pair known to collide without containment has them), then
+    // containment: the first pair in (i, j) order of the first kind found.
+    let meeting = |&(i, j): &(usize, usize)| match memo.verdict(key(i, j)) {
+        Some(v) => (v.collides && v.containment.is_none()).then_some((i, j)),
+        None if memo.no_meeting(key(i, j)) => None,
+        None => {
+            let (x, y) = (&a[i], &b[j]);
+            let m = api::meeting_pairs(&x.mesh(), &x.tree(), &y.mesh(), &y.tree(), true);
+            if m.is_empty() {
+                memo.keep_no_meeting(key(i, j));
+                return None;
+            }
+            memo.keep_verdict(key(i, j), Verdict { collides: true, containment: None });
+            Some((i, j))
+        }
+    };
+    let contained = |&(i, j): &(usize, usize)| {
+        let v = match memo.verdict(key(i, j)) {
+            Some(v) => v,
+            None => {
+                let c = api::collide(&a[i], &b[j], false);
+                let v = Verdict { collides: c.collides(), containment: c.containment.name() };
+                memo.keep_verdict(key(i, j), v);
+                v
+            }
+        };
+        v.collides.then_some((i, j))
+    };
+    if let Some((i, j)) = find_first(&overlapping, meeting).or_else(|| find_first(&overlapping, contained)) {
+        return Some(near(signed(i, j, 0.0).expect("colliding"), i, j));
+    }
+    let key3 = |x: &(f64, usize, usize), y: &(f64, usize, usize)| {
         x.0.total_cmp(&y.0).then((x.1, x.2).cmp(&(y.1, y.2)))
     };
     let mut by_bound: Vec<(f64, usize, usize)> =
-        pairs.into_iter().map(|(i, j)| (a[i].bounds().distance_sq(&b[j].bounds()).sqrt(), i, j)).collect();
-    // Only pairs whose box distance is at most the smallest box pair's true distance can win.
-    let (_, i0, j0) = *by_bound.iter().min_by(|x, y| key(x, y))?;
-    let cap = api::distance(&a[i0], &b[j0], f64::INFINITY).map_or(f64::INFINITY, |c| c.distance);
+        all().into_iter().map(|(i, j)| (a[i].gap(&b[j]), i, j)).collect();
+    // Only pairs whose lower bound is at most the smallest bound's true distance can win.
+    let (_, i0, j0) = *by_bound.iter().min_by(|x, y| key3(x, y))?;
+    let cap = signed(i0, j0, f64::INFINITY).map_or(f64::INFINITY, |c| c.distance);
     by_bound.retain(|x| x.0 <= cap);
-    by_bound.sort_by(key);
+    by_bound.sort_by(key3);
     // The best (distance, i, j) so far: a pair can only beat it if its (lower bound, i, j)
     // comes first, so the answer (smallest distance, then smallest (i, j)) does not depend on
     // the order the threads finish in.
     let best = Mutex::new((f64::INFINITY, usize::MAX, usize::MAX));
     let eval = |&(lb, i, j): &(f64, usize, usize)| {
         let bound = *best.lock().unwrap();
-        if key(&(lb, i, j), &bound).is_gt() {
+        if key3(&(lb, i, j), &bound).is_gt() {
             return None;
         }
-        let c = prepared::signed_distance(&a[i], &b[j], bound.0)?;
+        let c = signed(i, j, bound.0)?;
         let mut g = best.lock().unwrap();
-        if key(&(c.distance, i, j), &g).is_lt() {
+        if key3(&(c.distance, i, j), &g).is_lt() {
             *g = (c.distance, i, j);
         }
         Some(near(c, i, j))
     };
-    let found: Vec<Near> = if by_bound.len() <= SEQUENTIAL_PAIRS {
-        by_bound.iter().filter_map(eval).collect()
-    } else {
-        by_bound.par_iter().filter_map(eval).collect()
-    };
-    found.into_iter().min_by(|x, y| key(&(x.0, x.1, x.2), &(y.0, y.1, y.2)))
+    let found = filter_map_all(&by_bound, eval);
+    found.into_iter().min_by(|x, y| key3(&(x.0, x.1, x.2), &(y.0, y.1, y.2)))
 }
 
 /// A sweep-and-prune broad phase over the objects' world boxes, kept across queries: the
@@ -697,6 +976,11 @@ struct Manager {
     index: HashMap<String, usize>,
     objs: Vec<Arc<Placed>>,
     sweep: Sweep,
+    /// The candidate pairs (boxes meet) of the objects, sorted, kept across queries: updated
+    /// for the one object an add or set_transform places, rebuilt after a removal.
+    pairs: Mutex<Option<Vec<(usize, usize)>>>,
+    /// Pair answers kept across queries ([`Memo`]).
+    memo: Mutex<Memo>,
 }
 
 impl Manager {
@@ -710,7 +994,24 @@ impl Manager {
     fn set(&mut self, i: usize, placed: Arc<Placed>) {
         self.sweep.remove(i, &self.objs[i].bounds());
         self.sweep.insert(i, &placed.bounds());
+        self.memo.get_mut().unwrap().forget(self.objs[i].id());
         self.objs[i] = placed;
+        self.placed(i);
+    }
+
+    /// Object `i` was placed anew (added or moved): its candidate pairs are found again.
+    fn placed(&mut self, i: usize) {
+        let Some(pairs) = self.pairs.get_mut().unwrap().as_mut() else { return };
+        pairs.retain(|&(x, y)| x != i && y != i);
+        let with = self.sweep.against(&self.objs, &self.objs[i].bounds());
+        pairs.extend(with.into_iter().filter(|&j| j != i).map(|j| (i.min(j), i.max(j))));
+        pairs.sort_unstable();
+    }
+
+    /// The candidate pairs (i < j, boxes meet), sorted.
+    fn candidate_pairs(&self) -> Vec<(usize, usize)> {
+        let mut kept = self.pairs.lock().unwrap();
+        kept.get_or_insert_with(|| self.sweep.pairs(&self.objs)).clone()
     }
 
     /// Pairs (ours, theirs) whose boxes meet, sorted.
@@ -755,6 +1056,7 @@ impl Manager {
                 self.index.insert(name.clone(), i);
                 self.names.push(name);
                 self.objs.push(placed);
+                self.placed(i);
             }
         }
         Ok(())
@@ -764,6 +1066,8 @@ impl Manager {
         let i = self.find(name)?;
         self.sweep.remove(i, &self.objs[i].bounds());
         self.sweep.renumber_after(i);
+        self.memo.get_mut().unwrap().forget(self.objs[i].id());
+        *self.pairs.get_mut().unwrap() = None;
         self.names.remove(i);
         self.objs.remove(i);
         self.index = self.names.iter().enumerate().map(|(k, n)| (n.clone(), k)).collect();
@@ -784,9 +1088,9 @@ impl Manager {
 
     /// Colliding pairs among the objects: (name, name, contacts, containment).
     fn collide_internal(&self, py: Python<'_>, data: bool, stop_at_first: bool) -> Vec<NamedHit> {
-        let pairs = self.sweep.pairs(&self.objs);
-        let objs = &self.objs;
-        let hits = py.detach(|| collide_pairs(&pairs, objs, objs, data, stop_at_first));
+        let pairs = self.candidate_pairs();
+        let (objs, memo) = (&self.objs, &self.memo);
+        let hits = py.detach(|| collide_pairs(&pairs, objs, objs, data, stop_at_first, Memory(Some(memo))));
         hits.into_iter().map(|(i, j, c, k)| (self.names[i].clone(), self.names[j].clone(), c, k)).collect()
     }
 
@@ -799,8 +1103,8 @@ impl Manager {
         stop_at_first: bool,
     ) -> Vec<NamedHit> {
         let pairs = self.pairs_with(&other.objs);
-        let (a, b) = (&self.objs, &other.objs);
-        let hits = py.detach(|| collide_pairs(&pairs, a, b, data, stop_at_first));
+        let (a, b, memo) = (&self.objs, &other.objs, &self.memo);
+        let hits = py.detach(|| collide_pairs(&pairs, a, b, data, stop_at_first, Memory(Some(memo))));
         hits.into_iter().map(|(i, j, c, k)| (self.names[i].clone(), other.names[j].clone(), c, k)).collect()
     }
 
@@ -818,7 +1122,7 @@ impl Manager {
         let single = vec![place(py, &mesh.inner, transform_of(transform)?)?];
         let pairs = self.pairs_with(&single);
         let a = &self.objs;
-        let hits = py.detach(|| collide_pairs(&pairs, a, &single, data, stop_at_first));
+        let hits = py.detach(|| collide_pairs(&pairs, a, &single, data, stop_at_first, Memory(None)));
         Ok(hits.into_iter().map(|(i, _, c, k)| (self.names[i].clone(), c, k)).collect())
     }
 
@@ -826,14 +1130,27 @@ impl Manager {
     #[pyo3(signature = (name=None))]
     fn distance_internal(&self, py: Python<'_>, name: Option<String>) -> PyResult<Option<NamedNear>> {
         let objs = &self.objs;
-        let pairs: Vec<(usize, usize)> = match &name {
-            None => (0..objs.len()).flat_map(|i| (i + 1..objs.len()).map(move |j| (i, j))).collect(),
-            Some(n) => {
-                let k = self.find(n)?;
-                (0..objs.len()).filter(|&j| j != k).map(|j| (k, j)).collect()
+        let n = objs.len();
+        let k = name.as_deref().map(|n| self.find(n)).transpose()?;
+        let mut candidates = self.candidate_pairs();
+        if let Some(k) = k {
+            candidates.retain(|&(i, j)| i == k || j == k);
+            // The named object first in every pair.
+            for p in &mut candidates {
+                if p.0 != k {
+                    *p = (k, p.0);
+                }
+            }
+            candidates.sort_unstable();
+        }
+        let all = || -> Vec<(usize, usize)> {
+            match k {
+                None => (0..n).flat_map(|i| (i + 1..n).map(move |j| (i, j))).collect(),
+                Some(k) => (0..n).filter(|&j| j != k).map(|j| (k, j)).collect(),
             }
         };
-        let near = py.detach(|| nearest(pairs, objs, objs));
+        let memo = &self.memo;
+        let near = py.detach(|| nearest(&candidates, all, objs, objs, Memory(Some(memo))));
         Ok(near.map(|(d, i, j, fi, fj, pi, pj)| {
             (d, self.names[i].clone(), self.names[j].clone(), fi, fj, pi, pj)
         }))
@@ -841,9 +1158,10 @@ impl Manager {
 
     fn distance_other(&self, py: Python<'_>, other: PyRef<'_, Manager>) -> Option<NamedNear> {
         let (a, b) = (&self.objs, &other.objs);
-        let pairs: Vec<(usize, usize)> =
-            (0..a.len()).flat_map(|i| (0..b.len()).map(move |j| (i, j))).collect();
-        let near = py.detach(|| nearest(pairs, a, b));
+        let candidates = self.pairs_with(b);
+        let all = || (0..a.len()).flat_map(|i| (0..b.len()).map(move |j| (i, j))).collect();
+        let memo = &self.memo;
+        let near = py.detach(|| nearest(&candidates, all, a, b, Memory(Some(memo))));
         near.map(|(d, i, j, fi, fj, pi, pj)| {
             (d, self.names[i].clone(), other.names[j].clone(), fi, fj, pi, pj)
         })
@@ -858,8 +1176,9 @@ impl Manager {
     ) -> PyResult<Option<SingleNear>> {
         let single = vec![place(py, &mesh.inner, transform_of(transform)?)?];
         let a = &self.objs;
-        let pairs: Vec<(usize, usize)> = (0..a.len()).map(|i| (i, 0)).collect();
-        let near = py.detach(|| nearest(pairs, a, &single));
+        let candidates = self.pairs_with(&single);
+        let all = || (0..a.len()).map(|i| (i, 0)).collect();
+        let near = py.detach(|| nearest(&candidates, all, a, &single, Memory(None)));
         Ok(near.map(|(d, i, _, fi, fj, pi, pj)| (d, self.names[i].clone(), fi, fj, pi, pj)))
     }
 }

@@ -171,7 +171,7 @@ pub fn penetration(a: &Polytope<'_>, b: &Polytope<'_>) -> Option<Penetration> {
         let ball = if side == 0 { prune.ball_b } else { prune.ball_a };
         for (f, plane) in planes.iter().enumerate() {
             let t = p.tri(f as u32);
-            if plane.degenerate(&t) || prune.skips(plane, t[0], ball) {
+            if plane.degenerate(&t) || prune.skips_face(plane, t[0], ball) {
                 continue;
             }
             let (min_lo, min_hi) = q.surface.vertices.iter().fold((f64::INFINITY, f64::INFINITY), |m, &v| {
@@ -192,8 +192,7 @@ pub fn penetration(a: &Polytope<'_>, b: &Polytope<'_>) -> Option<Penetration> {
             .filter(|&i| {
                 let e = p.surface.edges[i];
                 let v = p.vertex(e.v[0]);
-                !(prune.skips(&planes[e.f[0] as usize], v, ball)
-                    && prune.skips(&planes[e.f[1] as usize], v, ball))
+                !prune.skips_edge(&planes[e.f[0] as usize], &planes[e.f[1] as usize], v, ball)
             })
             .collect()
     };
@@ -326,12 +325,43 @@ impl Prune {
         Prune { u, slack, ball_a: ball(a, na, ca), ball_b: ball(b, nb, cb), separated }
     }
 
-    /// Can the face with this plane (through `p`) be skipped against the other polytope's ball?
-    fn skips(&self, plane: &Plane, p: DVec3, ball: Option<(DVec3, f64)>) -> bool {
-        let (Some((c, r)), Some((n, err))) = (ball, plane.unit()) else { return false };
+    /// A lower bound of `(p - c)·n` for the exact unit normal `n` of `plane` (through `p`), with
+    /// `|p - c|`, the f64 unit normal and its direction error; `None` when the normal's
+    /// direction is not known well enough.
+    fn lower(&self, plane: &Plane, p: DVec3, c: DVec3) -> Option<(f64, f64, DVec3, f64)> {
+        let (n, err) = plane.unit()?;
         let lever = p - c;
-        let x = lever.dot(n) - lever.length() * err - self.slack;
-        x >= 0.0 && x + r > self.u
+        let len = lever.length();
+        Some((lever.dot(n) - len * err - self.slack, len, n, err))
+    }
+
+    /// Can the face with this plane (through `p`) be skipped against the other polytope's ball?
+    /// Its depth is at least `(p - c)·n + r`, whatever the sign of `(p - c)·n`.
+    fn skips_face(&self, plane: &Plane, p: DVec3, ball: Option<(DVec3, f64)>) -> bool {
+        let Some((c, r)) = ball else { return false };
+        self.lower(plane, p, c).is_some_and(|(x, ..)| x + r > self.u)
+    }
+
+    /// Can every axis of the edge between the faces of `p0` and `p1` (through its vertex `v`)
+    /// be skipped against the other polytope's ball? Its axes are the unit vectors `m` on the
+    /// arc between the two normals, where the depth is at least `(v - c)·m + r`. When that is
+    /// not negative at both normals it is at least the smaller of the two along the arc (a
+    /// sinusoid below both ends of an arc shorter than π would be negative at one of them);
+    /// otherwise it falls at most `|v - c|` times half the arc's angle below the smaller (the
+    /// slope along the arc is at most `|v - c|`), and half the angle is at most `π/4` times the
+    /// chord between the normals (the f64 chord plus both normals' direction errors).
+    fn skips_edge(&self, p0: &Plane, p1: &Plane, v: DVec3, ball: Option<(DVec3, f64)>) -> bool {
+        let Some((c, r)) = ball else { return false };
+        let (Some((x0, len, n0, e0)), Some((x1, _, n1, e1))) = (self.lower(p0, v, c), self.lower(p1, v, c))
+        else {
+            return false;
+        };
+        let mut x = x0.min(x1);
+        if x < 0.0 {
+            let chord = up((n0 - n1).length() + e0 + e1);
+            x = x - up(len * up(chord * std::f64::consts::FRAC_PI_4)) - self.slack;
+        }
+        x + r > self.u
     }
 }
 
