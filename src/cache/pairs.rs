@@ -30,7 +30,7 @@
 //! Storage: one run writes at most two entries, whatever its size. A *pack* holds the results
 //! of the pairs the run checked (keyed by their pair keys, hex) and the tree sizes it measured
 //! (keyed by part key; the report's memory figures need them); the *index* of the run's
-//! lineage (its settings, inputs as named on the command line, and selection) lists the packs
+//! lineage (its settings, input file names, and selection) lists the packs
 //! to read, newest first. A later run reads the index and its packs (at most [`MAX_PACKS`]),
 //! reuses what it finds, writes a pack of what it checked and a new index (its pack, and the
 //! old packs it reused from; past [`MAX_PACKS`] packs, one pack of every pair of the run
@@ -142,8 +142,8 @@ pub enum CheckCache {
 impl CheckCache {
     /// The cache of a check under `settings` (tolerances resolved) and `sel`, over `store`.
     /// `active` false (a sharding hook or the parry cross-check is in the way) checks
-    /// everything and stores nothing. `lineage` names the inputs (as given on the command
-    /// line; the index of the run is found by it, never a result).
+    /// everything and stores nothing. `lineage` names the inputs (their file names: the index
+    /// of earlier runs is found by it, never a result).
     pub fn new(
         store: Arc<Store>,
         settings: &Settings,

@@ -602,12 +602,12 @@ pub fn run(req: &Request, progress: &(dyn Fn(Phase) + Sync)) -> Result<Outcome> 
     progress(Phase::Check);
     let cache = store.map(|s| {
         let active = req.selection.hook.is_none() && !req.cross_check;
-        // The inputs as named: the cache finds its index of earlier runs by them (never a
-        // result: results are found by content).
+        // The inputs' file names: the cache finds its index of earlier runs by them (never a
+        // result: results are found by content), wherever the files sit.
         let lineage: Vec<String> = req
             .inputs
             .iter()
-            .map(|i| i.path().to_string_lossy().into_owned())
+            .map(|i| i.path().file_name().map_or_else(String::new, |n| n.to_string_lossy().into_owned()))
             .map(|p| format!("{}:{p}", p.len()))
             .collect();
         crate::cache::CheckCache::new(
