@@ -369,3 +369,49 @@ fn engine_scene_warm_equals_cold() {
     assert_eq!(warm.0, cold);
     assert_eq!((warm.1 .0, warm.1 .1), (candidates(&cold), 0));
 }
+
+#[test]
+fn clash_set_checks_share_one_cache() {
+    let d = tempfile::tempdir().unwrap();
+    write(d.path(), "row.obj", &row(&scene_cubes()));
+    write(d.path(), "chain.obj", &chain_obj(&chain(5)));
+    write(
+        d.path(),
+        "set.json",
+        r#"{"version": 1, "checks": [
+            {"name": "row", "scene": "row.obj", "clearance": "0.1"},
+            {"name": "chain", "scene": "chain.obj", "clearance": "0.01"}]}"#,
+    );
+    let set = |cache: Option<&str>| {
+        let mut c = bin(d.path());
+        c.args(["clash-set", "set.json", "--no-timings"]);
+        if let Some(dir) = cache {
+            c.env("MESHCLASH_CACHE", dir);
+        }
+        let o = c.output().unwrap();
+        assert!(matches!(o.status.code(), Some(0 | 1)), "{}", String::from_utf8_lossy(&o.stderr));
+        serde_json::from_slice::<serde_json::Value>(&o.stdout).unwrap()
+    };
+    let strip = |mut v: serde_json::Value| {
+        let mut blocks = Vec::new();
+        for c in v["checks"].as_array_mut().unwrap() {
+            let b = c["report"].as_object_mut().unwrap().remove("cache").expect("a cache block");
+            blocks
+                .push((b["part_pairs_reused"].as_u64().unwrap(), b["part_pairs_checked"].as_u64().unwrap()));
+        }
+        (v, blocks)
+    };
+    let cold = set(None);
+    let (first, b1) = strip(set(Some("c")));
+    let (warm, b2) = strip(set(Some("c")));
+    assert_eq!(first, cold);
+    assert_eq!(warm, cold);
+    let n: Vec<u64> = cold["checks"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|c| c["report"]["assembly"]["candidate_part_pairs"].as_u64().unwrap())
+        .collect();
+    assert_eq!(b1, vec![(0, n[0]), (0, n[1])]);
+    assert_eq!(b2, vec![(n[0], 0), (n[1], 0)], "each check found its own results");
+}
