@@ -415,3 +415,51 @@ fn clash_set_checks_share_one_cache() {
     assert_eq!(b1, vec![(0, n[0]), (0, n[1])]);
     assert_eq!(b2, vec![(n[0], 0), (n[1], 0)], "each check found its own results");
 }
+
+#[test]
+fn sharded_runs_reuse_their_pairs_and_merge_to_the_cold_report() {
+    let d = tempfile::tempdir().unwrap();
+    let mut cubes = chain(7);
+    write(d.path(), "chain.obj", &chain_obj(&cubes));
+    let check = ["scene", "chain.obj", "--no-timings", "--clearance", "0.01"];
+    let sharded = |cache: bool| {
+        let mut plan = vec!["plan"];
+        plan.extend(check);
+        plan.extend(["-o", "plan.json"]);
+        run(d.path(), &plan);
+        let mut blocks = Vec::new();
+        for i in 1..=3 {
+            let shard = format!("{i}/3");
+            let out = format!("shard-{i}.json");
+            let mut c = bin(d.path());
+            c.args(["run", "--plan", "plan.json", "--shard", &shard, "-o", &out]);
+            if cache {
+                c.env("MESHCLASH_CACHE", "c");
+            }
+            let o = c.output().unwrap();
+            assert_eq!(o.status.code(), Some(0), "{}", String::from_utf8_lossy(&o.stderr));
+            blocks.push(o);
+        }
+        let o = bin(d.path())
+            .args(["merge", "shard-1.json", "shard-2.json", "shard-3.json", "-o", "merged.json"])
+            .output()
+            .unwrap();
+        assert!(matches!(o.status.code(), Some(0 | 1)), "{}", String::from_utf8_lossy(&o.stderr));
+        std::fs::read_to_string(d.path().join("merged.json")).unwrap()
+    };
+    let cold = run_s(d.path(), &with(&check, &[]));
+    assert_eq!(sharded(false), cold, "sharding changes nothing");
+    assert_eq!(sharded(true), cold, "cold shards with the cache");
+    // Every pair was stored by some shard: a single-machine run of the same check reuses all.
+    let (body, (reused, checked, _)) = split(&run_s(d.path(), &with(&check, &["--cache", "c"])));
+    assert_eq!((reused, checked), (candidates(&cold), 0), "the shards stored every pair");
+    assert_eq!(body, cold);
+    // One part moves: warm shards reuse the rest and still merge to the cold report.
+    cubes[2].1[2] += 0.125;
+    write(d.path(), "chain.obj", &chain_obj(&cubes));
+    let cold = run_s(d.path(), &with(&check, &[]));
+    assert_eq!(sharded(true), cold, "warm shards after a move");
+    let (body, (reused, checked, _)) = split(&run_s(d.path(), &with(&check, &["--cache", "c"])));
+    let n = candidates(&cold);
+    assert_eq!((body, reused, checked), (cold, n, 0));
+}

@@ -27,16 +27,16 @@
 //!   together), and a selection that puts one part on both sides (its pairs with itself and
 //!   mirrored pairs take part in the check's distance bound).
 //!
-//! Storage: one run writes at most two entries, whatever its size. A *pack* holds the results
-//! of the pairs the run checked (keyed by their pair keys, hex) and the tree sizes it measured
-//! (keyed by part key; the report's memory figures need them); the *index* of the run's
-//! lineage (its settings, input file names, and selection) lists the packs
-//! to read, newest first. A later run reads the index and its packs (at most [`MAX_PACKS`]),
-//! reuses what it finds, writes a pack of what it checked and a new index (its pack, and the
-//! old packs it reused from; past [`MAX_PACKS`] packs, one pack of every pair of the run
-//! instead). A lost index or pack (evicted, corrupt, removed, written by another version) is a
-//! miss: the pairs are checked again. Two runs writing one index at once: one wins, and the
-//! other's pack is only unreachable (evicted in time).
+//! Storage: one run writes an index entry and packs, whatever its number of pairs. A *pack*
+//! holds results of pairs the run checked (keyed by their pair keys, hex; at most
+//! [`PACK_FINDINGS`] triangle pairs a pack) and the tree sizes it measured (keyed by part key;
+//! the report's memory figures need them); the *index* of the run's lineage (its settings,
+//! input file names and selection) lists the packs to read, newest first. A later run reads
+//! the index and its packs (at most [`MAX_INDEX`]), reuses what it finds, writes packs of what
+//! it checked and a new index (its packs, then the old packs it reused from; a shard also
+//! keeps the other shards' packs). A lost index or pack (evicted, corrupt, removed, written by
+//! another version) is a miss: the pairs are checked again. Two runs writing one index at
+//! once: one wins, and the other's packs are only unreachable (evicted in time).
 //!
 //! Layouts (SHA-256, integers little-endian): the index key is the tag `meshclash.cache.index`
 //! and a zero byte, the fingerprint's 32 bytes, the lineage's length (u64) and UTF-8 text; a
@@ -61,8 +61,12 @@ use std::collections::{HashMap, HashSet};
 use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
 use std::sync::{Arc, Mutex};
 
-/// The most packs an index lists; past it a run writes one pack of all its pairs.
-pub const MAX_PACKS: usize = 8;
+/// The most packs an index lists (the shards of a plan each add theirs to one index).
+pub const MAX_INDEX: usize = 256;
+
+/// The most triangle pairs (plus one per part pair) one pack holds: about 100 MB of JSON at
+/// most, below the entry limit ([`super::MAX_ENTRY_BYTES`]).
+pub const PACK_FINDINGS: usize = 300_000;
 
 const INDEX_TAG: &[u8] = b"meshclash.cache.index\0";
 const PACK_TAG: &[u8] = b"meshclash.cache.pack\0";
@@ -141,8 +145,9 @@ pub enum CheckCache {
 
 impl CheckCache {
     /// The cache of a check under `settings` (tolerances resolved) and `sel`, over `store`.
-    /// `active` false (a sharding hook or the parry cross-check is in the way) checks
-    /// everything and stores nothing. `lineage` names the inputs (their file names: the index
+    /// `active` false (the parry cross-check is in the way) checks everything and stores
+    /// nothing. A hook already in `sel` (a shard's) is kept: its pairs are the candidates, and
+    /// a stand-in outcome (a merge's) is not cached. `lineage` names the inputs (their file names: the index
     /// of earlier runs is found by it, never a result).
     pub fn new(
         store: Arc<Store>,
@@ -154,7 +159,8 @@ impl CheckCache {
         lineage: &str,
     ) -> CheckCache {
         let whole_fp = super::hook::check_fingerprint(settings, sel, split_bodies, penetration);
-        let whole = WholeCheck::new(store.clone(), whole_fp, active);
+        let inner = sel.hook.clone();
+        let whole = WholeCheck::new(store.clone(), whole_fp, active && inner.is_none());
         let exact_distance = settings.distance_error.rel == 0.0 && settings.distance_error.abs == 0.0;
         if !(active && sel.by_parts() && !settings.first_hit && exact_distance) {
             return CheckCache::Whole(Arc::new(whole));
@@ -180,6 +186,7 @@ impl CheckCache {
             fingerprint,
             index: PairKey::from_digest(sha.digest()),
             whole,
+            inner,
             delegated: AtomicBool::new(false),
             reused: AtomicU64::new(0),
             checked: AtomicU64::new(0),
@@ -223,6 +230,8 @@ pub struct PairReuse {
     index: PairKey,
     /// The whole-check cache, for a run that cannot be reused pair by pair.
     whole: WholeCheck,
+    /// The hook the run already had (a shard's, a plan's or a merge's).
+    inner: Option<Hook>,
     delegated: AtomicBool,
     reused: AtomicU64,
     checked: AtomicU64,
@@ -301,7 +310,7 @@ impl PairReuse {
         let Some(index) = self.store.get::<Index>(&self.index) else {
             return l;
         };
-        for hex in index.packs.iter().take(MAX_PACKS) {
+        for hex in index.packs.iter().take(MAX_INDEX) {
             let Some(d) = parse_hex(hex) else {
                 let path = self.store.entry_path(&self.index);
                 self.store.warn(format!("cache: ignored entry {}: bad pack key '{hex}'", path.display()));
@@ -331,25 +340,53 @@ impl PairReuse {
         pairs.dedup_by(|x, y| x.0 == y.0);
         trees.sort_unstable();
         trees.dedup_by(|x, y| x.0 == y.0);
-        let mut sha = Sha256::default();
-        sha.update(PACK_TAG);
-        sha.update(self.fingerprint.as_bytes());
-        for (k, _) in &pairs {
-            sha.update(k);
+        // Packs of at most PACK_FINDINGS triangle pairs each (an entry stays far below the
+        // entry limit); the tree sizes go with the first.
+        let mut chunks: Vec<Vec<(Digest, WireResult)>> = vec![Vec::new()];
+        let mut size = 0usize;
+        for p in pairs {
+            let n = p.1.findings() + 1;
+            if size + n > PACK_FINDINGS && !chunks.last().is_some_and(Vec::is_empty) {
+                chunks.push(Vec::new());
+                size = 0;
+            }
+            size += n;
+            chunks.last_mut().expect("one chunk").push(p);
         }
-        sha.update(&[0]);
-        for (k, _) in &trees {
-            sha.update(k);
+        let mut trees = Some(trees);
+        let mut written: Vec<String> = Vec::new();
+        for chunk in chunks {
+            let trees = trees.take().unwrap_or_default();
+            let mut sha = Sha256::default();
+            sha.update(PACK_TAG);
+            sha.update(self.fingerprint.as_bytes());
+            for (k, _) in &chunk {
+                sha.update(k);
+            }
+            sha.update(&[0]);
+            for (k, _) in &trees {
+                sha.update(k);
+            }
+            let key = PairKey::from_digest(sha.digest());
+            let pack = Pack {
+                pairs: chunk.into_iter().map(|(k, result)| Packed { key: to_hex(&k), result }).collect(),
+                trees: trees.into_iter().map(|(k, b)| (to_hex(&k), b)).collect(),
+            };
+            self.store.put(&key, &pack);
+            written.push(key.hex());
         }
-        let key = PairKey::from_digest(sha.digest());
-        let pack = Pack {
-            pairs: pairs.into_iter().map(|(k, result)| Packed { key: to_hex(&k), result }).collect(),
-            trees: trees.into_iter().map(|(k, b)| (to_hex(&k), b)).collect(),
-        };
-        self.store.put(&key, &pack);
-        let new = key.hex();
-        let mut packs: Vec<String> = kept.into_iter().filter(|k| *k != new).collect();
-        packs.insert(0, new);
+        let mut packs: Vec<String> = written;
+        if self.inner.is_some() {
+            // A shard: the other shards' packs stay listed (read again now, as they may have
+            // written meanwhile).
+            let now = self.store.get::<Index>(&self.index).unwrap_or_default();
+            packs.extend(kept.into_iter().chain(now.packs));
+        } else {
+            packs.extend(kept);
+        }
+        let mut seen = HashSet::new();
+        packs.retain(|k| seen.insert(k.clone()));
+        packs.truncate(MAX_INDEX);
         self.store.put(&self.index, &Index { packs });
     }
 
@@ -378,7 +415,11 @@ impl PairReuse {
         if over.load(Ordering::Relaxed) {
             return None; // the check refuses it
         }
-        let candidates: Vec<(usize, usize)> = recorded.into_inner().unwrap_or_else(|p| p.into_inner());
+        let mut candidates: Vec<(usize, usize)> = recorded.into_inner().unwrap_or_else(|p| p.into_inner());
+        if let Some(h) = &self.inner {
+            // A shard's pairs (asked in the check's order, as the check asks).
+            candidates.retain(|&(a, b)| h.0.keep(a, b));
+        }
         let mut seen = HashSet::new();
         if candidates.iter().any(|&(a, b)| a == b || !seen.insert((a.min(b), a.max(b)))) {
             return None;
@@ -522,26 +563,8 @@ impl PairReuse {
         .ok()?;
         let any_new = !fresh.is_empty() || !new_trees.is_empty();
         let used: Vec<String> = loaded.packs.iter().filter(|(_, u)| *u).map(|(k, _)| k.clone()).collect();
-        if any_new || used.len() != loaded.packs.len() {
-            if used.len() + 1 > MAX_PACKS {
-                // One pack of everything this run used.
-                let mut all = fresh;
-                let kept: HashSet<[u8; 32]> = all.iter().map(|(k, _)| *k).collect();
-                for k in &pair_keys {
-                    if !kept.contains(k.as_bytes()) {
-                        if let Some((_, w)) = loaded.pairs.get(k.as_bytes()) {
-                            all.push((*k.as_bytes(), w.clone()));
-                        }
-                    }
-                }
-                let mut trees = new_trees;
-                trees.extend(needed.iter().filter_map(|&p| {
-                    loaded.trees.get(key_of(p).as_bytes()).map(|&b| (*key_of(p).as_bytes(), b))
-                }));
-                self.save(all, trees, Vec::new());
-            } else {
-                self.save(fresh, new_trees, used);
-            }
+        if any_new {
+            self.save(fresh, new_trees, used);
         }
         self.reused.store(reused, Ordering::Relaxed);
         self.checked.store(checked, Ordering::Relaxed);
@@ -568,8 +591,8 @@ impl PairReuse {
 }
 
 impl PartsHook for PairReuse {
-    fn keep(&self, _: usize, _: usize) -> bool {
-        true
+    fn keep(&self, a: usize, b: usize) -> bool {
+        self.inner.as_ref().is_none_or(|h| h.0.keep(a, b))
     }
 
     fn stand_in(
@@ -578,18 +601,29 @@ impl PartsHook for PairReuse {
         parts: &[Part],
         selected: [usize; 2],
     ) -> Option<Result<Outcome, String>> {
+        if let Some(o) = self.inner.as_ref().and_then(|h| h.0.stand_in(meshes, parts, selected)) {
+            // A merge's outcome (or a shard's refusal): not cached.
+            self.delegated.store(true, Ordering::Relaxed);
+            return Some(o);
+        }
         match self.by_pairs(meshes, parts) {
             Some(o) => Some(Ok(o)),
             None => {
                 self.delegated.store(true, Ordering::Relaxed);
-                self.whole.stand_in(meshes, parts, selected)
+                match &self.inner {
+                    // The check runs, through `keep`.
+                    Some(_) => None,
+                    None => self.whole.stand_in(meshes, parts, selected),
+                }
             }
         }
     }
 
     fn seen(&self, meshes: [&Mesh; 2], o: &Outcome) {
-        if self.delegated.load(Ordering::Relaxed) {
-            self.whole.seen(meshes, o);
+        match &self.inner {
+            Some(h) => h.0.seen(meshes, o),
+            None if self.delegated.load(Ordering::Relaxed) => self.whole.seen(meshes, o),
+            None => {}
         }
     }
 }

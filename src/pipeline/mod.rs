@@ -601,7 +601,7 @@ pub fn run(req: &Request, progress: &(dyn Fn(Phase) + Sync)) -> Result<Outcome> 
     }
     progress(Phase::Check);
     let cache = store.map(|s| {
-        let active = req.selection.hook.is_none() && !req.cross_check;
+        let active = !req.cross_check;
         // The inputs' file names: the cache finds its index of earlier runs by them (never a
         // result: results are found by content), wherever the files sit.
         let lineage: Vec<String> = req

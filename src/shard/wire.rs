@@ -319,6 +319,11 @@ impl WireResult {
         }
     }
 
+    /// How many triangle pairs it holds.
+    pub fn findings(&self) -> usize {
+        self.pairs.len()
+    }
+
     /// Back to a [`ClashResult`] (no tree stats, zero timings, closedness unknown). Errors
     /// name the bad field.
     pub fn result(&self) -> Result<ClashResult, String> {
