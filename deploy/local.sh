@@ -9,6 +9,9 @@
 # Writes DIR/plan.json, DIR/shard-I.json, DIR/report.json and DIR/report.xml (JUnit); exits with
 # the merge's code
 # (0 clear, 1 findings at or above --fail-on, 2 error). MESHCLASH overrides the binary.
+# MESHCLASH_CACHE=DIR gives every shard one shared result cache: a re-run checks only the part
+# pairs whose parts or settings changed (entries are written by rename and verified on read, so
+# concurrent shards may share the directory).
 set -uo pipefail
 exe=${MESHCLASH:-meshclash}
 n=${1:?usage: local.sh N DIR -- CHECK ARGUMENTS...}

@@ -139,8 +139,64 @@ fn moved_part_gives_the_cold_report_of_the_edited_file() {
     let cold = run_s(d.path(), &with(&SCENE, &[]));
     let (body, (reused, checked, _)) = split(&run_s(d.path(), &with(&SCENE, &["--cache", "c"])));
     assert_eq!(body, cold);
-    assert_eq!((reused, checked), (0, candidates(&cold)), "the edited inputs are a new key");
+    // c's only candidate pair is (b, c): it alone is checked, (a, b) is reused.
+    let n = candidates(&cold);
+    assert_eq!((reused, checked), (n - 1, 1), "only the moved part's pairs are new keys");
     assert!(cold.contains("\"touching\""), "the move changed the answer");
+}
+
+/// A chain of `n` cubes, each overlapping the next by a quarter of an edge (candidate pairs: the
+/// neighbours; with the clearance, none farther).
+fn chain(n: usize) -> Vec<(String, [f64; 3])> {
+    (0..n).map(|i| (format!("p{i}"), [i as f64 * 0.75, 0.0, 0.0])).collect()
+}
+
+fn chain_obj(cubes: &[(String, [f64; 3])]) -> String {
+    cubes.iter().enumerate().map(|(i, (n, m))| cube(n, *m, 1.0, 8 * i)).collect()
+}
+
+#[test]
+fn one_moved_part_checks_only_its_pairs() {
+    let d = tempfile::tempdir().unwrap();
+    let mut cubes = chain(7);
+    let args = ["scene", "chain.obj", "--no-timings", "--clearance", "0.01"];
+    write(d.path(), "chain.obj", &chain_obj(&cubes));
+    let cold = run_s(d.path(), &with(&args, &[]));
+    let n = candidates(&cold);
+    assert_eq!(n, 6, "neighbours only");
+    let first = split(&run_s(d.path(), &with(&args, &["--cache", "c"])));
+    assert_eq!((first.0, first.1 .0, first.1 .1), (cold, 0, n));
+    // The middle cube moves a little (it still overlaps both neighbours): its two pairs are
+    // new keys; every other pair, whose parts did not move, is reused.
+    for (k, dy) in [(3, 0.125), (0, 0.25), (6, -0.0625)] {
+        cubes[k].1[1] += dy;
+        write(d.path(), "chain.obj", &chain_obj(&cubes));
+        let cold = run_s(d.path(), &with(&args, &[]));
+        let (body, (reused, checked, _)) = split(&run_s(d.path(), &with(&args, &["--cache", "c"])));
+        assert_eq!(body, cold, "cube {k} moved");
+        let own = if k == 0 || k == 6 { 1 } else { 2 };
+        assert_eq!((reused, checked), (n - own, own), "cube {k} moved");
+        // And again: nothing left to check.
+        let (body, (reused, checked, _)) = split(&run_s(d.path(), &with(&args, &["--cache", "c"])));
+        assert_eq!((body, reused, checked), (cold, n, 0), "cube {k} moved, warm");
+    }
+}
+
+#[test]
+fn selection_and_max_pairs_use_the_stored_pairs() {
+    let d = tempfile::tempdir().unwrap();
+    write(d.path(), "chain.obj", &chain_obj(&chain(7)));
+    let base = ["scene", "chain.obj", "--no-timings", "--clearance", "0.01"];
+    run_s(d.path(), &with(&base, &["--cache", "c"]));
+    // The listed-pair cut is applied after the pairs are merged: reused pairs are cut as
+    // checked ones are.
+    let cut = with(&base, &["--max-pairs", "3"]);
+    let cold = run_s(d.path(), &cut);
+    let mut cached = cut.clone();
+    cached.extend(["--cache".to_string(), "c".to_string()]);
+    let (body, (reused, checked, _)) = split(&run_s(d.path(), &cached));
+    assert_eq!(body, cold);
+    assert_eq!((reused, checked), (6, 0));
 }
 
 #[test]
@@ -172,37 +228,56 @@ fn corrupt_entry_is_ignored_with_a_warning_and_recomputed() {
     let file = write(d.path(), "row.obj", &row(&scene_cubes()));
     let cold = run_s(d.path(), &with(&SCENE, &[]));
     run_s(d.path(), &with(&SCENE, &["--cache", "c"]));
-    let mut flipped = 0;
-    for sub in std::fs::read_dir(d.path().join("c")).unwrap() {
-        let sub = sub.unwrap().path();
-        if sub.is_dir() {
-            for e in std::fs::read_dir(&sub).unwrap() {
-                let p = e.unwrap().path();
-                let mut b = std::fs::read(&p).unwrap();
-                let mid = b.len() / 2;
-                b[mid] ^= 0x20;
-                std::fs::write(&p, b).unwrap();
-                flipped += 1;
+    let entries = |dir: &Path| {
+        let mut v = Vec::new();
+        for sub in std::fs::read_dir(dir).unwrap() {
+            let sub = sub.unwrap().path();
+            if sub.is_dir() {
+                v.extend(std::fs::read_dir(&sub).unwrap().map(|e| e.unwrap().path()));
             }
         }
+        v.sort();
+        v
+    };
+    let found = entries(&d.path().join("c"));
+    assert_eq!(found.len(), 2, "one run writes an index and a pack: {found:?}");
+    // Each entry in turn: flipped in the middle, cut short, or replaced by the other's bytes
+    // (a foreign entry: right layout, wrong key).
+    for (i, how) in
+        [(0, "flip"), (1, "flip"), (0, "truncate"), (1, "truncate"), (0, "foreign"), (1, "foreign")]
+    {
+        let found = entries(&d.path().join("c"));
+        assert_eq!(found.len(), 2, "{how} {i}: {found:?}");
+        let (p, other) = (&found[i], &found[1 - i]);
+        let saved = std::fs::read(p).unwrap();
+        let bad = match how {
+            "flip" => {
+                let mut b = saved.clone();
+                let mid = b.len() / 2;
+                b[mid] ^= 0x20;
+                b
+            }
+            "truncate" => saved[..saved.len() - 3].to_vec(),
+            _ => std::fs::read(other).unwrap(),
+        };
+        std::fs::write(p, bad).unwrap();
+        // Through the library, where the warning is handed over.
+        let mut req = meshclash::pipeline::Request::scene(&file);
+        req.deterministic = true;
+        req.clearance = meshclash::pipeline::Tolerance::Abs(0.1);
+        req.cache = Some(meshclash::cache::CacheConfig {
+            dir: d.path().join("c"),
+            max_bytes: meshclash::cache::DEFAULT_MAX_BYTES,
+        });
+        let o = meshclash::pipeline::run(&req, &|_| {}).unwrap();
+        assert_eq!(o.cache_warnings.len(), 1, "{how} {i}: {:?}", o.cache_warnings);
+        assert!(o.cache_warnings[0].contains("ignored entry"), "{:?}", o.cache_warnings);
+        assert_eq!(o.cache.as_ref().unwrap().part_pairs_reused, 0, "{how} {i}");
+        // Recomputed and stored again: the binary now reuses it and writes the cold report.
+        let (body, (reused, checked, _)) = split(&run_s(d.path(), &with(&SCENE, &["--cache", "c"])));
+        assert_eq!(body, cold, "{how} {i}");
+        assert_eq!((reused, checked), (candidates(&cold), 0), "{how} {i}");
     }
-    assert_eq!(flipped, 1, "one whole-check entry");
-    // Through the library, where the warning is handed over.
-    let mut req = meshclash::pipeline::Request::scene(&file);
-    req.deterministic = true;
-    req.clearance = meshclash::pipeline::Tolerance::Abs(0.1);
-    req.cache = Some(meshclash::cache::CacheConfig {
-        dir: d.path().join("c"),
-        max_bytes: meshclash::cache::DEFAULT_MAX_BYTES,
-    });
-    let o = meshclash::pipeline::run(&req, &|_| {}).unwrap();
-    assert_eq!(o.cache_warnings.len(), 1, "{:?}", o.cache_warnings);
-    assert!(o.cache_warnings[0].contains("ignored entry"), "{:?}", o.cache_warnings);
-    assert_eq!(o.cache.as_ref().unwrap().part_pairs_reused, 0);
-    // Recomputed and stored again: the binary now reuses it and writes the cold report.
-    let (body, (reused, checked, _)) = split(&run_s(d.path(), &with(&SCENE, &["--cache", "c"])));
-    assert_eq!(body, cold);
-    assert_eq!((reused, checked), (candidates(&cold), 0));
 }
 
 #[test]
@@ -293,4 +368,98 @@ fn engine_scene_warm_equals_cold() {
     assert_eq!(first.0, cold);
     assert_eq!(warm.0, cold);
     assert_eq!((warm.1 .0, warm.1 .1), (candidates(&cold), 0));
+}
+
+#[test]
+fn clash_set_checks_share_one_cache() {
+    let d = tempfile::tempdir().unwrap();
+    write(d.path(), "row.obj", &row(&scene_cubes()));
+    write(d.path(), "chain.obj", &chain_obj(&chain(5)));
+    write(
+        d.path(),
+        "set.json",
+        r#"{"version": 1, "checks": [
+            {"name": "row", "scene": "row.obj", "clearance": "0.1"},
+            {"name": "chain", "scene": "chain.obj", "clearance": "0.01"}]}"#,
+    );
+    let set = |cache: Option<&str>| {
+        let mut c = bin(d.path());
+        c.args(["clash-set", "set.json", "--no-timings"]);
+        if let Some(dir) = cache {
+            c.env("MESHCLASH_CACHE", dir);
+        }
+        let o = c.output().unwrap();
+        assert!(matches!(o.status.code(), Some(0 | 1)), "{}", String::from_utf8_lossy(&o.stderr));
+        serde_json::from_slice::<serde_json::Value>(&o.stdout).unwrap()
+    };
+    let strip = |mut v: serde_json::Value| {
+        let mut blocks = Vec::new();
+        for c in v["checks"].as_array_mut().unwrap() {
+            let b = c["report"].as_object_mut().unwrap().remove("cache").expect("a cache block");
+            blocks
+                .push((b["part_pairs_reused"].as_u64().unwrap(), b["part_pairs_checked"].as_u64().unwrap()));
+        }
+        (v, blocks)
+    };
+    let cold = set(None);
+    let (first, b1) = strip(set(Some("c")));
+    let (warm, b2) = strip(set(Some("c")));
+    assert_eq!(first, cold);
+    assert_eq!(warm, cold);
+    let n: Vec<u64> = cold["checks"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|c| c["report"]["assembly"]["candidate_part_pairs"].as_u64().unwrap())
+        .collect();
+    assert_eq!(b1, vec![(0, n[0]), (0, n[1])]);
+    assert_eq!(b2, vec![(n[0], 0), (n[1], 0)], "each check found its own results");
+}
+
+#[test]
+fn sharded_runs_reuse_their_pairs_and_merge_to_the_cold_report() {
+    let d = tempfile::tempdir().unwrap();
+    let mut cubes = chain(7);
+    write(d.path(), "chain.obj", &chain_obj(&cubes));
+    let check = ["scene", "chain.obj", "--no-timings", "--clearance", "0.01"];
+    let sharded = |cache: bool| {
+        let mut plan = vec!["plan"];
+        plan.extend(check);
+        plan.extend(["-o", "plan.json"]);
+        run(d.path(), &plan);
+        let mut blocks = Vec::new();
+        for i in 1..=3 {
+            let shard = format!("{i}/3");
+            let out = format!("shard-{i}.json");
+            let mut c = bin(d.path());
+            c.args(["run", "--plan", "plan.json", "--shard", &shard, "-o", &out]);
+            if cache {
+                c.env("MESHCLASH_CACHE", "c");
+            }
+            let o = c.output().unwrap();
+            assert_eq!(o.status.code(), Some(0), "{}", String::from_utf8_lossy(&o.stderr));
+            blocks.push(o);
+        }
+        let o = bin(d.path())
+            .args(["merge", "shard-1.json", "shard-2.json", "shard-3.json", "-o", "merged.json"])
+            .output()
+            .unwrap();
+        assert!(matches!(o.status.code(), Some(0 | 1)), "{}", String::from_utf8_lossy(&o.stderr));
+        std::fs::read_to_string(d.path().join("merged.json")).unwrap()
+    };
+    let cold = run_s(d.path(), &with(&check, &[]));
+    assert_eq!(sharded(false), cold, "sharding changes nothing");
+    assert_eq!(sharded(true), cold, "cold shards with the cache");
+    // Every pair was stored by some shard: a single-machine run of the same check reuses all.
+    let (body, (reused, checked, _)) = split(&run_s(d.path(), &with(&check, &["--cache", "c"])));
+    assert_eq!((reused, checked), (candidates(&cold), 0), "the shards stored every pair");
+    assert_eq!(body, cold);
+    // One part moves: warm shards reuse the rest and still merge to the cold report.
+    cubes[2].1[2] += 0.125;
+    write(d.path(), "chain.obj", &chain_obj(&cubes));
+    let cold = run_s(d.path(), &with(&check, &[]));
+    assert_eq!(sharded(true), cold, "warm shards after a move");
+    let (body, (reused, checked, _)) = split(&run_s(d.path(), &with(&check, &["--cache", "c"])));
+    let n = candidates(&cold);
+    assert_eq!((body, reused, checked), (cold, n, 0));
 }

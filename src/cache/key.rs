@@ -22,18 +22,14 @@ const PART_TAG: &[u8] = b"meshclash.cache.part\0";
 const SETTINGS_TAG: &[u8] = b"meshclash.cache.settings\0";
 const PAIR_TAG: &[u8] = b"meshclash.cache.pair\0";
 const MESH_TAG: &[u8] = b"meshclash.cache.mesh\0";
+const LAYOUT_TAG: &[u8] = b"meshclash.cache.part-layout\0";
 
 /// A SHA-256 digest, the 32 bytes of every key.
 pub type Digest = [u8; 32];
 
 /// The digest of everything fed to `sha`, as bytes.
 pub(crate) fn finish(sha: Sha256) -> Digest {
-    let hex = sha.hex();
-    let mut out = [0u8; 32];
-    for (o, pair) in out.iter_mut().zip(hex.as_bytes().chunks_exact(2)) {
-        *o = (nibble(pair[0]) << 4) | nibble(pair[1]);
-    }
-    out
+    sha.digest()
 }
 
 /// SHA-256 of `data`, as bytes.
@@ -41,14 +37,6 @@ pub(crate) fn digest(data: &[u8]) -> Digest {
     let mut sha = Sha256::default();
     sha.update(data);
     finish(sha)
-}
-
-fn nibble(c: u8) -> u8 {
-    match c {
-        b'0'..=b'9' => c - b'0',
-        b'a'..=b'f' => c - b'a' + 10,
-        _ => unreachable!("Sha256::hex writes lowercase hex digits only"),
-    }
 }
 
 /// `d` as 64 lowercase hex digits.
@@ -148,6 +136,66 @@ impl PartKey {
             }
         }
         PartKey(finish(sha))
+    }
+
+    /// The key of a part as a part-pair check sees it: its name, its world-space vertices and
+    /// how its triangles share them (closedness, winding and containment read the sharing),
+    /// independent of where its vertices sit in the file's vertex list, so a part keeps its
+    /// key when other parts change.
+    ///
+    /// The part's vertices are numbered in order of first use by its triangles (as the check
+    /// numbers them). The SHA-256 input, every integer little-endian, every f64 as `to_bits`:
+    /// the tag `meshclash.cache.part-layout` and a zero byte; the name's length (u64) and the
+    /// name; then for each triangle of `triangles` (indices into `mesh.triangles`, in order)
+    /// and each of its three corners, the corner's part-local vertex number (u32), followed,
+    /// when that number is used for the first time, by the vertex's x, y, z; finally the
+    /// triangle count (u64). `mesh` must be in world space (placed, in the run's units).
+    pub fn of_part_layout(name: &str, mesh: &Mesh, triangles: &[u32]) -> PartKey {
+        let mut sha = Sha256::default();
+        sha.update(LAYOUT_TAG);
+        put_len(&mut sha, name.len());
+        sha.update(name.as_bytes());
+        let corners = || triangles.iter().flat_map(|&t| mesh.triangles[t as usize]);
+        let (lo, hi) = corners().fold((u32::MAX, 0u32), |(lo, hi), v| (lo.min(v), hi.max(v)));
+        // Local numbers by a dense table over the part's index range (parts are nearly always
+        // one run of the file's vertices); a map when the range is sparse.
+        let span = if triangles.is_empty() { 0 } else { (hi - lo) as usize + 1 };
+        let dense = span <= 3 * triangles.len() + 64;
+        let mut table: Vec<u32> = if dense { vec![u32::MAX; span] } else { Vec::new() };
+        let mut map: std::collections::HashMap<u32, u32> = std::collections::HashMap::new();
+        let mut next = 0u32;
+        let mut buf: Vec<u8> = Vec::with_capacity(1 << 16);
+        for v in corners() {
+            let slot = if dense { &mut table[(v - lo) as usize] } else { map.entry(v).or_insert(u32::MAX) };
+            let fresh = *slot == u32::MAX;
+            if fresh {
+                *slot = next;
+                next += 1;
+            }
+            buf.extend(slot.to_le_bytes());
+            if fresh {
+                for c in mesh.positions[v as usize].to_array() {
+                    buf.extend(c.to_bits().to_le_bytes());
+                }
+            }
+            if buf.len() >= 1 << 16 {
+                sha.update(&buf);
+                buf.clear();
+            }
+        }
+        sha.update(&buf);
+        put_len(&mut sha, triangles.len());
+        PartKey(finish(sha))
+    }
+
+    /// The keys of `parts` (see [`PartKey::of_part_layout`]), computed in parallel, in the
+    /// order of `parts`; `meshes[p.input]` holds part `p`.
+    pub fn of_part_layouts(meshes: [&Mesh; 2], parts: &[&Part]) -> Vec<PartKey> {
+        use rayon::prelude::*;
+        parts
+            .par_iter()
+            .map(|p| PartKey::of_part_layout(&p.name, meshes[p.input as usize], &p.triangles))
+            .collect()
     }
 
     /// The 32 digest bytes.
@@ -359,6 +407,12 @@ impl PairKey {
     /// tool version's length (u64, little-endian) and the version (UTF-8).
     pub fn new(a: &PartKey, b: &PartKey, settings: &Fingerprint) -> PairKey {
         PairKey::for_version(a, b, settings, TOOL_VERSION, FORMAT)
+    }
+
+    /// A key made of a digest computed elsewhere (the result cache's run indexes and packs,
+    /// whose layouts [`super::pairs`] describes).
+    pub(crate) fn from_digest(d: Digest) -> PairKey {
+        PairKey(d)
     }
 
     pub(crate) fn for_version(

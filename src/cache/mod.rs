@@ -41,10 +41,12 @@
 pub mod entry;
 pub mod hook;
 pub mod key;
+pub mod pairs;
 pub mod store;
 
 pub use hook::{CacheConfig, WholeCheck};
 pub use key::{Fingerprint, PairKey, PartHasher, PartKey, Setting, FORMAT, TOOL_VERSION};
+pub use pairs::{CheckCache, PairReuse};
 pub use store::{CacheSummary, Stats, Store, DEFAULT_MAX_BYTES, MAX_ENTRY_BYTES};
 
 #[cfg(test)]

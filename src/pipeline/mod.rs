@@ -605,14 +605,24 @@ pub fn run(req: &Request, progress: &(dyn Fn(Phase) + Sync)) -> Result<Outcome> 
     }
     progress(Phase::Check);
     let cache = store.map(|s| {
-        let fp = crate::cache::hook::check_fingerprint(
+        let active = !req.cross_check;
+        // The inputs' file names: the cache finds its index of earlier runs by them (never a
+        // result: results are found by content), wherever the files sit.
+        let lineage: Vec<String> = req
+            .inputs
+            .iter()
+            .map(|i| i.path().file_name().map_or_else(String::new, |n| n.to_string_lossy().into_owned()))
+            .map(|p| format!("{}:{p}", p.len()))
+            .collect();
+        crate::cache::CheckCache::new(
+            std::sync::Arc::new(s),
             &settings,
             &req.selection,
             req.split_bodies,
             req.penetration,
-        );
-        let active = req.selection.hook.is_none() && !req.cross_check;
-        std::sync::Arc::new(crate::cache::WholeCheck::new(std::sync::Arc::new(s), fp, active))
+            active,
+            &lineage.join(","),
+        )
     });
     let selection = cache.as_ref().map(|c| c.selection(&req.selection));
     let outcome = assembly::run(&a.mesh, &b.mesh, selection.as_ref().unwrap_or(&req.selection), &settings)

@@ -130,10 +130,29 @@ pub fn sharing(
     needed: &[usize],
     tree_bytes: &HashMap<usize, u64>,
 ) -> Result<(usize, Sharing), usize> {
+    sharing_lazy(meshes, parts, needed, |_, own| match own.iter().find(|p| !tree_bytes.contains_key(p)) {
+        Some(&p) => Err(p),
+        None => Ok(tree_bytes.clone()),
+    })
+}
+
+/// [`sharing`], asking `sizes(wanted, own)` for the tree sizes it needs: `wanted` are the own
+/// trees some instance walks through a box map (the only ones the figures depend on), `own`
+/// every own-tree part; both ascending. The answer must hold every part of `wanted`.
+///
+/// The figures: a copy per needed part costs its vertices (24 bytes), triangles (16 bytes)
+/// and the tree of its layout; what is kept is each layout, each own tree, each refitted copy
+/// (as large as its leader's tree) and each box map. The difference is the layouts' copies
+/// less the kept layouts and maps, plus the tree of every mapped instance's leader.
+pub fn sharing_lazy(
+    meshes: [&Mesh; 2],
+    parts: &[Part],
+    needed: &[usize],
+    sizes: impl FnOnce(&[usize], &[usize]) -> Result<HashMap<usize, u64>, usize>,
+) -> Result<(usize, Sharing), usize> {
     use rayon::prelude::*;
     let g = group(meshes, parts, needed);
     let mesh_of = |i: usize| meshes[parts[i].input as usize];
-    let tb = |layout: usize| tree_bytes.get(&g.own[layout]).map(|&b| b as usize).ok_or(g.own[layout]);
     let layouts: Vec<Layout> = g.own.par_iter().map(|&i| Layout::of(mesh_of(i), &parts[i])).collect();
     // Instances: a box map when one fits, else a refitted copy (same size as the leader's tree).
     let instances: Vec<(usize, usize, i64, usize)> = g
@@ -158,35 +177,39 @@ pub fn sharing(
         })
         .collect();
     let mut users = vec![0usize; g.own.len()];
-    let mut refit_bytes = 0usize;
-    let mut maps = 0usize;
     for &(layout, fits) in &mapped {
         if fits {
             users[layout] += 1;
-            maps += 1;
-        } else {
-            refit_bytes += tb(layout)?;
         }
     }
-    let mut copied = 0usize;
+    let wanted: Vec<usize> = {
+        let mut w: Vec<usize> = (0..g.own.len()).filter(|&l| users[l] > 0).map(|l| g.own[l]).collect();
+        w.sort_unstable();
+        w
+    };
+    let mut own_sorted = g.own.clone();
+    own_sorted.sort_unstable();
+    let tb = sizes(&wanted, &own_sorted)?;
+    let mut copied: i128 = 0;
     for &(layout, _, _) in g.plan.values() {
         let l = &layouts[layout];
-        copied += l.vertices * 24 + l.tris * 16 + tb(layout)?;
+        copied += (l.vertices * 24 + l.tris * 16) as i128;
     }
-    let mut own_bytes = 0usize;
-    for layout in 0..g.own.len() {
-        own_bytes += tb(layout)?;
+    let mut kept: i128 = layouts.iter().map(|l| l.bytes as i128).sum();
+    let maps: usize = users.iter().sum();
+    kept += (maps * std::mem::size_of::<BoxMap>()) as i128;
+    for (layout, &u) in users.iter().enumerate() {
+        if u > 0 {
+            let b = *tb.get(&g.own[layout]).ok_or(g.own[layout])?;
+            copied += u as i128 * b as i128;
+        }
     }
-    let kept = layouts.iter().map(|l| l.bytes).sum::<usize>()
-        + own_bytes
-        + refit_bytes
-        + maps * std::mem::size_of::<BoxMap>();
     Ok((
         g.own.len(),
         Sharing {
             shared_trees: users.iter().filter(|&&u| u > 0).count(),
-            mapped_instances: users.iter().sum(),
-            memory_saved_bytes: copied.saturating_sub(kept),
+            mapped_instances: maps,
+            memory_saved_bytes: (copied - kept).max(0) as usize,
         },
     ))
 }

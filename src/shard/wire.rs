@@ -282,3 +282,74 @@ impl WireOutcome {
         })
     }
 }
+
+/// One part pair's check result on the wire (the result cache's stored value): its triangle
+/// pairs, counts, closest pair, verdict and containment, every f64 as its bits. Triangle
+/// indices are whatever the caller put in (the cache stores them per part).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct WireResult {
+    pairs: Vec<WirePair>,
+    counts: [u64; 4],
+    closest: Option<WireClosest>,
+    verdict: String,
+    containment: WireContainment,
+}
+
+impl WireResult {
+    /// The wire form of `r`'s answer (its tree stats, timings and closedness left out).
+    pub fn of(r: &ClashResult) -> WireResult {
+        WireResult {
+            pairs: r
+                .pairs
+                .iter()
+                .map(|p| WirePair {
+                    a: p.a,
+                    b: p.b,
+                    kind: p.kind.name().into(),
+                    contact: p.contact.map(|c| c.name().into()),
+                    distance: p.distance.to_bits(),
+                    segment: p.segment.map(|s| s.map(v3)),
+                })
+                .collect(),
+            counts: counts(&r.counts),
+            closest: r.closest.as_ref().map(closest),
+            verdict: r.verdict.name().into(),
+            containment: containment(&r.containment),
+        }
+    }
+
+    /// How many triangle pairs it holds.
+    pub fn findings(&self) -> usize {
+        self.pairs.len()
+    }
+
+    /// Back to a [`ClashResult`] (no tree stats, zero timings, closedness unknown). Errors
+    /// name the bad field.
+    pub fn result(&self) -> Result<ClashResult, String> {
+        let pairs = self
+            .pairs
+            .iter()
+            .map(|p| {
+                Ok(PairFinding {
+                    a: p.a,
+                    b: p.b,
+                    kind: kind(&p.kind)?,
+                    contact: p.contact.as_deref().map(contact).transpose()?,
+                    distance: f64::from_bits(p.distance),
+                    segment: p.segment.map(|s| s.map(p3)),
+                })
+            })
+            .collect::<Result<Vec<_>, String>>()?;
+        Ok(ClashResult {
+            pairs,
+            counts: counts_of(self.counts),
+            closest: self.closest.as_ref().map(closest_of),
+            verdict: verdict(&self.verdict)?,
+            containment: containment_of(&self.containment)?,
+            closed: [None, None],
+            trees: Default::default(),
+            timings: Timings::default(),
+        })
+    }
+}

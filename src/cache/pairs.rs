@@ -1,0 +1,629 @@
+//! Part-pair reuse: a re-check costs what changed.
+//!
+//! In parts mode (`scene`, or a selection) the broad phase over the part boxes runs every
+//! time. Each candidate part pair then has a [`PairKey`]: the [`PartKey::of_part_layout`] of
+//! its A-side and B-side parts (name, exact world-space vertices, how the triangles share
+//! them), the [`pair_fingerprint`] of the settings that change a pair's answer, and the tool
+//! version. A pair whose key is stored reuses its stored result — verdict, counts, triangle
+//! pairs, closest pair, containment — instead of walking trees; the others are checked
+//! together, exactly as the check checks them, and stored. The reduction over the pairs, the
+//! tree-sharing figures and everything after the check (regions, finding ids, the baseline
+//! comparison, the report) are then those of a run without the cache.
+//!
+//! Exactness:
+//!
+//! - A stored result names triangles by their place in their part (the n-th triangle of the
+//!   part), so it holds whatever other parts do; it is mapped to the file's triangle numbers
+//!   when reused.
+//! - A clear pair's distance only matters when it could be the scene's closest. A pair with a
+//!   finding is stored with its exact closest pair (the check searches it in full); a clear
+//!   pair is stored without one. When no reused or checked pair touches or crosses (the
+//!   scene's minimum distance is then positive and could be a clear pair's), the reused clear
+//!   pairs are checked again together with the new ones, so the scene's closest pair is the
+//!   one a run without the cache finds; they count as checked.
+//! - A run where reuse by pair could differ from a whole check falls back to caching the
+//!   whole check ([`WholeCheck`]): file mode (one unit), `--first-hit` (a stop rule),
+//!   a distance error allowance (the reported distance may depend on which pairs are searched
+//!   together), and a selection that puts one part on both sides (its pairs with itself and
+//!   mirrored pairs take part in the check's distance bound).
+//!
+//! Storage: one run writes an index entry and packs, whatever its number of pairs. A *pack*
+//! holds results of pairs the run checked (keyed by their pair keys, hex; at most
+//! [`PACK_FINDINGS`] triangle pairs a pack) and the tree sizes it measured (keyed by part key;
+//! the report's memory figures need them); the *index* of the run's lineage (its settings,
+//! input file names and selection) lists the packs to read, newest first. A later run reads
+//! the index and its packs (at most [`MAX_INDEX`]), reuses what it finds, writes packs of what
+//! it checked and a new index (its packs, then the old packs it reused from; a shard also
+//! keeps the other shards' packs). A lost index or pack (evicted, corrupt, removed, written by
+//! another version) is a miss: the pairs are checked again. Two runs writing one index at
+//! once: one wins, and the other's packs are only unreachable (evicted in time).
+//!
+//! Layouts (SHA-256, integers little-endian): the index key is the tag `meshclash.cache.index`
+//! and a zero byte, the fingerprint's 32 bytes, the lineage's length (u64) and UTF-8 text; a
+//! pack's key is the tag `meshclash.cache.pack` and a zero byte, the fingerprint's 32 bytes,
+//! then the 32 bytes of each pair key it holds, in order, a zero byte, then the 32 bytes of
+//! each part key whose tree size it holds, in order.
+
+use super::hook::WholeCheck;
+use super::key::{to_hex, Digest, Fingerprint, PairKey, PartKey, Setting};
+use super::store::{CacheSummary, Store};
+use crate::check::assembly::{
+    check_parts_kept, glob_match, AssemblyInfo, Hook, Outcome, Pairing, Part, PartPairSummary, PartsHook,
+    Selection, MAX_CANDIDATE_PART_PAIRS,
+};
+use crate::check::containment::Containment;
+use crate::check::query::{ClashResult, Closest, Counts, Detail, PairFinding, Settings, Timings, Verdict};
+use crate::scene::mesh::Mesh;
+use crate::shard::sha256::Sha256;
+use crate::shard::wire::WireResult;
+use serde::{Deserialize, Serialize};
+use std::collections::{HashMap, HashSet};
+use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
+use std::sync::{Arc, Mutex};
+
+/// The most packs an index lists (the shards of a plan each add theirs to one index).
+pub const MAX_INDEX: usize = 256;
+
+/// The most triangle pairs (plus one per part pair) one pack holds: about 100 MB of JSON at
+/// most, below the entry limit ([`super::MAX_ENTRY_BYTES`]).
+pub const PACK_FINDINGS: usize = 300_000;
+
+const INDEX_TAG: &[u8] = b"meshclash.cache.index\0";
+const PACK_TAG: &[u8] = b"meshclash.cache.pack\0";
+
+/// The fingerprint of the settings that change one part pair's answer: the resolved
+/// tolerances (bits), the predicate mode, the detail level, the tree options (the tree sizes
+/// stored beside the results depend on them), `--split-bodies` and `--penetration`. The
+/// selection is not in it (it changes which pairs are checked, not a pair's answer); nor are
+/// `--first-hit` and the distance error, under which pairs are not reused one by one. The
+/// structs are taken apart field by field, so a new setting does not compile until it is
+/// placed here.
+pub fn pair_fingerprint(settings: &Settings, split_bodies: bool, penetration: bool) -> Fingerprint {
+    let Settings { tolerances, bvh, mode, first_hit: _, distance_error: _, detail } = *settings;
+    let crate::geom::predicates::Tolerances { touch, clearance } = tolerances;
+    let crate::bvh::BuildOptions { strategy, leaf_size } = bvh;
+    Fingerprint::of([
+        ("unit", Setting::from("part-pair")),
+        ("touch", touch.into()),
+        ("clearance", clearance.into()),
+        ("mode", mode.name().into()),
+        ("detail", detail.name().into()),
+        ("bvh", strategy.name().into()),
+        ("leaf_size", leaf_size.into()),
+        ("split_bodies", split_bodies.into()),
+        ("penetration", penetration.into()),
+    ])
+}
+
+/// One stored pair result, by its pair key.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct Packed {
+    key: String,
+    result: WireResult,
+}
+
+/// What one run stored: pair results and tree sizes.
+#[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct Pack {
+    pairs: Vec<Packed>,
+    trees: Vec<(String, u64)>,
+}
+
+/// The packs of a lineage, newest first (their keys, hex).
+#[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct Index {
+    packs: Vec<String>,
+}
+
+fn parse_hex(s: &str) -> Option<Digest> {
+    if s.len() != 64 {
+        return None;
+    }
+    let mut out = [0u8; 32];
+    for (o, pair) in out.iter_mut().zip(s.as_bytes().chunks_exact(2)) {
+        let n = |c: u8| match c {
+            b'0'..=b'9' => Some(c - b'0'),
+            b'a'..=b'f' => Some(c - b'a' + 10),
+            _ => None,
+        };
+        *o = (n(pair[0])? << 4) | n(pair[1])?;
+    }
+    Some(out)
+}
+
+/// The cache of one check: per part pair when it can be, else the whole check.
+#[derive(Debug)]
+pub enum CheckCache {
+    /// Reuse per part pair (parts mode).
+    Pairs(Arc<PairReuse>),
+    /// Reuse of the whole check (file mode, `--first-hit`, a distance error allowance).
+    Whole(Arc<WholeCheck>),
+}
+
+impl CheckCache {
+    /// The cache of a check under `settings` (tolerances resolved) and `sel`, over `store`.
+    /// `active` false (the parry cross-check is in the way) checks everything and stores
+    /// nothing. A hook already in `sel` (a shard's) is kept: its pairs are the candidates, and
+    /// a stand-in outcome (a merge's) is not cached. `lineage` names the inputs (their file names: the index
+    /// of earlier runs is found by it, never a result).
+    pub fn new(
+        store: Arc<Store>,
+        settings: &Settings,
+        sel: &Selection,
+        split_bodies: bool,
+        penetration: bool,
+        active: bool,
+        lineage: &str,
+    ) -> CheckCache {
+        let whole_fp = super::hook::check_fingerprint(settings, sel, split_bodies, penetration);
+        let inner = sel.hook.clone();
+        let whole = WholeCheck::new(store.clone(), whole_fp, active && inner.is_none());
+        let exact_distance = settings.distance_error.rel == 0.0 && settings.distance_error.abs == 0.0;
+        if !(active && sel.by_parts() && !settings.first_hit && exact_distance) {
+            return CheckCache::Whole(Arc::new(whole));
+        }
+        let fingerprint = pair_fingerprint(settings, split_bodies, penetration);
+        let mut sha = Sha256::default();
+        sha.update(INDEX_TAG);
+        sha.update(fingerprint.as_bytes());
+        let globs = |g: &[String]| g.iter().map(|s| format!("{}:{s}", s.len())).collect::<Vec<_>>().join(",");
+        let lineage = format!(
+            "inputs={lineage}\nscene={}\nselect_a={}\nselect_b={}\nexclude={}",
+            sel.scene,
+            globs(&sel.select_a),
+            globs(&sel.select_b),
+            globs(&sel.exclude)
+        );
+        sha.update(&(lineage.len() as u64).to_le_bytes());
+        sha.update(lineage.as_bytes());
+        CheckCache::Pairs(Arc::new(PairReuse {
+            store,
+            settings: *settings,
+            sel: Selection { hook: None, ..sel.clone() },
+            fingerprint,
+            index: PairKey::from_digest(sha.digest()),
+            whole,
+            inner,
+            delegated: AtomicBool::new(false),
+            reused: AtomicU64::new(0),
+            checked: AtomicU64::new(0),
+        }))
+    }
+
+    /// `sel` with this cache's hook in it (when it caches; else `sel` as it is).
+    pub fn selection(&self, sel: &Selection) -> Selection {
+        match self {
+            CheckCache::Whole(w) => w.selection(sel),
+            CheckCache::Pairs(p) => Selection { hook: Some(Hook(p.clone())), ..sel.clone() },
+        }
+    }
+
+    /// The report's `cache` block for the check's outcome `o`.
+    pub fn summary(&self, o: &Outcome) -> CacheSummary {
+        match self {
+            CheckCache::Whole(w) => w.summary(o),
+            CheckCache::Pairs(p) => p.summary(o),
+        }
+    }
+
+    /// The warnings collected (entries ignored, results not stored).
+    pub fn take_warnings(&self) -> Vec<String> {
+        match self {
+            CheckCache::Whole(w) => w.take_warnings(),
+            CheckCache::Pairs(p) => p.whole.take_warnings(),
+        }
+    }
+}
+
+/// Per-part-pair reuse: a [`PartsHook`] that stands in for the check an outcome made of
+/// stored pair results and the results of checking the rest.
+#[derive(Debug)]
+pub struct PairReuse {
+    store: Arc<Store>,
+    settings: Settings,
+    sel: Selection,
+    fingerprint: Fingerprint,
+    /// The key of this lineage's index.
+    index: PairKey,
+    /// The whole-check cache, for a run that cannot be reused pair by pair.
+    whole: WholeCheck,
+    /// The hook the run already had (a shard's, a plan's or a merge's).
+    inner: Option<Hook>,
+    delegated: AtomicBool,
+    reused: AtomicU64,
+    checked: AtomicU64,
+}
+
+/// What a run read from the cache.
+#[derive(Default)]
+struct Loaded {
+    /// Pack keys (hex), in index order, and whether a pair of this run came from each.
+    packs: Vec<(String, bool)>,
+    /// Pair key -> (pack, result).
+    pairs: HashMap<Digest, (usize, WireResult)>,
+    /// Part key -> tree size.
+    trees: HashMap<Digest, u64>,
+}
+
+fn select(parts: &[Part], input: u8, globs: &[String], exclude: &[String]) -> Vec<usize> {
+    (0..parts.len())
+        .filter(|&i| parts[i].input == input)
+        .filter(|&i| globs.is_empty() || globs.iter().any(|g| glob_match(g, &parts[i].name)))
+        .filter(|&i| !exclude.iter().any(|g| glob_match(g, &parts[i].name)))
+        .collect()
+}
+
+/// `r` (triangles numbered in the input meshes) with its triangles numbered in their parts;
+/// `None` if a triangle is not in its part (never stored then).
+fn to_local(r: &ClashResult, pa: &Part, pb: &Part) -> Option<ClashResult> {
+    let local = |p: &Part, t: u32| p.triangles.binary_search(&t).ok().map(|i| i as u32);
+    let mut out = r.clone();
+    for p in &mut out.pairs {
+        *p = PairFinding { a: local(pa, p.a)?, b: local(pb, p.b)?, ..*p };
+    }
+    if let Some(c) = &mut out.closest {
+        c.a.0 = local(pa, c.a.0)?;
+        c.b.0 = local(pb, c.b.0)?;
+    }
+    Some(out)
+}
+
+/// A stored result back in the input meshes' triangle numbers; an error names an index out
+/// of its part.
+fn to_global(r: &mut ClashResult, pa: &Part, pb: &Part) -> Result<(), String> {
+    let map = |p: &Part, t: u32| {
+        p.triangles.get(t as usize).copied().ok_or_else(|| {
+            format!("triangle {t} out of range (part {} has {} triangles)", p.name, p.triangles.len())
+        })
+    };
+    for p in &mut r.pairs {
+        *p = PairFinding { a: map(pa, p.a)?, b: map(pb, p.b)?, ..*p };
+    }
+    if let Some(c) = &mut r.closest {
+        c.a.0 = map(pa, c.a.0)?;
+        c.b.0 = map(pb, c.b.0)?;
+    }
+    Ok(())
+}
+
+fn listed(r: &ClashResult) -> bool {
+    r.verdict != Verdict::Clear || r.containment != Containment::None
+}
+
+impl PairReuse {
+    fn summary(&self, o: &Outcome) -> CacheSummary {
+        if self.delegated.load(Ordering::Relaxed) {
+            return self.whole.summary(o);
+        }
+        CacheSummary {
+            part_pairs_reused: self.reused.load(Ordering::Relaxed),
+            part_pairs_checked: self.checked.load(Ordering::Relaxed),
+            dir: self.store.dir().to_string_lossy().into_owned(),
+        }
+    }
+
+    fn load(&self) -> Loaded {
+        let mut l = Loaded::default();
+        let Some(index) = self.store.get::<Index>(&self.index) else {
+            return l;
+        };
+        for hex in index.packs.iter().take(MAX_INDEX) {
+            let Some(d) = parse_hex(hex) else {
+                let path = self.store.entry_path(&self.index);
+                self.store.warn(format!("cache: ignored entry {}: bad pack key '{hex}'", path.display()));
+                return Loaded::default();
+            };
+            let Some(pack) = self.store.get::<Pack>(&PairKey::from_digest(d)) else { continue };
+            let at = l.packs.len();
+            l.packs.push((hex.clone(), false));
+            for p in pack.pairs {
+                if let Some(k) = parse_hex(&p.key) {
+                    l.pairs.entry(k).or_insert((at, p.result));
+                }
+            }
+            for (k, b) in pack.trees {
+                if let Some(k) = parse_hex(&k) {
+                    l.trees.entry(k).or_insert(b);
+                }
+            }
+        }
+        l
+    }
+
+    /// Store `pairs` (pair key, result in part triangle numbers) and `trees` as a new pack,
+    /// and point the index at it and at the `kept` older packs.
+    fn save(&self, mut pairs: Vec<(Digest, WireResult)>, mut trees: Vec<(Digest, u64)>, kept: Vec<String>) {
+        pairs.sort_by_key(|x| x.0);
+        pairs.dedup_by(|x, y| x.0 == y.0);
+        trees.sort_unstable();
+        trees.dedup_by(|x, y| x.0 == y.0);
+        // Packs of at most PACK_FINDINGS triangle pairs each (an entry stays far below the
+        // entry limit); the tree sizes go with the first.
+        let mut chunks: Vec<Vec<(Digest, WireResult)>> = vec![Vec::new()];
+        let mut size = 0usize;
+        for p in pairs {
+            let n = p.1.findings() + 1;
+            if size + n > PACK_FINDINGS && !chunks.last().is_some_and(Vec::is_empty) {
+                chunks.push(Vec::new());
+                size = 0;
+            }
+            size += n;
+            chunks.last_mut().expect("one chunk").push(p);
+        }
+        let mut trees = Some(trees);
+        let mut written: Vec<String> = Vec::new();
+        for chunk in chunks {
+            let trees = trees.take().unwrap_or_default();
+            let mut sha = Sha256::default();
+            sha.update(PACK_TAG);
+            sha.update(self.fingerprint.as_bytes());
+            for (k, _) in &chunk {
+                sha.update(k);
+            }
+            sha.update(&[0]);
+            for (k, _) in &trees {
+                sha.update(k);
+            }
+            let key = PairKey::from_digest(sha.digest());
+            let pack = Pack {
+                pairs: chunk.into_iter().map(|(k, result)| Packed { key: to_hex(&k), result }).collect(),
+                trees: trees.into_iter().map(|(k, b)| (to_hex(&k), b)).collect(),
+            };
+            self.store.put(&key, &pack);
+            written.push(key.hex());
+        }
+        let mut packs: Vec<String> = written;
+        if self.inner.is_some() {
+            // A shard: the other shards' packs stay listed (read again now, as they may have
+            // written meanwhile).
+            let now = self.store.get::<Index>(&self.index).unwrap_or_default();
+            packs.extend(kept.into_iter().chain(now.packs));
+        } else {
+            packs.extend(kept);
+        }
+        let mut seen = HashSet::new();
+        packs.retain(|k| seen.insert(k.clone()));
+        packs.truncate(MAX_INDEX);
+        self.store.put(&self.index, &Index { packs });
+    }
+
+    /// The check, by pairs: see the module documentation. `None` when this run cannot be
+    /// reused pair by pair (then the whole-check cache takes it).
+    fn by_pairs(&self, meshes: [&Mesh; 2], parts: &[Part]) -> Option<Outcome> {
+        let sel = &self.sel;
+        let settings = &self.settings;
+        let b_input = if sel.scene { 0 } else { 1 };
+        let sa = select(parts, 0, &sel.select_a, &sel.exclude);
+        let sb = select(parts, b_input, &sel.select_b, &sel.exclude);
+        let pairing = if sel.scene && sel.select_b.is_empty() { Pairing::AllVsAll } else { Pairing::Cross };
+        // The broad phase, as the check runs it: record every candidate, check none.
+        let recorded = Mutex::new(Vec::new());
+        let over = AtomicBool::new(false);
+        let record = |a: usize, b: usize| {
+            let mut r = recorded.lock().unwrap_or_else(|p| p.into_inner());
+            if r.len() < MAX_CANDIDATE_PART_PAIRS {
+                r.push((a, b));
+            } else {
+                over.store(true, Ordering::Relaxed);
+            }
+            false
+        };
+        check_parts_kept(meshes, parts.to_vec(), &sa, &sb, pairing, settings, &record);
+        if over.load(Ordering::Relaxed) {
+            return None; // the check refuses it
+        }
+        let mut candidates: Vec<(usize, usize)> = recorded.into_inner().unwrap_or_else(|p| p.into_inner());
+        if let Some(h) = &self.inner {
+            // A shard's pairs (asked in the check's order, as the check asks).
+            candidates.retain(|&(a, b)| h.0.keep(a, b));
+        }
+        let mut seen = HashSet::new();
+        if candidates.iter().any(|&(a, b)| a == b || !seen.insert((a.min(b), a.max(b)))) {
+            return None;
+        }
+        let mut needed: Vec<usize> = candidates.iter().flat_map(|&(a, b)| [a, b]).collect();
+        needed.sort_unstable();
+        needed.dedup();
+        let needed_parts: Vec<&Part> = needed.iter().map(|&i| &parts[i]).collect();
+        let mut part_key: Vec<Option<PartKey>> = vec![None; parts.len()];
+        for (&i, k) in needed.iter().zip(PartKey::of_part_layouts(meshes, &needed_parts)) {
+            part_key[i] = Some(k);
+        }
+        let key_of = |i: usize| part_key[i].expect("needed part has a key");
+        let pair_keys: Vec<PairKey> = candidates
+            .iter()
+            .map(|&(a, b)| PairKey::new(&key_of(a), &key_of(b), &self.fingerprint))
+            .collect();
+        let mut loaded = self.load();
+        // Reuse what is stored.
+        let mut results: Vec<Option<ClashResult>> = candidates
+            .iter()
+            .zip(&pair_keys)
+            .map(|(&(a, b), k)| {
+                let (pack, wire) = loaded.pairs.get(k.as_bytes())?;
+                let got = wire.result().and_then(|mut r| to_global(&mut r, &parts[a], &parts[b]).map(|()| r));
+                match got {
+                    Ok(r) => {
+                        loaded.packs[*pack].1 = true;
+                        Some(r)
+                    }
+                    Err(e) => {
+                        self.store.warn(format!("cache: ignored stored result of {}: {e}", k.hex()));
+                        None
+                    }
+                }
+            })
+            .collect();
+        let mut fresh: Vec<(Digest, WireResult)> = Vec::new();
+        let mut timings = Timings::default();
+        let mut check = |results: &mut Vec<Option<ClashResult>>, which: &HashSet<(usize, usize)>| {
+            if which.is_empty() {
+                return;
+            }
+            let keep = |a: usize, b: usize| which.contains(&(a, b));
+            let ar = check_parts_kept(meshes, parts.to_vec(), &sa, &sb, pairing, settings, &keep);
+            timings.build_ms += ar.build_ms;
+            timings.query_ms += ar.query_ms;
+            let at: HashMap<(usize, usize), usize> =
+                candidates.iter().enumerate().map(|(i, &p)| (p, i)).collect();
+            for pp in ar.part_pairs {
+                let i = at[&(pp.a, pp.b)];
+                let mut stored = pp.result.clone();
+                if !listed(&stored) {
+                    // A clear pair's distance was searched only as far as the run needed.
+                    stored.closest = None;
+                }
+                if let Some(l) = to_local(&stored, &parts[pp.a], &parts[pp.b]) {
+                    fresh.push((*pair_keys[i].as_bytes(), WireResult::of(&l)));
+                }
+                results[i] = Some(pp.result);
+            }
+        };
+        let missing: HashSet<(usize, usize)> =
+            candidates.iter().zip(&results).filter(|(_, r)| r.is_none()).map(|(&p, _)| p).collect();
+        let mut checked = missing.len() as u64;
+        check(&mut results, &missing);
+        // When nothing touches or crosses, a clear pair may be the scene's closest: the reused
+        // clear pairs are searched again, with the scene's bound (see the module docs).
+        let touching =
+            results.iter().flatten().any(|r| listed(r) && r.closest.is_some_and(|c| c.distance == 0.0));
+        if !touching {
+            let clear: HashSet<(usize, usize)> = candidates
+                .iter()
+                .zip(&results)
+                .filter(|(p, r)| !missing.contains(p) && r.as_ref().is_some_and(|r| !listed(r)))
+                .map(|(&p, _)| p)
+                .collect();
+            checked += clear.len() as u64;
+            // The other clear pairs' results are of no use beside these: drop their
+            // distances so that only the searches below (sharing one bound) and the listed
+            // pairs take part in the minimum.
+            check(&mut results, &clear);
+        }
+        let reused = candidates.len() as u64 - checked;
+        // The reduction of the check over its part pairs.
+        let detail = settings.detail;
+        let mut merged: Vec<PairFinding> = Vec::new();
+        let mut part_pairs = Vec::new();
+        let mut closest: Option<Closest> = None;
+        let mut containment = Containment::None;
+        let mut counts = Counts::default();
+        for (&(a, b), r) in candidates.iter().zip(results) {
+            let mut r = r.expect("every candidate reused or checked");
+            if detail == Detail::Parts {
+                r.pairs = Vec::new();
+            }
+            merged.extend(r.pairs.iter().copied());
+            counts.merge(&r.counts);
+            if let Some(c) = r.closest {
+                if closest.is_none_or(|m| (c.distance, c.a.0, c.b.0) < (m.distance, m.a.0, m.b.0)) {
+                    closest = Some(c);
+                }
+            }
+            if containment == Containment::None && r.containment.is_clash() {
+                containment = r.containment.clone();
+            }
+            if listed(&r) {
+                part_pairs.push(PartPairSummary {
+                    a,
+                    b,
+                    verdict: r.verdict,
+                    counts: r.counts,
+                    min_distance: r.closest.map(|c| c.distance),
+                    containment: r.containment.clone(),
+                    closest: r.closest,
+                    pairs: r.pairs.iter().map(|p| (p.a, p.b)).collect(),
+                });
+            }
+        }
+        merged.sort_unstable_by_key(|p| (p.a, p.b));
+        let verdict = part_pairs.iter().map(|p| p.verdict).max().unwrap_or(Verdict::Clear);
+        // Tree-sharing figures: the tree sizes they need, stored by part key or measured.
+        let mut new_trees: Vec<(Digest, u64)> = Vec::new();
+        let (sah_builds, sharing) = crate::shard::stats::sharing_lazy(meshes, parts, &needed, |wanted, _| {
+            let mut sizes = HashMap::new();
+            let mut build = Vec::new();
+            for &p in wanted {
+                match loaded.trees.get(key_of(p).as_bytes()) {
+                    Some(&b) => {
+                        sizes.insert(p, b);
+                    }
+                    None => build.push(p),
+                }
+            }
+            for (p, b) in crate::shard::stats::owned_tree_bytes(meshes, parts, &build, settings.bvh) {
+                sizes.insert(p, b);
+                new_trees.push((*key_of(p).as_bytes(), b));
+            }
+            Ok(sizes)
+        })
+        .ok()?;
+        let any_new = !fresh.is_empty() || !new_trees.is_empty();
+        let used: Vec<String> = loaded.packs.iter().filter(|(_, u)| *u).map(|(k, _)| k.clone()).collect();
+        if any_new {
+            self.save(fresh, new_trees, used);
+        }
+        self.reused.store(reused, Ordering::Relaxed);
+        self.checked.store(checked, Ordering::Relaxed);
+        let info = AssemblyInfo {
+            mode: "parts",
+            selected: [sa.len(), sb.len()],
+            candidate_part_pairs: candidates.len(),
+            built_parts: Some(needed.len()),
+            sah_builds: Some(sah_builds),
+            sharing: Some(sharing),
+        };
+        let result = ClashResult {
+            pairs: merged,
+            counts,
+            closest,
+            verdict,
+            containment,
+            closed: [None, None],
+            trees: Default::default(),
+            timings,
+        };
+        Some(Outcome { result, parts: parts.to_vec(), part_pairs, info })
+    }
+}
+
+impl PartsHook for PairReuse {
+    fn keep(&self, a: usize, b: usize) -> bool {
+        self.inner.as_ref().is_none_or(|h| h.0.keep(a, b))
+    }
+
+    fn stand_in(
+        &self,
+        meshes: [&Mesh; 2],
+        parts: &[Part],
+        selected: [usize; 2],
+    ) -> Option<Result<Outcome, String>> {
+        if let Some(o) = self.inner.as_ref().and_then(|h| h.0.stand_in(meshes, parts, selected)) {
+            // A merge's outcome (or a shard's refusal): not cached.
+            self.delegated.store(true, Ordering::Relaxed);
+            return Some(o);
+        }
+        match self.by_pairs(meshes, parts) {
+            Some(o) => Some(Ok(o)),
+            None => {
+                self.delegated.store(true, Ordering::Relaxed);
+                match &self.inner {
+                    // The check runs, through `keep`.
+                    Some(_) => None,
+                    None => self.whole.stand_in(meshes, parts, selected),
+                }
+            }
+        }
+    }
+
+    fn seen(&self, meshes: [&Mesh; 2], o: &Outcome) {
+        match &self.inner {
+            Some(h) => h.0.seen(meshes, o),
+            None if self.delegated.load(Ordering::Relaxed) => self.whole.seen(meshes, o),
+            None => {}
+        }
+    }
+}
