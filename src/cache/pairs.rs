@@ -48,11 +48,11 @@ use super::hook::WholeCheck;
 use super::key::{to_hex, Digest, Fingerprint, PairKey, PartKey, Setting};
 use super::store::{CacheSummary, Store};
 use crate::check::assembly::{
-    check_parts_kept, glob_match, AssemblyInfo, Hook, Outcome, Pairing, Part, PartPairSummary, PartsHook,
+    check_parts_kept, glob_match, AssemblyInfo, Hook, Outcome, Pairing, Part, PartPairReduction, PartsHook,
     Selection, MAX_CANDIDATE_PART_PAIRS,
 };
 use crate::check::containment::Containment;
-use crate::check::query::{ClashResult, Closest, Counts, Detail, PairFinding, Settings, Timings, Verdict};
+use crate::check::query::{ClashResult, PairFinding, Settings, Timings, Verdict};
 use crate::scene::mesh::Mesh;
 use crate::shard::sha256::Sha256;
 use crate::shard::wire::WireResult;
@@ -504,43 +504,11 @@ impl PairReuse {
             check(&mut results, &clear);
         }
         let reused = candidates.len() as u64 - checked;
-        // The reduction of the check over its part pairs.
-        let detail = settings.detail;
-        let mut merged: Vec<PairFinding> = Vec::new();
-        let mut part_pairs = Vec::new();
-        let mut closest: Option<Closest> = None;
-        let mut containment = Containment::None;
-        let mut counts = Counts::default();
+        // The reduction of the check over its part pairs, as the check itself reduces them.
+        let mut reduction = PartPairReduction::new(settings.detail);
         for (&(a, b), r) in candidates.iter().zip(results) {
-            let mut r = r.expect("every candidate reused or checked");
-            if detail == Detail::Parts {
-                r.pairs = Vec::new();
-            }
-            merged.extend(r.pairs.iter().copied());
-            counts.merge(&r.counts);
-            if let Some(c) = r.closest {
-                if closest.is_none_or(|m| (c.distance, c.a.0, c.b.0) < (m.distance, m.a.0, m.b.0)) {
-                    closest = Some(c);
-                }
-            }
-            if containment == Containment::None && r.containment.is_clash() {
-                containment = r.containment.clone();
-            }
-            if listed(&r) {
-                part_pairs.push(PartPairSummary {
-                    a,
-                    b,
-                    verdict: r.verdict,
-                    counts: r.counts,
-                    min_distance: r.closest.map(|c| c.distance),
-                    containment: r.containment.clone(),
-                    closest: r.closest,
-                    pairs: r.pairs.iter().map(|p| (p.a, p.b)).collect(),
-                });
-            }
+            reduction.add(a, b, r.expect("every candidate reused or checked"));
         }
-        merged.sort_unstable_by_key(|p| (p.a, p.b));
-        let verdict = part_pairs.iter().map(|p| p.verdict).max().unwrap_or(Verdict::Clear);
         // Tree-sharing figures: the tree sizes they need, stored by part key or measured.
         let mut new_trees: Vec<(Digest, u64)> = Vec::new();
         let (sah_builds, sharing) = crate::shard::stats::sharing_lazy(meshes, parts, &needed, |wanted, _| {
@@ -576,16 +544,7 @@ impl PairReuse {
             sah_builds: Some(sah_builds),
             sharing: Some(sharing),
         };
-        let result = ClashResult {
-            pairs: merged,
-            counts,
-            closest,
-            verdict,
-            containment,
-            closed: [None, None],
-            trees: Default::default(),
-            timings,
-        };
+        let (result, part_pairs) = reduction.finish(timings);
         Some(Outcome { result, parts: parts.to_vec(), part_pairs, info })
     }
 }

@@ -849,12 +849,6 @@ fn run_checked(a: &Mesh, b: &Mesh, sel: &Selection, settings: &Settings) -> Resu
     let keep = |x, y| sel.hook.as_ref().is_none_or(|h| h.0.keep(x, y));
     let ar = check_parts_kept([a, if sel.scene { a } else { b }], parts, &sa, &sb, pairing, settings, &keep);
     let mut pairs_seen = std::collections::HashSet::new();
-    let mut merged: Vec<PairFinding> = Vec::new();
-    let mut part_pairs = Vec::new();
-    let mut closest: Option<crate::check::query::Closest> = None;
-    let mut containment = Containment::None;
-    let mut counts = crate::check::query::Counts::default();
-    let detail = settings.detail;
     let AssemblyResult {
         parts: ar_parts,
         part_pairs: ar_pairs,
@@ -865,30 +859,75 @@ fn run_checked(a: &Mesh, b: &Mesh, sel: &Selection, settings: &Settings) -> Resu
         query_ms,
     } = ar;
     let candidate_part_pairs = ar_pairs.len();
-    merged.reserve_exact(ar_pairs.iter().map(|pp| pp.result.pairs.len()).sum());
+    let mut reduction = PartPairReduction::new(settings.detail);
+    reduction.merged.reserve_exact(ar_pairs.iter().map(|pp| pp.result.pairs.len()).sum());
     for pp in ar_pairs {
         let (x, y) = (pp.a.min(pp.b), pp.a.max(pp.b));
         if x == y || !pairs_seen.insert((x, y)) {
             continue; // a part selected on both sides, or the mirror of a pair already done
         }
-        let mut r = pp.result;
-        if detail == Detail::Parts {
+        reduction.add(pp.a, pp.b, pp.result);
+    }
+    let info = AssemblyInfo {
+        mode: "parts",
+        selected: [sa.len(), sb.len()],
+        candidate_part_pairs,
+        built_parts: Some(built.iter().filter(|b| **b).count()),
+        sah_builds: Some(sah_builds),
+        sharing: Some(sharing),
+    };
+    let (result, part_pairs) = reduction.finish(crate::check::query::Timings { build_ms, query_ms });
+    Ok(Outcome { result, parts: ar_parts, part_pairs, info })
+}
+
+/// The reduction of a parts-mode check over its part pairs, in the order they are added: the
+/// merged findings (sorted at the end), the counts, the scene's closest pair (smallest distance,
+/// then triangle indices), the first containment clash, and a [`PartPairSummary`] for every pair
+/// that is not clear. Used by the check itself and by the result cache, which adds stored and
+/// checked pairs alike, so both give the same outcome.
+#[derive(Debug)]
+pub struct PartPairReduction {
+    detail: Detail,
+    /// The findings so far (reserve on it when their number is known).
+    pub merged: Vec<PairFinding>,
+    part_pairs: Vec<PartPairSummary>,
+    closest: Option<crate::check::query::Closest>,
+    containment: Containment,
+    counts: crate::check::query::Counts,
+}
+
+impl PartPairReduction {
+    /// An empty reduction; with [`Detail::Parts`] the pairs' triangle-pair lists are dropped.
+    pub fn new(detail: Detail) -> PartPairReduction {
+        PartPairReduction {
+            detail,
+            merged: Vec::new(),
+            part_pairs: Vec::new(),
+            closest: None,
+            containment: Containment::None,
+            counts: Default::default(),
+        }
+    }
+
+    /// Adds part pair `(a, b)`'s result.
+    pub fn add(&mut self, a: usize, b: usize, mut r: ClashResult) {
+        if self.detail == Detail::Parts {
             r.pairs = Vec::new();
         }
-        merged.extend(r.pairs.iter().copied());
-        counts.merge(&r.counts);
+        self.merged.extend(r.pairs.iter().copied());
+        self.counts.merge(&r.counts);
         if let Some(c) = r.closest {
-            if closest.is_none_or(|m| (c.distance, c.a.0, c.b.0) < (m.distance, m.a.0, m.b.0)) {
-                closest = Some(c);
+            if self.closest.is_none_or(|m| (c.distance, c.a.0, c.b.0) < (m.distance, m.a.0, m.b.0)) {
+                self.closest = Some(c);
             }
         }
-        if containment == Containment::None && r.containment.is_clash() {
-            containment = r.containment.clone();
+        if self.containment == Containment::None && r.containment.is_clash() {
+            self.containment = r.containment.clone();
         }
         if r.verdict != Verdict::Clear || r.containment != Containment::None {
-            part_pairs.push(PartPairSummary {
-                a: pp.a,
-                b: pp.b,
+            self.part_pairs.push(PartPairSummary {
+                a,
+                b,
                 verdict: r.verdict,
                 counts: r.counts,
                 min_distance: r.closest.map(|c| c.distance),
@@ -899,27 +938,24 @@ fn run_checked(a: &Mesh, b: &Mesh, sel: &Selection, settings: &Settings) -> Resu
         }
         // r (and its pair list) is dropped here: each list is held once, in `merged`.
     }
-    merged.sort_unstable_by_key(|p| (p.a, p.b));
-    let verdict = part_pairs.iter().map(|p| p.verdict).max().unwrap_or(Verdict::Clear);
-    let info = AssemblyInfo {
-        mode: "parts",
-        selected: [sa.len(), sb.len()],
-        candidate_part_pairs,
-        built_parts: Some(built.iter().filter(|b| **b).count()),
-        sah_builds: Some(sah_builds),
-        sharing: Some(sharing),
-    };
-    let result = ClashResult {
-        pairs: merged,
-        counts,
-        closest,
-        verdict,
-        containment,
-        closed: [None, None],
-        trees: Default::default(),
-        timings: crate::check::query::Timings { build_ms, query_ms },
-    };
-    Ok(Outcome { result, parts: ar_parts, part_pairs, info })
+
+    /// The merged result (findings sorted by triangle pair, verdict the worst part pair's) and
+    /// the part pairs that are not clear.
+    pub fn finish(mut self, timings: crate::check::query::Timings) -> (ClashResult, Vec<PartPairSummary>) {
+        self.merged.sort_unstable_by_key(|p| (p.a, p.b));
+        let verdict = self.part_pairs.iter().map(|p| p.verdict).max().unwrap_or(Verdict::Clear);
+        let result = ClashResult {
+            pairs: self.merged,
+            counts: self.counts,
+            closest: self.closest,
+            verdict,
+            containment: self.containment,
+            closed: [None, None],
+            trees: Default::default(),
+            timings,
+        };
+        (result, self.part_pairs)
+    }
 }
 
 /// The most candidate part pairs (part boxes within the search margin of each other) one run
