@@ -283,6 +283,20 @@ pub struct Counts {
 }
 
 impl Counts {
+    /// The verdict the pairs alone imply: any crossing is a clash, else any touching pair
+    /// touches, else any pair within the clearance is a clearance finding.
+    pub fn verdict(&self) -> Verdict {
+        if self.crossing > 0 {
+            Verdict::Clash
+        } else if self.touching > 0 {
+            Verdict::Touching
+        } else if self.clearance > 0 {
+            Verdict::Clearance
+        } else {
+            Verdict::Clear
+        }
+    }
+
     /// Count one pair; returns the verdict that pair alone implies.
     pub fn record(&mut self, p: &PairFinding) -> Verdict {
         match p.kind {
@@ -510,16 +524,7 @@ impl Tally {
 
     /// The verdict the pairs alone imply (as [`Counts::record`] gives pair by pair).
     pub fn verdict(&self) -> Verdict {
-        let c = &self.counts;
-        if c.crossing > 0 {
-            Verdict::Clash
-        } else if c.touching > 0 {
-            Verdict::Touching
-        } else if c.clearance > 0 {
-            Verdict::Clearance
-        } else {
-            Verdict::Clear
-        }
+        self.counts.verdict()
     }
 }
 
@@ -799,15 +804,7 @@ impl PairPhase {
                 }
             }
         };
-        let verdict = if counts.crossing > 0 || containment.is_clash() {
-            Verdict::Clash
-        } else if counts.touching > 0 {
-            Verdict::Touching
-        } else if counts.clearance > 0 {
-            Verdict::Clearance
-        } else {
-            Verdict::Clear
-        };
+        let verdict = if containment.is_clash() { Verdict::Clash } else { counts.verdict() };
         ClashResult {
             pairs,
             counts,
