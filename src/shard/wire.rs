@@ -30,6 +30,32 @@ pub struct WirePair {
     segment: Option<[V3; 2]>,
 }
 
+impl WirePair {
+    /// The wire form of a finding (its distance and points bit for bit).
+    fn of(p: &PairFinding) -> WirePair {
+        WirePair {
+            a: p.a,
+            b: p.b,
+            kind: p.kind.name().into(),
+            contact: p.contact.map(|c| c.name().into()),
+            distance: p.distance.to_bits(),
+            segment: p.segment.map(|s| s.map(v3)),
+        }
+    }
+
+    /// Back to a finding; errors name the bad field.
+    fn finding(&self) -> Result<PairFinding, String> {
+        Ok(PairFinding {
+            a: self.a,
+            b: self.b,
+            kind: kind(&self.kind)?,
+            contact: self.contact.as_deref().map(contact).transpose()?,
+            distance: f64::from_bits(self.distance),
+            segment: self.segment.map(|s| s.map(p3)),
+        })
+    }
+}
+
 /// A closest pair.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
@@ -154,18 +180,7 @@ impl WireOutcome {
             ]
         };
         WireOutcome {
-            pairs: r
-                .pairs
-                .iter()
-                .map(|p| WirePair {
-                    a: p.a,
-                    b: p.b,
-                    kind: p.kind.name().into(),
-                    contact: p.contact.map(|c| c.name().into()),
-                    distance: p.distance.to_bits(),
-                    segment: p.segment.map(|s| s.map(v3)),
-                })
-                .collect(),
+            pairs: r.pairs.iter().map(WirePair::of).collect(),
             counts: counts(&r.counts),
             closest: r.closest.as_ref().map(closest),
             verdict: r.verdict.name().into(),
@@ -208,20 +223,7 @@ impl WireOutcome {
     pub fn outcome(&self, n: usize) -> Result<Outcome, String> {
         let part =
             |i: usize| if i < n { Ok(i) } else { Err(format!("part index {i} out of range ({n} parts)")) };
-        let pairs = self
-            .pairs
-            .iter()
-            .map(|p| {
-                Ok(PairFinding {
-                    a: p.a,
-                    b: p.b,
-                    kind: kind(&p.kind)?,
-                    contact: p.contact.as_deref().map(contact).transpose()?,
-                    distance: f64::from_bits(p.distance),
-                    segment: p.segment.map(|s| s.map(p3)),
-                })
-            })
-            .collect::<Result<Vec<_>, String>>()?;
+        let pairs = self.pairs.iter().map(WirePair::finding).collect::<Result<Vec<_>, String>>()?;
         let part_pairs = self
             .part_pairs
             .iter()
@@ -300,18 +302,7 @@ impl WireResult {
     /// The wire form of `r`'s answer (its tree stats, timings and closedness left out).
     pub fn of(r: &ClashResult) -> WireResult {
         WireResult {
-            pairs: r
-                .pairs
-                .iter()
-                .map(|p| WirePair {
-                    a: p.a,
-                    b: p.b,
-                    kind: p.kind.name().into(),
-                    contact: p.contact.map(|c| c.name().into()),
-                    distance: p.distance.to_bits(),
-                    segment: p.segment.map(|s| s.map(v3)),
-                })
-                .collect(),
+            pairs: r.pairs.iter().map(WirePair::of).collect(),
             counts: counts(&r.counts),
             closest: r.closest.as_ref().map(closest),
             verdict: r.verdict.name().into(),
@@ -327,20 +318,7 @@ impl WireResult {
     /// Back to a [`ClashResult`] (no tree stats, zero timings, closedness unknown). Errors
     /// name the bad field.
     pub fn result(&self) -> Result<ClashResult, String> {
-        let pairs = self
-            .pairs
-            .iter()
-            .map(|p| {
-                Ok(PairFinding {
-                    a: p.a,
-                    b: p.b,
-                    kind: kind(&p.kind)?,
-                    contact: p.contact.as_deref().map(contact).transpose()?,
-                    distance: f64::from_bits(p.distance),
-                    segment: p.segment.map(|s| s.map(p3)),
-                })
-            })
-            .collect::<Result<Vec<_>, String>>()?;
+        let pairs = self.pairs.iter().map(WirePair::finding).collect::<Result<Vec<_>, String>>()?;
         Ok(ClashResult {
             pairs,
             counts: counts_of(self.counts),
