@@ -14,17 +14,23 @@ SHARED = REPO.parent / "shared" / "meshes"
 
 
 def cli_binary() -> Path:
-    """The release binary built from this repository: $MESHCLASH_BIN (run-tests.sh sets it),
-    else $CARGO_TARGET_DIR/release/meshclash, else target/release/meshclash."""
+    """The meshclash CLI built from this repository, in any profile (the tests compare documents,
+    not speed): $MESHCLASH_BIN (run-tests.sh sets it; .ci/test passes the test-profile binary its
+    Rust tests built), else target/debug/meshclash or target/release/meshclash under
+    $CARGO_TARGET_DIR or target/."""
     env = os.environ.get("MESHCLASH_BIN")
     if env:
         return Path(env)
     tgt = os.environ.get("CARGO_TARGET_DIR")
     for base in ([Path(tgt)] if tgt else []) + [REPO / "target"]:
-        p = base / "release" / "meshclash"
-        if p.exists():
-            return p
-    pytest.fail("the meshclash binary is missing: run python/run-tests.sh (it builds it) or set MESHCLASH_BIN")
+        for profile in ("debug", "release"):
+            p = base / profile / "meshclash"
+            if p.exists():
+                return p
+    pytest.fail(
+        "the meshclash CLI is missing: set MESHCLASH_BIN to a meshclash binary built from this "
+        "repository, or run python/run-tests.sh (it builds one)"
+    )
 
 
 def run_cli(*args, expect=(0, 1)):

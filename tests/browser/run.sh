@@ -1,6 +1,6 @@
 #!/bin/sh
 # Browser test of the HTML report: generate reports from the shipped meshes with the
-# release binary, load each from disk in headless Chromium (Debian package `chromium`; Node.js
+# meshclash binary, load each from disk in headless Chromium (Debian package `chromium`; Node.js
 # runs the driver, no npm package needed), screenshot the overview and the first clash, and
 # assert the clash colours are in the frame, no network request was made and the console has no
 # error. Exit non-zero on the first failure.
@@ -9,7 +9,9 @@
 #   tests/browser/run.sh --update-docs   # also copy the screenshots README shows to docs/img/
 #
 # Environment: CHROMIUM (default /usr/bin/chromium), CARGO_TARGET_DIR (default target),
-# MESHCLASH (a binary to use instead of building one).
+# MESHCLASH or MESHCLASH_BIN (a binary to use instead of building one; .ci/test passes the one its
+# Rust tests built). Without either, the test profile's binary is built (target/debug/meshclash,
+# what `cargo test` builds, so after it nothing compiles).
 set -eu
 cd "$(dirname "$0")/../.."
 update_docs=0
@@ -17,9 +19,10 @@ update_docs=0
 
 command -v node >/dev/null || { echo "tests/browser/run.sh: node not found (apt-get install nodejs)" >&2; exit 2; }
 [ -x "${CHROMIUM:-/usr/bin/chromium}" ] || { echo "tests/browser/run.sh: chromium not found (apt-get install chromium)" >&2; exit 2; }
-if [ -z "${MESHCLASH:-}" ]; then
-  cargo build --release --quiet
-  MESHCLASH="${CARGO_TARGET_DIR:-target}/release/meshclash"
+MESHCLASH="${MESHCLASH:-${MESHCLASH_BIN:-}}"
+if [ -z "$MESHCLASH" ]; then
+  cargo build --profile test --quiet --bin meshclash
+  MESHCLASH="${CARGO_TARGET_DIR:-target}/debug/meshclash"
 fi
 
 out=$(mktemp -d)
