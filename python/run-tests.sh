@@ -7,7 +7,8 @@
 #      own collision tests in tests/trimesh_compat) and mypy (the stubs' check) from the
 #      package registry;
 #   3. installs the package with the one install command, `pip install ./python`, its extension
-#      built in the test profile in the same target directory as the Rust tests: python/ is a
+#      built in the dev profile (`cargo rustc --profile test` would build a test harness) in the
+#      same target directory as the Rust tests: python/ is a
 #      member of the root workspace, so the library and its dependencies compiled for the tests
 #      and the CLI are reused, not compiled again ($MESHCLASH_PY_PROFILE=release for a release
 #      build);
@@ -17,7 +18,7 @@ here="$(cd "$(dirname "${BASH_SOURCE[0]}")" && pwd)"
 repo="$(cd "$here/.." && pwd)"
 py="${PYTHON:-python3}"
 venv="${MESHCLASH_VENV:-$here/.venv}"
-profile="${MESHCLASH_PY_PROFILE:-test}"
+profile="${MESHCLASH_PY_PROFILE:-dev}"
 
 target="${CARGO_TARGET_DIR:-$repo/target}"
 case "$target" in /*) ;; *) target="$repo/$target" ;; esac
