@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # Python tests of the meshclash package, on a fresh machine:
 #   1. finds the CLI the tests compare the package with: $MESHCLASH_BIN (.ci/test passes the one
-#      its Rust tests just built), else builds it in the test profile (target/debug/meshclash);
+#      its Rust tests just built), else builds target/debug/meshclash;
 #   2. creates a venv (python/.venv, or $MESHCLASH_VENV) and installs maturin, numpy, pytest,
 #      trimesh, python-fcl, scipy, networkx, lxml and pillow (trimesh's .3DXML loader, for its
 #      own collision tests in tests/trimesh_compat) and mypy (the stubs' check) from the
@@ -23,9 +23,10 @@ profile="${MESHCLASH_PY_PROFILE:-dev}"
 target="${CARGO_TARGET_DIR:-$repo/target}"
 case "$target" in /*) ;; *) target="$repo/$target" ;; esac
 if [ -z "${MESHCLASH_BIN:-}" ]; then
-    # The test profile's binary (target/debug/meshclash): what `cargo test` builds for the
-    # integration tests, so after a `cargo test` this compiles nothing.
-    (cd "$repo" && cargo build --profile test --quiet --bin meshclash)
+    # target/debug/meshclash: the dev and test profiles build the product crate alike (Cargo.toml),
+    # so this is the binary `cargo test` builds for the integration tests; after one, nothing
+    # compiles.
+    (cd "$repo" && cargo build --quiet --bin meshclash)
     export MESHCLASH_BIN="$target/debug/meshclash"
 fi
 [ -x "$MESHCLASH_BIN" ] || { echo "python/run-tests.sh: MESHCLASH_BIN=$MESHCLASH_BIN is not an executable" >&2; exit 2; }

@@ -10,8 +10,8 @@
 #
 # Environment: CHROMIUM (default /usr/bin/chromium), CARGO_TARGET_DIR (default target),
 # MESHCLASH or MESHCLASH_BIN (a binary to use instead of building one; .ci/test passes the one its
-# Rust tests built). Without either, the test profile's binary is built (target/debug/meshclash,
-# what `cargo test` builds, so after it nothing compiles).
+# Rust tests built). Without either, target/debug/meshclash is built (the dev and test profiles
+# build it alike, so after a `cargo test` nothing compiles).
 set -eu
 cd "$(dirname "$0")/../.."
 update_docs=0
@@ -21,7 +21,7 @@ command -v node >/dev/null || { echo "tests/browser/run.sh: node not found (apt-
 [ -x "${CHROMIUM:-/usr/bin/chromium}" ] || { echo "tests/browser/run.sh: chromium not found (apt-get install chromium)" >&2; exit 2; }
 MESHCLASH="${MESHCLASH:-${MESHCLASH_BIN:-}}"
 if [ -z "$MESHCLASH" ]; then
-  cargo build --profile test --quiet --bin meshclash
+  cargo build --quiet --bin meshclash
   MESHCLASH="${CARGO_TARGET_DIR:-target}/debug/meshclash"
 fi
 
