@@ -585,3 +585,55 @@ fn regression_obj_huge_face_line_is_refused_naming_file_and_line() {
     let file = write(&dir, "huge_face.obj", &face);
     rejects_without_allocating(&file, &["line 4: face has more than 65536 vertices"]);
 }
+
+/// A FIFO given as the plan of `run`, a shard report of `merge`, a `--baseline` or a
+/// `clash-set` file is refused at once (exit 2, one line naming it), never opened for reading
+/// (which blocks until a writer comes, forever). Each run is a child killed after a generous
+/// limit: a hang fails.
+#[test]
+fn fifo_as_plan_shard_report_baseline_or_clash_set_is_refused_without_blocking() {
+    if !cfg!(unix) || !Path::new("/usr/bin/mkfifo").exists() && !Path::new("/bin/mkfifo").exists() {
+        return;
+    }
+    let d = tempfile::tempdir().unwrap();
+    let fifo = d.path().join("f.json");
+    let made = std::process::Command::new("mkfifo").arg(&fifo).status().unwrap();
+    assert!(made.success());
+    let f = s(&fifo);
+    let out = d.path().join("out.json");
+    let o = s(&out);
+    let g = good();
+    let cases: [Vec<&str>; 4] = [
+        vec!["run", "--plan", f, "--shard", "1/1", "-o", o],
+        vec!["merge", f, "-o", o],
+        vec![s(&g), s(&g), "--baseline", f, "-o", o],
+        vec!["clash-set", f],
+    ];
+    for args in cases {
+        let mut child = std::process::Command::new(env!("CARGO_BIN_EXE_meshclash"))
+            .args(&args)
+            .stdout(std::process::Stdio::null())
+            .stderr(std::process::Stdio::piped())
+            .spawn()
+            .unwrap();
+        let start = Instant::now();
+        let status = loop {
+            if let Some(st) = child.try_wait().unwrap() {
+                break Some(st);
+            }
+            if start.elapsed() > Duration::from_secs(60) {
+                child.kill().unwrap();
+                child.wait().unwrap();
+                break None;
+            }
+            std::thread::sleep(Duration::from_millis(20));
+        };
+        let status = status.unwrap_or_else(|| panic!("{args:?} blocked on the FIFO"));
+        let mut err = String::new();
+        std::io::Read::read_to_string(&mut child.stderr.take().unwrap(), &mut err).unwrap();
+        assert_eq!(status.code(), Some(2), "{args:?}: {err}");
+        assert_eq!(err.trim_end().lines().count(), 1, "{args:?}: {err}");
+        assert!(err.contains(f) && err.contains("FIFO"), "{args:?}: {err}");
+        assert!(!out.exists(), "{args:?} wrote an output");
+    }
+}

@@ -199,3 +199,95 @@ fn detail_parts_on_coincident_fans_runs_in_memory_that_does_not_grow_with_their_
         std::fs::remove_file(&out).unwrap();
     }
 }
+
+/// `n` zero-area triangles on the line through the origin along (1, 2, 3), each with its own
+/// three vertices: triangle `i` spans `[3i, 3i + 2 + 3h]` along the line, so `i < j` meet
+/// (touch along a segment) iff `j - i <= h`.
+fn collinear_obj(n: usize, h: usize) -> String {
+    let mut s = String::with_capacity(n * 90);
+    for i in 0..n {
+        let t0 = 3 * i;
+        for t in [t0 + 1, t0 + 2 + 3 * h, t0] {
+            s.push_str(&format!("v {t} {} {}\n", 2 * t, 3 * t));
+        }
+    }
+    for i in 0..n {
+        s.push_str(&format!("f {} {} {}\n", 3 * i + 1, 3 * i + 2, 3 * i + 3));
+    }
+    s
+}
+
+/// The same construction as a mesh, for the brute force.
+fn collinear_mesh(n: usize, h: usize) -> meshclash::scene::mesh::Mesh {
+    let (mut positions, mut triangles) = (Vec::new(), Vec::new());
+    for i in 0..n {
+        let t0 = 3 * i;
+        for t in [t0 + 1, t0 + 2 + 3 * h, t0] {
+            let t = t as f64;
+            positions.push(meshclash::geom::DVec3::new(t, 2.0 * t, 3.0 * t));
+        }
+        let b = 3 * i as u32;
+        triangles.push([b, b + 1, b + 2]);
+    }
+    meshclash::scene::mesh::Mesh {
+        positions,
+        tri_object: vec![0; triangles.len()],
+        triangles,
+        objects: vec![meshclash::scene::mesh::Object { name: "line".into(), ..Default::default() }],
+    }
+}
+
+#[test]
+fn self_on_100k_collinear_overlapping_triangles_counts_every_pair_under_1_gb() {
+    if !cfg!(target_os = "linux") {
+        return;
+    }
+    let d = tempfile::tempdir().unwrap();
+    let out = d.path().join("r.json");
+    let o = out.to_str().unwrap();
+    let report = |file: &Path, extra: &[&str], kib: u64| -> (Option<i32>, serde_json::Value) {
+        let f = file.to_str().unwrap();
+        let args: Vec<&str> =
+            ["self", f, "--no-timings", "-q", "-o", o].iter().chain(extra).copied().collect();
+        let (code, err) = under_limit(kib, &args);
+        assert!(err.is_empty(), "{args:?}: {err}");
+        (code, serde_json::from_slice(&std::fs::read(&out).unwrap()).unwrap())
+    };
+    // A small instance: every pair, listed and counted, is the brute force's.
+    let (n, h) = (300usize, 40usize);
+    let small = d.path().join("small.obj");
+    std::fs::write(&small, collinear_obj(n, h)).unwrap();
+    let m = collinear_mesh(n, h);
+    let (merged, _) = meshclash::scene::bodies::merge_vertices(&m.positions);
+    let all: Vec<u32> = (0..n as u32).collect();
+    let want = meshclash::check::self_clash::self_pairs_brute_force(&m, &merged, &all);
+    assert_eq!(want.len(), (0..n).map(|i| h.min(n - 1 - i)).sum::<usize>(), "the construction");
+    assert!(want.iter().all(|p| !p.hit.crossing));
+    let (code, r) = report(&small, &["--max-pairs", "100000"], 1_000_000);
+    assert_eq!(code, Some(0), "touching only: clear for --fail-on self-clash");
+    assert_eq!(r["verdict"], "touching");
+    assert_eq!(r["summary"]["touching_pairs"], want.len() as u64);
+    assert_eq!(r["summary"]["crossing_pairs"], 0);
+    let listed: Vec<(u64, u64)> = r["pairs"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|p| (p["a"].as_u64().unwrap(), p["b"].as_u64().unwrap()))
+        .collect();
+    assert_eq!(listed, want.iter().map(|p| (p.a as u64, p.b as u64)).collect::<Vec<_>>());
+    assert_eq!(r["pairs_truncated"], false);
+    // 100,000 triangles: 3,749,975,000 pairs, counted in under 1 GB, the first 1,000 listed.
+    let (n, h) = (100_000usize, 50_000usize);
+    let big = d.path().join("big.obj");
+    std::fs::write(&big, collinear_obj(n, h)).unwrap();
+    let (code, r) = report(&big, &["--fail-on", "touching"], 1_000_000);
+    assert_eq!(code, Some(1), "touching pairs fail --fail-on touching");
+    assert_eq!(r["verdict"], "touching");
+    assert_eq!(r["summary"]["touching_pairs"], (0..n).map(|i| h.min(n - 1 - i) as u64).sum::<u64>());
+    assert_eq!(r["summary"]["crossing_pairs"], 0);
+    assert_eq!(r["pairs_truncated"], true);
+    let pairs = r["pairs"].as_array().unwrap();
+    assert_eq!(pairs.len(), 1000);
+    // The first pairs in (a, b) order: triangle 0 with 1, 2, ..., 1000.
+    assert!(pairs.iter().enumerate().all(|(k, p)| p["a"] == 0 && p["b"] == k as u64 + 1));
+}

@@ -1,6 +1,7 @@
 //! Outputs that must never cost a file, through the real binary: a report written to
 //! `/dev/stdout` while standard output is redirected to a file, an output naming a file a glTF
-//! input reads (its external buffer or image), and two outputs naming one new file.
+//! input reads (its external buffer or image), two outputs naming one new file, a plan or
+//! shard report named as an output, and outputs written though stdout failed.
 
 use assert_cmd::Command;
 use std::path::{Path, PathBuf};
@@ -122,5 +123,59 @@ fn two_outputs_naming_one_new_file_are_refused() {
         assert_eq!(o.status.code(), Some(2), "{err}");
         assert!(err.contains("--junit names the same file as -o"), "{err}");
         assert!(!d.path().join("r.json").exists());
+    }
+}
+
+/// `meshclash merge s1.json -o s1.json`: a shard report is an input, refused (exit 2, one
+/// line), and left as it was.
+#[test]
+fn merge_output_naming_a_shard_report_is_refused_and_the_report_kept() {
+    let d = two_meshes();
+    let (code, err) = sh(
+        d.path(),
+        r#""$M" plan a.obj b.obj -o p.json -q && "$M" run --plan p.json --shard 1/1 -o s1.json -q"#,
+    );
+    assert_eq!(code, Some(0), "{err}");
+    let before = std::fs::read(d.path().join("s1.json")).unwrap();
+    let (code, err) = sh(d.path(), r#""$M" merge s1.json -o s1.json -q"#);
+    assert_eq!(code, Some(2), "{err}");
+    assert_eq!(err.trim_end().lines().count(), 1, "{err}");
+    assert!(err.contains("s1.json") && err.contains("names the input"), "{err}");
+    assert_eq!(std::fs::read(d.path().join("s1.json")).unwrap(), before, "the shard report was rewritten");
+}
+
+/// `meshclash run --plan p.json -o p.json`: the plan is an input, refused (exit 2) and left as
+/// it was. The refusal is right today, but the report of the failed shard is then written to
+/// `-o` anyway (`run_cmd` in src/app/shard.rs writes it whatever the error), replacing the plan.
+#[test]
+#[ignore = "run --plan P -o P still replaces P with the failed shard's report (src/app/shard.rs run_cmd)"]
+fn run_output_naming_its_plan_is_refused_and_the_plan_kept() {
+    let d = two_meshes();
+    let (code, err) = sh(d.path(), r#""$M" plan a.obj b.obj -o p.json -q"#);
+    assert_eq!(code, Some(0), "{err}");
+    let before = std::fs::read(d.path().join("p.json")).unwrap();
+    let (code, err) = sh(d.path(), r#""$M" run --plan p.json --shard 1/1 -o p.json -q"#);
+    assert_eq!(code, Some(2), "{err}");
+    assert!(err.contains("p.json") && err.contains("names the input"), "{err}");
+    assert_eq!(std::fs::read(d.path().join("p.json")).unwrap(), before, "the plan was rewritten");
+}
+
+/// `--format text -o t.json > /dev/full`: the summary is lost, so the run is exit 2 and writes
+/// no report file either (all or nothing includes stdout); `--help` and `--version` to a full
+/// or closed stdout are exit 2 with a message, not 0 in silence.
+#[test]
+fn a_full_stdout_writes_no_output_file_and_help_to_it_is_an_error() {
+    if !Path::new("/dev/full").exists() {
+        return;
+    }
+    let d = two_meshes();
+    let (code, err) = sh(d.path(), r#""$M" a.obj b.obj --format text -o t.json > /dev/full"#);
+    assert_eq!(code, Some(2), "{err}");
+    assert!(err.contains("cannot write to stdout"), "{err}");
+    assert!(!d.path().join("t.json").exists(), "t.json was written though stdout failed");
+    for script in [r#""$M" --help > /dev/full"#, r#""$M" --version > /dev/full"#, r#""$M" --version >&-"#] {
+        let (code, err) = sh(d.path(), script);
+        assert_eq!(code, Some(2), "{script}: {err}");
+        assert!(err.contains("cannot write to stdout"), "{script}: {err}");
     }
 }

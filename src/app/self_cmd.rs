@@ -10,7 +10,7 @@ pub use super::args::{SelfArgs, SelfFormat};
 use glam::DMat4;
 use meshclash::bvh::{BuildOptions, Strategy};
 use meshclash::check::query::{self, InputSpec};
-use meshclash::check::self_clash::{check_parts, PartChoice, PartResult};
+use meshclash::check::self_clash::{check_parts_listing, PartChoice, PartResult};
 use meshclash::error::{Error, InputProblem, Quantity, Result, UsageProblem};
 use meshclash::report::self_report::SelfFailOn;
 use meshclash::report::self_report::{self as rep, SelfReport};
@@ -79,7 +79,9 @@ fn run_in_pool(args: &SelfArgs, threads: usize) -> Result<SelfOutcome> {
     let opts = BuildOptions { strategy, leaf_size: args.leaf_size };
     let whole_name = args.file.display().to_string();
     let choice = if args.whole_file { PartChoice::Whole(&whole_name) } else { PartChoice::Objects(&keep) };
-    let (parts, health_ms, query_ms) = check_parts(&input.mesh, choice, opts, args.first_n);
+    // Each part lists what the report and the JUnit failures show; every pair is counted.
+    let listed = args.max_pairs.max(meshclash::output::junit::FIRST);
+    let (parts, health_ms, query_ms) = check_parts_listing(&input.mesh, choice, opts, args.first_n, listed);
     let warnings: Vec<String> =
         input.warnings.iter().map(|w| format!("{}: {w}", args.file.display())).collect();
     if parts.is_empty() && !args.whole_file {
@@ -154,7 +156,7 @@ pub fn junit(parts: &[PartResult], fail_on: &[SelfFailOn]) -> String {
         .iter()
         .map(|p| {
             let h = &p.health;
-            let touching = p.pairs.len() as u64 - p.crossing;
+            let touching = p.count - p.crossing;
             let mut findings: Vec<String> = p
                 .pairs
                 .iter()
@@ -172,7 +174,7 @@ pub fn junit(parts: &[PartResult], fail_on: &[SelfFailOn]) -> String {
                 ("zero-area triangles", &h.zero_area_triangles),
                 ("inconsistent winding edges", &h.inconsistent_winding_edges),
             ];
-            let mut total = p.pairs.len() as u64;
+            let mut total = p.count;
             for (what, f) in health {
                 if f.count > 0 {
                     total += 1; // one line per kind of health finding

@@ -416,12 +416,11 @@ fn tri_meets_box(p: &[DVec3; 3], b: &Aabb) -> bool {
 ///
 /// `settled(i, j)` (`i == j` for a node with itself) says that no pair of triangles under
 /// nodes `i` and `j` is a self-clash: that node pair is not opened.
-fn self_walk<T, Z, S, P>(nodes: &[SNode], settled: Z, leaf_self: S, leaf_pair: P) -> Vec<T>
+fn self_walk<Z, S, P>(nodes: &[SNode], cap: usize, settled: Z, leaf_self: S, leaf_pair: P) -> Found
 where
-    T: Send,
     Z: Fn(u32, u32) -> bool + Sync,
-    S: Fn(Range<usize>, &mut Vec<T>) + Sync,
-    P: Fn(Range<usize>, Range<usize>, &mut Vec<T>) + Sync,
+    S: Fn(Range<usize>, &mut Found) + Sync,
+    P: Fn(Range<usize>, Range<usize>, &mut Found) + Sync,
 {
     let range = |n: &SNode| n.a as usize..(n.a + n.count) as usize;
     #[derive(Clone, Copy)]
@@ -430,11 +429,11 @@ where
         Pair(u32, u32),
     }
     if nodes.is_empty() {
-        return Vec::new();
+        return Found::new(cap);
     }
     let meet = |i: u32, j: u32| nodes[i as usize].b.meets(&nodes[j as usize].b);
     // Expand one job; leaf work goes to `out`, new jobs to `jobs`.
-    let step = |job: Job, out: &mut Vec<T>, jobs: &mut Vec<Job>| match job {
+    let step = |job: Job, out: &mut Found, jobs: &mut Vec<Job>| match job {
         Job::Node(i) if settled(i, i) => {}
         Job::Pair(i, j) if settled(i, j) => {}
         Job::Node(i) => {
@@ -469,7 +468,7 @@ where
         }
     };
     // Breadth-first seeding: leaf work met on the way is done here, in order.
-    let mut early = Vec::new();
+    let mut early = Found::new(cap);
     let mut level = vec![Job::Node(0)];
     while !level.is_empty() && level.len() < SEED_TASKS {
         let mut next = Vec::with_capacity(level.len() * 3);
@@ -478,18 +477,77 @@ where
         }
         level = next;
     }
-    let parts: Vec<Vec<T>> = level
+    let parts: Vec<Found> = level
         .par_iter()
         .map(|&seed| {
-            let mut out = Vec::new();
+            let mut out = Found::new(cap);
             let mut stack = vec![seed];
             while let Some(job) = stack.pop() {
                 step(job, &mut out, &mut stack);
             }
+            out.compact();
             out
         })
         .collect();
-    early.into_iter().chain(parts.into_iter().flatten()).collect()
+    for p in parts {
+        early.absorb(p);
+    }
+    early.compact();
+    early
+}
+
+/// Self-clash pairs as a walk finds them: every one counted, only the first `cap` in `(a, b)`
+/// order kept (the list is cut back to them whenever it grows to twice that, so memory does
+/// not grow with the number of pairs).
+struct Found {
+    pairs: Vec<SelfPair>,
+    total: u64,
+    crossing: u64,
+    cap: usize,
+}
+
+impl Found {
+    fn new(cap: usize) -> Found {
+        Found { pairs: Vec::new(), total: 0, crossing: 0, cap }
+    }
+
+    #[inline]
+    fn push(&mut self, p: SelfPair) {
+        self.total += 1;
+        self.crossing += p.hit.crossing as u64;
+        self.pairs.push(p);
+        if self.pairs.len() >= self.cap.saturating_mul(2).max(4096) {
+            self.compact();
+        }
+    }
+
+    /// Keep the first `cap` pairs in `(a, b)` order.
+    fn compact(&mut self) {
+        if self.pairs.len() > self.cap {
+            self.pairs.par_sort_unstable_by_key(|p| (p.a, p.b));
+            self.pairs.truncate(self.cap);
+        }
+    }
+
+    /// Add another walk's pairs and counts.
+    fn absorb(&mut self, o: Found) {
+        self.total += o.total;
+        self.crossing += o.crossing;
+        self.pairs.extend(o.pairs);
+        self.compact();
+    }
+}
+
+/// The self-clash pairs of one part: how many there are, how many of them cross, and the first
+/// of them.
+#[derive(Debug, Clone, PartialEq, Default)]
+pub struct SelfPairs {
+    /// The first pairs in `(a, b)` order (all of them, or as many as were asked for).
+    pub pairs: Vec<SelfPair>,
+    /// How many pairs there are.
+    pub total: u64,
+    /// How many of them cross.
+    pub crossing: u64,
 }
 
 /// Every self-clashing pair among `tris` (triangle indices of `mesh`, one part), sorted by
@@ -497,6 +555,19 @@ where
 /// ([`crate::scene::bodies::merge_vertices`]).
 pub fn self_pairs(mesh: &Mesh, merged: &[u32], tris: &[u32], opts: BuildOptions) -> Vec<SelfPair> {
     self_pairs_timed(mesh, merged, tris, opts).0
+}
+
+/// [`self_pairs`] with at most the first `cap` pairs listed (in `(a, b)` order) and every
+/// pair counted: memory does not grow with the number of pairs.
+pub fn self_pairs_counted(
+    mesh: &Mesh,
+    merged: &[u32],
+    tris: &[u32],
+    opts: BuildOptions,
+    cap: usize,
+) -> SelfPairs {
+    let fans = Fans::new(mesh, merged, tris);
+    self_pairs_with(mesh, tris, &fans, opts, cap).0
 }
 
 /// Milliseconds spent by one [`self_pairs_timed`] call, by phase.
@@ -517,20 +588,25 @@ pub fn self_pairs_timed(
 ) -> (Vec<SelfPair>, SelfTimes) {
     let t0 = std::time::Instant::now();
     let fans = Fans::new(mesh, merged, tris);
-    let (pairs, mut times) = self_pairs_with(mesh, tris, &fans, opts);
+    let (found, mut times) = self_pairs_with(mesh, tris, &fans, opts, usize::MAX);
     times.tree_ms = t0.elapsed().as_secs_f64() * 1e3 - times.walk_ms;
-    (pairs, times)
+    (found.pairs, times)
 }
 
-/// [`self_pairs_timed`], given the part's fans ([`Fans::new`] over the same triangles).
+/// [`self_pairs_counted`] with the time of each phase, given the part's fans ([`Fans::new`]
+/// over the same triangles).
+///
+/// Pairs of two members of one line group ([`lines`]) are counted group by group, not walked.
 pub fn self_pairs_with(
     mesh: &Mesh,
     tris: &[u32],
     fans: &Fans,
     opts: BuildOptions,
-) -> (Vec<SelfPair>, SelfTimes) {
+    cap: usize,
+) -> (SelfPairs, SelfTimes) {
     let t0 = std::time::Instant::now();
     let copies = Copies::new(fans);
+    let lines = lines::LineGroups::new(mesh, tris, fans);
     let certified = certified_fans(mesh, tris, fans, copies.as_ref().map(|c| c.walked.as_slice()));
     let corners = |k: usize| crate::bvh::triangle(mesh, tris[k]);
     // The triangles walked: all, or the first of each set of copies.
@@ -559,17 +635,20 @@ pub fn self_pairs_with(
     let edges = certified_edges(mesh, tris, fans, walked_mask, &is_certified);
     let shared_edges = common_edges(&nodes, &slots, &edges);
     let is_certified_edge = |a: u32, b: u32| edges.binary_search(&edge_key(a, b)).is_ok();
+    let line_of_node = lines.as_ref().map_or_else(Vec::new, |l| common_line(&nodes, &slots, l));
+    let same_line = |x: &Slot, y: &Slot| lines.as_ref().is_some_and(|l| l.same(x.k, y.k));
     let tree_ms = t0.elapsed().as_secs_f64() * 1e3;
     let t1 = std::time::Instant::now();
-    let tri = |s: &Slot| Tri { p: corners(s.k as usize), ids: s.ids, t: tris[s.k as usize] };
+    let tri_of = |k: u32| Tri { p: corners(k as usize), ids: fans.ids[k as usize], t: tris[k as usize] };
+    let tri = |s: &Slot| tri_of(s.k);
     // `x` against each of `ys`: the box test; then a pair sharing a vertex whose fan is
     // certified is settled; the rest get the exact box test and the pair test (`x`'s corners,
     // box and plane filter read once, on first use).
-    let against = |x: &Slot, ys: &[Slot], out: &mut Vec<SelfPair>| {
+    let against = |x: &Slot, ys: &[Slot], out: &mut Found| {
         let cx = x.ids.iter().enumerate().fold(0, |m, (k, &v)| m | (is_certified(v) as usize) << k);
         let mut full = None;
         for y in ys {
-            if x.b.meets(&y.b) {
+            if x.b.meets(&y.b) && !same_line(x, y) {
                 let mx = shared_mask(x.ids, y.ids);
                 if mx & cx != 0 {
                     continue;
@@ -597,13 +676,17 @@ pub fn self_pairs_with(
             }
         }
     };
-    let mut pairs = self_walk(
+    let mut found = self_walk(
         &nodes,
+        cap,
         |i, j| {
             certified_in_common(&shared[i as usize], &shared[j as usize])
                 || shared_edges
                     .get(i as usize)
                     .is_some_and(|&e| e != u64::MAX && shared_edges[j as usize] == e)
+                || line_of_node
+                    .get(i as usize)
+                    .is_some_and(|&g| g != lines::NONE && line_of_node[j as usize] == g)
         },
         |leaf, out| {
             let leaf = &slots[leaf];
@@ -618,8 +701,51 @@ pub fn self_pairs_with(
             }
         },
     );
-    pairs.par_sort_unstable_by_key(|p| (p.a, p.b));
-    (pairs, SelfTimes { tree_ms, walk_ms: t1.elapsed().as_secs_f64() * 1e3 })
+    if let Some(l) = &lines {
+        // The pairs inside each line group: counted, the first listed (all touching).
+        for g in 0..l.len() {
+            found.total += l.count(g);
+            for (x, y) in l.first_pairs(g, cap) {
+                let (tx, ty) = (tri_of(x), tri_of(y));
+                let (lo, hi) = if tx.t < ty.t { (tx, ty) } else { (ty, tx) };
+                if let Some(hit) = classify_adjacent(&lo.p, lo.ids, &hi.p, hi.ids) {
+                    found.pairs.push(SelfPair { a: lo.t, b: hi.t, hit });
+                }
+            }
+            found.compact();
+        }
+    }
+    found.compact();
+    found.pairs.par_sort_unstable_by_key(|p| (p.a, p.b));
+    let walk_ms = t1.elapsed().as_secs_f64() * 1e3;
+    (
+        SelfPairs { pairs: found.pairs, total: found.total, crossing: found.crossing },
+        SelfTimes { tree_ms, walk_ms },
+    )
+}
+
+/// Per node of the self tree: the line group ([`lines`]) every triangle under it belongs to
+/// ([`lines::NONE`]: none). No pair inside such a node, or between two nodes of one group, is
+/// walked: those pairs are counted with the group.
+fn common_line(nodes: &[SNode], slots: &[Slot], lines: &lines::LineGroups) -> Vec<u32> {
+    let mut out = vec![lines::NONE; nodes.len()];
+    for i in (0..nodes.len()).rev() {
+        let n = &nodes[i];
+        out[i] = if n.is_leaf() {
+            let items = &slots[n.a as usize..(n.a + n.count) as usize];
+            let g = lines.of(items[0].k);
+            if items.iter().all(|s| lines.of(s.k) == g) {
+                g
+            } else {
+                lines::NONE
+            }
+        } else if out[i + 1] == out[n.a as usize] {
+            out[i + 1]
+        } else {
+            lines::NONE
+        };
+    }
+    out
 }
 
 /// Triangles of one part with the same distinct vertices (the same face stored again, in any
@@ -687,7 +813,7 @@ impl Copies {
 
     /// Every pair of the sets of `x` and `y` (two walked triangles found to be a self-clash
     /// pair), each classified by [`classify_adjacent`] on its own triangles.
-    fn every_pair(&self, mesh: &Mesh, tris: &[u32], fans: &Fans, x: u32, y: u32, out: &mut Vec<SelfPair>) {
+    fn every_pair(&self, mesh: &Mesh, tris: &[u32], fans: &Fans, x: u32, y: u32, out: &mut Found) {
         for &i in self.of(x) {
             for &j in self.of(y) {
                 let (ti, tj) = (tris[i as usize], tris[j as usize]);
@@ -1115,8 +1241,11 @@ pub struct PartResult {
     pub name: String,
     /// Its triangles (indices into the mesh).
     pub triangles: usize,
-    /// Its self-clashing pairs, sorted by (a, b).
+    /// Its first self-clashing pairs, sorted by (a, b): all of them unless the check was asked
+    /// to list fewer ([`check_parts_listing`]).
     pub pairs: Vec<SelfPair>,
+    /// How many self-clashing pairs it has (listed or not).
+    pub count: u64,
     /// How many of them cross.
     pub crossing: u64,
     /// Its health.
@@ -1148,6 +1277,18 @@ pub fn check_parts(
     opts: BuildOptions,
     first_n: usize,
 ) -> (Vec<PartResult>, f64, f64) {
+    check_parts_listing(mesh, choice, opts, first_n, usize::MAX)
+}
+
+/// [`check_parts`], listing at most the first `max_listed` pairs of each part (the counts stay
+/// complete): memory does not grow with the number of pairs.
+pub fn check_parts_listing(
+    mesh: &crate::scene::mesh::Mesh,
+    choice: PartChoice,
+    opts: BuildOptions,
+    first_n: usize,
+    max_listed: usize,
+) -> (Vec<PartResult>, f64, f64) {
     let parts: Vec<PartSpec> = match choice {
         PartChoice::Objects(keep) => crate::check::assembly::parts_of(mesh, 0)
             .into_iter()
@@ -1156,7 +1297,7 @@ pub fn check_parts(
             .collect(),
         PartChoice::Whole(name) => vec![(None, name.to_string(), (0..mesh.triangles.len() as u32).collect())],
     };
-    check_part_list(mesh, parts, opts, first_n, false)
+    check_part_list(mesh, parts, opts, first_n, max_listed, false)
 }
 
 /// [`check_parts`] for a given list of parts. With `reuse` (scene mode), a part whose triangles
@@ -1167,12 +1308,14 @@ pub fn check_parts(
 /// its pairs are re-classified on its own coordinates (for its own contact segments) and its
 /// health findings renumbered. Any other part (an instance rotated or scaled, whose coordinates
 /// were rounded differently) is checked on its own placed coordinates, so the answer is always
-/// exactly the one a separate check of each part gives.
+/// exactly the one a separate check of each part gives. Each part lists at most its first
+/// `max_listed` pairs.
 pub fn check_part_list(
     mesh: &crate::scene::mesh::Mesh,
     parts: Vec<PartSpec>,
     opts: BuildOptions,
     first_n: usize,
+    max_listed: usize,
     reuse: bool,
 ) -> (Vec<PartResult>, f64, f64) {
     let t = std::time::Instant::now();
@@ -1198,16 +1341,16 @@ pub fn check_part_list(
         },
         || {
             let t = std::time::Instant::now();
-            let f: Vec<Vec<SelfPair>> = leaders
+            let f: Vec<SelfPairs> = leaders
                 .par_iter()
                 .zip(&fans)
-                .map(|(&i, f)| self_pairs_with(mesh, &parts[i].2, f, opts).0)
+                .map(|(&i, f)| self_pairs_with(mesh, &parts[i].2, f, opts, max_listed).0)
                 .collect();
             (f, ms(t))
         },
     );
     drop(fans);
-    let mut checked: Vec<Option<(crate::check::health::Health, Vec<SelfPair>)>> = vec![None; parts.len()];
+    let mut checked: Vec<Option<(crate::check::health::Health, SelfPairs)>> = vec![None; parts.len()];
     for (&i, r) in leaders.iter().zip(healths.into_iter().zip(found)) {
         checked[i] = Some(r);
     }
@@ -1215,10 +1358,13 @@ pub fn check_part_list(
     let mut results: Vec<PartResult> = Vec::with_capacity(parts.len());
     for (i, (object, name, tris)) in parts.iter().enumerate() {
         let derived = same_as[i].and_then(|l| {
-            let (health, pairs) = checked[l].as_ref().expect("leaders come first");
-            derive(mesh, &merged, &parts[l].2, tris, health, pairs).map(|r| (r, l))
+            let (health, found) = checked[l].as_ref().expect("leaders come first");
+            // The counts are the leader's (every verdict is the same); the listed pairs are
+            // renumbered and re-classified.
+            derive(mesh, &merged, &parts[l].2, tris, health, &found.pairs)
+                .map(|(h, pairs)| ((h, SelfPairs { pairs, total: found.total, crossing: found.crossing }), l))
         });
-        let ((health, pairs), from) = match derived {
+        let ((health, found), from) = match derived {
             Some((r, l)) => (r, Some(l)),
             // Not derivable after all (never expected): check it itself.
             None => match checked[i].clone() {
@@ -1226,19 +1372,19 @@ pub fn check_part_list(
                 None => (
                     (
                         crate::check::health::health(mesh, &merged, tris, first_n),
-                        self_pairs(mesh, &merged, tris, opts),
+                        self_pairs_counted(mesh, &merged, tris, opts, max_listed),
                     ),
                     None,
                 ),
             },
         };
-        let crossing = pairs.iter().filter(|q| q.hit.crossing).count() as u64;
         results.push(PartResult {
             object: *object,
             name: name.clone(),
             triangles: tris.len(),
-            pairs,
-            crossing,
+            pairs: found.pairs,
+            count: found.total,
+            crossing: found.crossing,
             health,
             same_as: from,
         });
@@ -1339,6 +1485,7 @@ fn derive(
     Some((h, out))
 }
 
+mod lines;
 mod tree;
 
 #[cfg(test)]

@@ -22,7 +22,8 @@ fn scene_self(
         .iter()
         .map(|&i| (Some(all[i].object), all[i].name.clone(), all[i].triangles.clone()))
         .collect();
-    let (results, _, _) = crate::check::self_clash::check_part_list(mesh, specs, opts, SCENE_FIRST_N, true);
+    let (results, _, _) =
+        crate::check::self_clash::check_part_list(mesh, specs, opts, SCENE_FIRST_N, max_pairs, true);
     let (pairs, pairs_truncated) = pairs_of(mesh, &results, max_pairs);
     let summary = summary_of(&results);
     let failed_on: Vec<SelfFailOn> =
@@ -46,7 +47,7 @@ fn scene_self(
                 name: p.name.clone(),
                 triangles: p.triangles,
                 crossing_pairs: p.crossing,
-                touching_pairs: p.pairs.len() as u64 - p.crossing,
+                touching_pairs: p.count - p.crossing,
                 same_as: p.same_as.map(|l| chosen[l]),
                 health: health_report(&p.health),
             })

@@ -103,7 +103,7 @@ impl SelfFailOn {
 
     /// Does this part's result meet the condition?
     pub fn hit(self, part: &PartResult) -> bool {
-        self.met(part.crossing, part.pairs.len() as u64 - part.crossing, &health_report(&part.health))
+        self.met(part.crossing, part.count - part.crossing, &health_report(&part.health))
     }
 
     /// Does a part with these self-clash counts and this health meet the condition?
@@ -372,7 +372,7 @@ pub(crate) fn pairs_of(
             status: None,
         })
         .collect();
-    (pairs, all.len() > max_pairs)
+    (pairs, parts.iter().map(|p| p.count).sum::<u64>() > max_pairs as u64)
 }
 
 /// Sums over the parts.
@@ -381,8 +381,8 @@ pub(crate) fn summary_of(parts: &[PartResult]) -> SelfSummary {
     SelfSummary {
         parts: parts.len(),
         crossing_pairs: sum(&|p| p.crossing),
-        touching_pairs: sum(&|p| p.pairs.len() as u64 - p.crossing),
-        parts_with_self_clash: parts.iter().filter(|p| !p.pairs.is_empty()).count(),
+        touching_pairs: sum(&|p| p.count - p.crossing),
+        parts_with_self_clash: parts.iter().filter(|p| p.count > 0).count(),
         open_parts: parts.iter().filter(|p| !p.health.closed).count(),
         duplicate_faces: sum(&|p| p.health.duplicate_faces.count),
         zero_area_triangles: sum(&|p| p.health.zero_area_triangles.count),
@@ -453,7 +453,7 @@ pub fn build(ctx: &Context) -> SelfReport {
                 name: p.name.clone(),
                 triangles: p.triangles,
                 crossing_pairs: p.crossing,
-                touching_pairs: p.pairs.len() as u64 - p.crossing,
+                touching_pairs: p.count - p.crossing,
                 health: health_report(&p.health),
             })
             .collect(),

@@ -348,8 +348,8 @@ fn instances_reuse_only_exact_translates_and_give_the_same_results() {
             .map(|p| (Some(p.object), p.name, p.triangles))
             .collect()
     };
-    let (with, _, _) = check_part_list(&m, specs(), BuildOptions::default(), 10, true);
-    let (without, _, _) = check_part_list(&m, specs(), BuildOptions::default(), 10, false);
+    let (with, _, _) = check_part_list(&m, specs(), BuildOptions::default(), 10, usize::MAX, true);
+    let (without, _, _) = check_part_list(&m, specs(), BuildOptions::default(), 10, usize::MAX, false);
     assert_eq!(with.iter().map(|p| p.same_as).collect::<Vec<_>>(), [None, Some(0), None]);
     assert!(without.iter().all(|p| p.same_as.is_none()));
     for (x, y) in with.iter().zip(&without) {
@@ -689,5 +689,89 @@ proptest! {
         }).collect();
         thirds.extend([[0.0, 0.0, 2.0], [0.0, 0.0, 3.0]].iter().take(beyond));
         pairs(&book(&thirds));
+    }
+}
+
+/// `n` zero-area triangles on the line through the origin along `dir`, triangle `i` spanning
+/// `[3i, 3i + 2 + 3h]` (times `dir`) with its own three vertices: members `i < j` meet iff
+/// `j - i <= h`. Then `extra` triangles that are not isolated or not on that line: a segment
+/// sharing a vertex with triangle 0, a proper triangle through the line, a point on it and a
+/// segment on a parallel line.
+fn line_soup(n: usize, h: usize, dir: [f64; 3], extra: bool) -> Mesh {
+    let at = |t: f64| [t * dir[0], t * dir[1], t * dir[2]];
+    let mut p = Vec::new();
+    let mut t = Vec::new();
+    for i in 0..n {
+        let b = p.len() as u32;
+        let s = 3.0 * i as f64;
+        // Vertex order varies: the middle vertex is stored first, last or in between.
+        let pts = [at(s), at(s + 1.0), at(s + 2.0 + 3.0 * h as f64)];
+        let order = [[1, 0, 2], [0, 2, 1], [2, 1, 0]][i % 3];
+        p.extend(order.map(|k| pts[k]));
+        t.push([b, b + 1, b + 2]);
+    }
+    if extra {
+        let b = p.len() as u32;
+        p.extend([at(5.5), at(40.0), [1.0, 1.0, 1.0], [-1.0, 2.0, 0.5], at(7.25), at(7.25)]);
+        t.push([0, b, b + 1]); // shares triangle 0's first vertex
+        t.push([b + 2, b + 3, b + 1]); // a proper triangle with a corner on the line
+        t.push([b + 4, b + 5, b + 4]); // a point on the line
+        let off = [dir[0] + 1.0, dir[1], dir[2] + 1.0];
+        let c = p.len() as u32;
+        p.extend([off, [off[0] + 9.0 * dir[0], off[1] + 9.0 * dir[1], off[2] + 9.0 * dir[2]], off]);
+        t.push([c, c + 1, c + 2]); // a segment off the line
+    }
+    mesh(&p, &t)
+}
+
+#[test]
+fn collinear_segments_are_counted_by_groups_as_the_brute_force_lists_them() {
+    // (Scaled by 0.1, -0.7, 0.3 the points are rounded off the line: no group, the walk.)
+    for (n, h, dir, extra, grouped) in [
+        (40, 5, [1.0, 2.0, 3.0], true, true),
+        (60, 100, [0.0, 0.0, 1.0], true, true),
+        (50, 0, [0.5, -0.75, 0.25], true, true),
+        (30, 7, [1.0, 0.0, 0.0], false, true),
+        (40, 4, [0.1, -0.7, 0.3], true, false),
+    ] {
+        let m = line_soup(n, h, dir, extra);
+        let (merged, _) = crate::scene::bodies::merge_vertices(&m.positions);
+        let all: Vec<u32> = (0..m.triangles.len() as u32).collect();
+        let fans = Fans::new(&m, &merged, &all);
+        assert!(!grouped || lines::LineGroups::new(&m, &all, &fans).is_some(), "{n} {dir:?}: a group");
+        let want = self_pairs_brute_force(&m, &merged, &all);
+        let crossing = want.iter().filter(|p| p.hit.crossing).count() as u64;
+        for leaf_size in [1, 4] {
+            let opts = BuildOptions { leaf_size, ..Default::default() };
+            assert_eq!(self_pairs(&m, &merged, &all, opts), want, "{n} {h} {dir:?} leaf {leaf_size}");
+            for cap in [0, 1, 7, 50, want.len(), usize::MAX] {
+                let got = self_pairs_counted(&m, &merged, &all, opts, cap);
+                assert_eq!(got.total, want.len() as u64, "{n} {h} {dir:?} cap {cap}");
+                assert_eq!(got.crossing, crossing);
+                assert_eq!(got.pairs[..], want[..cap.min(want.len())], "{n} {h} {dir:?} cap {cap}");
+            }
+        }
+    }
+}
+
+#[test]
+fn a_part_lists_its_first_pairs_and_counts_them_all() {
+    // A folded torus and a figure-eight tube: crossing and touching pairs from the walk.
+    for m in [gen::folded_torus(2_000), gen::figure_eight_tube(64, 12, 0.2)] {
+        let (merged, _) = crate::scene::bodies::merge_vertices(&m.positions);
+        let all: Vec<u32> = (0..m.triangles.len() as u32).collect();
+        let want = self_pairs(&m, &merged, &all, BuildOptions::default());
+        assert!(want.len() > 3);
+        let crossing = want.iter().filter(|p| p.hit.crossing).count() as u64;
+        for cap in [0, 1, 3, want.len() - 1, want.len(), usize::MAX] {
+            let got = self_pairs_counted(&m, &merged, &all, BuildOptions::default(), cap);
+            assert_eq!((got.total, got.crossing), (want.len() as u64, crossing), "cap {cap}");
+            assert_eq!(got.pairs[..], want[..cap.min(want.len())], "cap {cap}");
+        }
+        let whole = |cap| check_parts_listing(&m, PartChoice::Whole("m"), BuildOptions::default(), 10, cap).0;
+        let (full, cut) = (whole(usize::MAX), whole(2));
+        assert_eq!(full[0].pairs, want);
+        assert_eq!((cut[0].count, cut[0].crossing), (full[0].count, full[0].crossing));
+        assert_eq!(cut[0].pairs[..], want[..2]);
     }
 }
