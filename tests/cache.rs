@@ -463,3 +463,56 @@ fn sharded_runs_reuse_their_pairs_and_merge_to_the_cold_report() {
     let n = candidates(&cold);
     assert_eq!((body, reused, checked), (cold, n, 0));
 }
+
+#[test]
+fn clash_set_cache_flags_name_the_directory_and_bound_it() {
+    let d = tempfile::tempdir().unwrap();
+    std::fs::create_dir(d.path().join("sets")).unwrap();
+    write(d.path(), "sets/row.obj", &row(&scene_cubes()));
+    write(
+        d.path(),
+        "sets/set.json",
+        r#"{"version": 1, "checks": [{"name": "row", "scene": "row.obj", "clearance": "0.1"}]}"#,
+    );
+    let set = |extra: &[&str], env: Option<&str>| {
+        let mut c = bin(d.path());
+        c.args(["clash-set", "sets/set.json", "--no-timings"]).args(extra);
+        if let Some(dir) = env {
+            c.env("MESHCLASH_CACHE", dir);
+        }
+        let o = c.output().unwrap();
+        assert!(matches!(o.status.code(), Some(0 | 1)), "{}", String::from_utf8_lossy(&o.stderr));
+        let mut v = serde_json::from_slice::<serde_json::Value>(&o.stdout).unwrap();
+        let block = v["checks"][0]["report"].as_object_mut().unwrap().remove("cache");
+        let block = block.map(|b| {
+            (
+                b["part_pairs_reused"].as_u64().unwrap(),
+                b["part_pairs_checked"].as_u64().unwrap(),
+                b["dir"].as_str().unwrap().to_string(),
+            )
+        });
+        (v, block, String::from_utf8_lossy(&o.stderr).into_owned())
+    };
+    let (cold, none, _) = set(&[], None);
+    assert_eq!(none, None, "no block without a cache");
+    let n = cold["checks"][0]["report"]["assembly"]["candidate_part_pairs"].as_u64().unwrap();
+    // The flag names a directory relative to the working directory (not to the set's file),
+    // and wins over the environment variable.
+    let (first, b1, _) = set(&["--cache", "c"], Some("env"));
+    let (warm, b2, _) = set(&["--cache", "c"], Some("env"));
+    assert_eq!((&first, &warm), (&cold, &cold));
+    assert_eq!(b1, Some((0, n, "c".to_string())));
+    assert_eq!(b2, Some((n, 0, "c".to_string())));
+    assert!(d.path().join("c/CACHEDIR.TAG").is_file());
+    assert!(!d.path().join("env").exists() && !d.path().join("sets/c").exists());
+    // A bound below one entry: nothing is stored (one warning), so nothing is reused.
+    let (tiny, b3, err) = set(&["--cache", "tiny", "--cache-max-bytes", "64"], None);
+    let (again, b4, _) = set(&["--cache", "tiny", "--cache-max-bytes", "64"], None);
+    assert_eq!((&tiny, &again), (&cold, &cold));
+    assert_eq!((b3, b4), (Some((0, n, "tiny".to_string())), Some((0, n, "tiny".to_string()))));
+    assert!(err.contains("entry limit"), "{err}");
+    // A bad bound is a usage error naming the flag.
+    let o = bin(d.path()).args(["clash-set", "sets/set.json", "--cache-max-bytes", "x"]).output().unwrap();
+    assert_eq!(o.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&o.stderr).contains("--cache-max-bytes"));
+}
