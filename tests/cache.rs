@@ -463,3 +463,132 @@ fn sharded_runs_reuse_their_pairs_and_merge_to_the_cold_report() {
     let n = candidates(&cold);
     assert_eq!((body, reused, checked), (cold, n, 0));
 }
+
+#[test]
+fn clash_set_cache_flags_name_the_directory_and_bound_it() {
+    let d = tempfile::tempdir().unwrap();
+    std::fs::create_dir(d.path().join("sets")).unwrap();
+    write(d.path(), "sets/row.obj", &row(&scene_cubes()));
+    write(
+        d.path(),
+        "sets/set.json",
+        r#"{"version": 1, "checks": [{"name": "row", "scene": "row.obj", "clearance": "0.1"}]}"#,
+    );
+    let set = |extra: &[&str], env: Option<&str>| {
+        let mut c = bin(d.path());
+        c.args(["clash-set", "sets/set.json", "--no-timings"]).args(extra);
+        if let Some(dir) = env {
+            c.env("MESHCLASH_CACHE", dir);
+        }
+        let o = c.output().unwrap();
+        assert!(matches!(o.status.code(), Some(0 | 1)), "{}", String::from_utf8_lossy(&o.stderr));
+        let mut v = serde_json::from_slice::<serde_json::Value>(&o.stdout).unwrap();
+        let block = v["checks"][0]["report"].as_object_mut().unwrap().remove("cache");
+        let block = block.map(|b| {
+            (
+                b["part_pairs_reused"].as_u64().unwrap(),
+                b["part_pairs_checked"].as_u64().unwrap(),
+                b["dir"].as_str().unwrap().to_string(),
+            )
+        });
+        (v, block, String::from_utf8_lossy(&o.stderr).into_owned())
+    };
+    let (cold, none, _) = set(&[], None);
+    assert_eq!(none, None, "no block without a cache");
+    let n = cold["checks"][0]["report"]["assembly"]["candidate_part_pairs"].as_u64().unwrap();
+    // The flag names a directory relative to the working directory (not to the set's file),
+    // and wins over the environment variable.
+    let (first, b1, _) = set(&["--cache", "c"], Some("env"));
+    let (warm, b2, _) = set(&["--cache", "c"], Some("env"));
+    assert_eq!((&first, &warm), (&cold, &cold));
+    assert_eq!(b1, Some((0, n, "c".to_string())));
+    assert_eq!(b2, Some((n, 0, "c".to_string())));
+    assert!(d.path().join("c/CACHEDIR.TAG").is_file());
+    assert!(!d.path().join("env").exists() && !d.path().join("sets/c").exists());
+    // A bound below one entry: nothing is stored (one warning), so nothing is reused.
+    let (tiny, b3, err) = set(&["--cache", "tiny", "--cache-max-bytes", "64"], None);
+    let (again, b4, _) = set(&["--cache", "tiny", "--cache-max-bytes", "64"], None);
+    assert_eq!((&tiny, &again), (&cold, &cold));
+    assert_eq!((b3, b4), (Some((0, n, "tiny".to_string())), Some((0, n, "tiny".to_string()))));
+    assert!(err.contains("entry limit"), "{err}");
+    // A bad bound is a usage error naming the flag.
+    let o = bin(d.path()).args(["clash-set", "sets/set.json", "--cache-max-bytes", "x"]).output().unwrap();
+    assert_eq!(o.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&o.stderr).contains("--cache-max-bytes"));
+}
+
+/// A regular octahedron of radius `r` at `c`, as OBJ lines (vertices numbered from `base`):
+/// its box reaches further than its faces, so two of them can be a candidate pair (their boxes
+/// overlap) and still be clear.
+fn octahedron(name: &str, c: [f64; 3], r: f64, base: usize) -> String {
+    let mut out = format!("o {name}\n");
+    let axes = [
+        [1.0, 0.0, 0.0],
+        [-1.0, 0.0, 0.0],
+        [0.0, 1.0, 0.0],
+        [0.0, -1.0, 0.0],
+        [0.0, 0.0, 1.0],
+        [0.0, 0.0, -1.0],
+    ];
+    for a in axes {
+        out += &format!("v {} {} {}\n", c[0] + r * a[0], c[1] + r * a[1], c[2] + r * a[2]);
+    }
+    // +x 1, -x 2, +y 3, -y 4, +z 5, -z 6 (one-based, before `base`), wound outwards.
+    let faces = [[1, 3, 5], [3, 2, 5], [2, 4, 5], [4, 1, 5], [3, 1, 6], [2, 3, 6], [4, 2, 6], [1, 4, 6]];
+    for f in faces {
+        out += &format!("f {} {} {}\n", f[0] + base, f[1] + base, f[2] + base);
+    }
+    out
+}
+
+/// Octahedra of radius 1 along the xy diagonal, each `gaps[i]` further than touching its
+/// predecessor (touching: centres 1 apart along x and y).
+fn diagonal(gaps: &[f64], order: &[usize]) -> String {
+    let mut at = 0.0;
+    let mut centres = vec![[0.0, 0.0, 0.0]];
+    for g in gaps {
+        at += 1.0 + g;
+        centres.push([at, at, 0.0]);
+    }
+    order.iter().enumerate().map(|(k, &i)| octahedron(&format!("o{i}"), centres[i], 1.0, 6 * k)).collect()
+}
+
+#[test]
+fn clear_scene_warm_run_searches_nothing_and_keeps_the_closest_pair() {
+    let d = tempfile::tempdir().unwrap();
+    let args = ["scene", "diag.obj", "--no-timings"];
+    let step = |gaps: &[f64], order: &[usize]| {
+        write(d.path(), "diag.obj", &diagonal(gaps, order));
+        let cold = run_s(d.path(), &with(&args, &[]));
+        let v: serde_json::Value = serde_json::from_str(&cold).unwrap();
+        assert_eq!(v["verdict"], "clear", "{cold}");
+        assert!(closest_parts(&cold).2 > 0.0);
+        let (body, (reused, checked, _)) = split(&run_s(d.path(), &with(&args, &["--cache", "c"])));
+        assert_eq!(body, cold, "gaps {gaps:?}, order {order:?}");
+        // Nothing changed since: every pair is reused and none is searched again.
+        let (again, counts) = split(&run_s(d.path(), &with(&args, &["--cache", "c"])));
+        assert_eq!(again, cold, "warm, gaps {gaps:?}, order {order:?}");
+        let n = candidates(&cold);
+        assert_eq!((counts.0, counts.1), (n, 0), "warm, gaps {gaps:?}, order {order:?}");
+        (reused, checked, n)
+    };
+    let order: Vec<usize> = (0..6).collect();
+    let mut gaps = vec![0.5, 0.25, 0.75, 0.375, 0.625];
+    let (_, checked, n) = step(&gaps, &order);
+    assert_eq!(n, 5, "neighbours only: their boxes overlap, their faces do not meet");
+    assert_eq!(checked, n, "cold");
+    // The closest pair (o1-o2) moves apart: o3-o4 becomes the closest, a reused pair that must
+    // be searched again or be proven by its stored bound.
+    gaps[1] = 0.875;
+    step(&gaps, &order);
+    // One pair comes closer than every other.
+    gaps[3] = 0.125;
+    step(&gaps, &order);
+    // Ties: every neighbour pair at one distance (the lowest triangle numbers win), then the
+    // file's parts in another order (the triangle numbering changes, the parts do not).
+    let even = vec![0.5; 5];
+    step(&even, &order);
+    let (reused, checked, n) = step(&even, &[5, 4, 3, 2, 1, 0]);
+    assert_eq!(reused + checked, n);
+    step(&even, &[2, 0, 4, 1, 5, 3]);
+}

@@ -556,6 +556,15 @@ pub struct ClashSetArgs {
     /// Deterministic reports: no timings, no thread count.
     #[arg(long)]
     pub no_timings: bool,
+    /// Reuse results stored in the cache directory DIR (created when missing) and store new
+    /// ones, for every check of the set (as `--cache` on the check; the checks share one
+    /// directory). Default: the MESHCLASH_CACHE environment variable when set and not empty.
+    #[arg(long, value_name = "DIR")]
+    pub cache: Option<PathBuf>,
+    /// Bound of the cache directory in bytes (as `--cache-max-bytes` on the check)
+    /// [default: 1073741824].
+    #[arg(long, value_name = "N")]
+    pub cache_max_bytes: Option<u64>,
     /// Nothing on stderr but errors.
     #[arg(short, long)]
     pub quiet: bool,

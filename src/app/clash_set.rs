@@ -350,6 +350,15 @@ pub fn argv(c: &CheckSpec, dir: &Path, run: &ClashSetArgs) -> std::result::Resul
     if run.no_timings {
         v.push("--no-timings".into());
     }
+    if let Some(dir) = &run.cache {
+        // As given on the command line: relative to the working directory, not to the file.
+        let mut f = OsString::from("--cache=");
+        f.push(dir.as_os_str());
+        v.push(f);
+    }
+    if let Some(n) = run.cache_max_bytes {
+        v.push(flag("cache-max-bytes", &n.to_string()));
+    }
     v.push("--".into());
     match (&c.a, &c.b, &c.scene) {
         (Some(a), Some(b), None) => {

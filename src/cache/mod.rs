@@ -11,10 +11,12 @@
 //!   ([`FORMAT`]): a cache written by another version, or under other settings, is never found.
 //! - **Nothing is trusted without verification.** An entry is read back only if its header has
 //!   the magic, this layout, this version and exactly the requested key, its declared length
-//!   is what the file holds, and the payload's SHA-256 matches. Anything else (corrupt,
-//!   truncated, foreign, not a regular file) is ignored with one warning, counted as a miss
-//!   and removed; the caller recomputes and stores it again. A value is stored only when its
-//!   encoding decodes back to the same bytes, so every f64 returns bit for bit.
+//!   is what the file holds, and the payload's SHA-256 matches; then the payload must decode
+//!   whole. Anything else (corrupt, truncated, foreign, not a regular file) is ignored with one
+//!   warning, counted as a miss and removed; the caller recomputes and stores it again. The
+//!   per-pair results travel in a binary layout ([`pack`]) that holds every f64 as its bits; a
+//!   JSON value ([`Store::put`]) is stored only when its encoding decodes back to the same
+//!   bytes, so every f64 returns bit for bit.
 //! - **Atomic, shareable.** Entries are written to a new temporary (unpredictable name,
 //!   `O_EXCL`) beside the entry and renamed over it: readers see no entry or a whole one, and
 //!   two processes storing the same key at once both succeed. Concurrent runs and shards may
@@ -41,6 +43,7 @@
 pub mod entry;
 pub mod hook;
 pub mod key;
+pub mod pack;
 pub mod pairs;
 pub mod store;
 

@@ -16,11 +16,22 @@
 //!   part), so it holds whatever other parts do; it is mapped to the file's triangle numbers
 //!   when reused.
 //! - A clear pair's distance only matters when it could be the scene's closest. A pair with a
-//!   finding is stored with its exact closest pair (the check searches it in full); a clear
-//!   pair is stored without one. When no reused or checked pair touches or crosses (the
-//!   scene's minimum distance is then positive and could be a clear pair's), the reused clear
-//!   pairs are checked again together with the new ones, so the scene's closest pair is the
-//!   one a run without the cache finds; they count as checked.
+//!   finding is stored with its exact closest pair (the check searches it in full). The clear
+//!   pairs a check searches together share one bound, so each search stops as soon as it
+//!   cannot beat the least candidate `m` found over all of them: afterwards, each clear pair's
+//!   closest pair is the one it found, or comes after `m` in the order the scene's closest is
+//!   chosen by (distance, then triangle in A, then in B). A clear pair is stored with `m` (its
+//!   *bound*, [`pack::Stored::beyond`], with the digest of the triangle numbering it is in),
+//!   and with its closest pair only when that is `m` itself (the others are where the search
+//!   stopped, not proven closest).
+//! - When no reused or checked pair touches or crosses (the scene's minimum distance is then
+//!   positive and could be a clear pair's), let `best` be the least candidate over every
+//!   result at hand (listed pairs, checked pairs, stored closest pairs). A reused clear pair
+//!   whose bound is not before `best` (compared as stored when the numbering is the same,
+//!   else by distance alone, strictly) cannot hold a pair before `best`, and is not searched.
+//!   The other reused clear pairs are checked again, together, and count as checked; so the
+//!   scene's closest pair is the one a run without the cache finds. A warm re-run of an
+//!   unchanged clear scene searches nothing.
 //! - A run where reuse by pair could differ from a whole check falls back to caching the
 //!   whole check ([`WholeCheck`]): file mode (one unit), `--first-hit` (a stop rule),
 //!   a distance error allowance (the reported distance may depend on which pairs are searched
@@ -28,7 +39,7 @@
 //!   mirrored pairs take part in the check's distance bound).
 //!
 //! Storage: one run writes an index entry and packs, whatever its number of pairs. A *pack*
-//! holds results of pairs the run checked (keyed by their pair keys, hex; at most
+//! holds results of pairs the run checked (keyed by their pair keys; at most
 //! [`PACK_FINDINGS`] triangle pairs a pack) and the tree sizes it measured (keyed by part key;
 //! the report's memory figures need them); the *index* of the run's lineage (its settings,
 //! input file names and selection) lists the packs to read, newest first. A later run reads
@@ -38,25 +49,30 @@
 //! another version) is a miss: the pairs are checked again. Two runs writing one index at
 //! once: one wins, and the other's packs are only unreachable (evicted in time).
 //!
+//! Packs and indexes are binary ([`pack`] describes their bytes): written without any
+//! round-trip check, read with every bound checked, whole by the entry's SHA-256.
+//!
 //! Layouts (SHA-256, integers little-endian): the index key is the tag `meshclash.cache.index`
-//! and a zero byte, the fingerprint's 32 bytes, the lineage's length (u64) and UTF-8 text; a
-//! pack's key is the tag `meshclash.cache.pack` and a zero byte, the fingerprint's 32 bytes,
-//! then the 32 bytes of each pair key it holds, in order, a zero byte, then the 32 bytes of
-//! each part key whose tree size it holds, in order.
+//! and a zero byte, [`FORMAT`](super::FORMAT) (u32), the fingerprint's 32 bytes, the lineage's
+//! length (u64) and UTF-8 text; a pack's key is the tag `meshclash.cache.pack` and a zero
+//! byte, [`FORMAT`](super::FORMAT) (u32), the fingerprint's 32 bytes, then the 32 bytes of each
+//! pair key it holds, in order, a zero byte, then the 32 bytes of each part key whose tree
+//! size it holds, in order. The numbering digest is the tag `meshclash.cache.numbering` and a
+//! zero byte, the number of parts (u64), then for each part its input (one byte), its number
+//! of triangles (u64) and their numbers in the input mesh (u32 each).
 
 use super::hook::WholeCheck;
-use super::key::{to_hex, Digest, Fingerprint, PairKey, PartKey, Setting};
+use super::key::{Digest, Fingerprint, PairKey, PartKey, Setting};
+use super::pack::{self, Beyond, Stored};
 use super::store::{CacheSummary, Store};
 use crate::check::assembly::{
     check_parts_kept, glob_match, AssemblyInfo, Hook, Outcome, Pairing, Part, PartPairReduction, PartsHook,
     Selection, MAX_CANDIDATE_PART_PAIRS,
 };
 use crate::check::containment::Containment;
-use crate::check::query::{ClashResult, PairFinding, Settings, Timings, Verdict};
+use crate::check::query::{ClashResult, Closest, PairFinding, Settings, Timings, Verdict};
 use crate::scene::mesh::Mesh;
 use crate::shard::sha256::Sha256;
-use crate::shard::wire::WireResult;
-use serde::{Deserialize, Serialize};
 use std::collections::{HashMap, HashSet};
 use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
 use std::sync::{Arc, Mutex};
@@ -64,12 +80,14 @@ use std::sync::{Arc, Mutex};
 /// The most packs an index lists (the shards of a plan each add theirs to one index).
 pub const MAX_INDEX: usize = 256;
 
-/// The most triangle pairs (plus one per part pair) one pack holds: about 100 MB of JSON at
-/// most, below the entry limit ([`super::MAX_ENTRY_BYTES`]).
+/// The most triangle pairs (plus one per part pair) one pack holds: about 22 MB at most (a
+/// triangle pair takes at most 71 bytes, a part pair's result at most 240 and its reason),
+/// far below the entry limit ([`super::MAX_ENTRY_BYTES`]).
 pub const PACK_FINDINGS: usize = 300_000;
 
 const INDEX_TAG: &[u8] = b"meshclash.cache.index\0";
 const PACK_TAG: &[u8] = b"meshclash.cache.pack\0";
+const NUMBERING_TAG: &[u8] = b"meshclash.cache.numbering\0";
 
 /// The fingerprint of the settings that change one part pair's answer: the resolved
 /// tolerances (bits), the predicate mode, the detail level, the tree options (the tree sizes
@@ -93,45 +111,6 @@ pub fn pair_fingerprint(settings: &Settings, split_bodies: bool, penetration: bo
         ("split_bodies", split_bodies.into()),
         ("penetration", penetration.into()),
     ])
-}
-
-/// One stored pair result, by its pair key.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-#[serde(deny_unknown_fields)]
-struct Packed {
-    key: String,
-    result: WireResult,
-}
-
-/// What one run stored: pair results and tree sizes.
-#[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
-#[serde(deny_unknown_fields)]
-struct Pack {
-    pairs: Vec<Packed>,
-    trees: Vec<(String, u64)>,
-}
-
-/// The packs of a lineage, newest first (their keys, hex).
-#[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
-#[serde(deny_unknown_fields)]
-struct Index {
-    packs: Vec<String>,
-}
-
-fn parse_hex(s: &str) -> Option<Digest> {
-    if s.len() != 64 {
-        return None;
-    }
-    let mut out = [0u8; 32];
-    for (o, pair) in out.iter_mut().zip(s.as_bytes().chunks_exact(2)) {
-        let n = |c: u8| match c {
-            b'0'..=b'9' => Some(c - b'0'),
-            b'a'..=b'f' => Some(c - b'a' + 10),
-            _ => None,
-        };
-        *o = (n(pair[0])? << 4) | n(pair[1])?;
-    }
-    Some(out)
 }
 
 /// The cache of one check: per part pair when it can be, else the whole check.
@@ -168,6 +147,7 @@ impl CheckCache {
         let fingerprint = pair_fingerprint(settings, split_bodies, penetration);
         let mut sha = Sha256::default();
         sha.update(INDEX_TAG);
+        sha.update(&super::FORMAT.to_le_bytes());
         sha.update(fingerprint.as_bytes());
         let globs = |g: &[String]| g.iter().map(|s| format!("{}:{s}", s.len())).collect::<Vec<_>>().join(",");
         let lineage = format!(
@@ -240,10 +220,10 @@ pub struct PairReuse {
 /// What a run read from the cache.
 #[derive(Default)]
 struct Loaded {
-    /// Pack keys (hex), in index order, and whether a pair of this run came from each.
-    packs: Vec<(String, bool)>,
-    /// Pair key -> (pack, result).
-    pairs: HashMap<Digest, (usize, WireResult)>,
+    /// Pack keys, in index order, and whether a pair of this run came from each.
+    packs: Vec<(Digest, bool)>,
+    /// Pair key -> (pack, stored answer).
+    pairs: HashMap<Digest, (usize, Stored)>,
     /// Part key -> tree size.
     trees: HashMap<Digest, u64>,
 }
@@ -289,6 +269,42 @@ fn to_global(r: &mut ClashResult, pa: &Part, pb: &Part) -> Result<(), String> {
     Ok(())
 }
 
+/// A closest-pair candidate's place in the order the scene's closest pair is chosen by:
+/// distance, then triangle in A, then in B.
+fn order(c: &Closest) -> (f64, u32, u32) {
+    (c.distance, c.a.0, c.b.0)
+}
+
+/// The total order of [`order`] keys (distances are never NaN; `total_cmp` orders them as
+/// `<` does, but for -0 before +0, which a distance never is).
+trait KeyOrder {
+    fn total_cmp_key(&self, o: &Self) -> std::cmp::Ordering;
+}
+
+impl KeyOrder for (f64, u32, u32) {
+    fn total_cmp_key(&self, o: &Self) -> std::cmp::Ordering {
+        self.0.total_cmp(&o.0).then(self.1.cmp(&o.1)).then(self.2.cmp(&o.2))
+    }
+}
+
+/// The digest of how the parts number their triangles in the input meshes (each part's input,
+/// triangle count and triangle numbers, in part order): two runs with the same digest number
+/// every part's triangles alike.
+fn numbering_digest(parts: &[Part]) -> Digest {
+    let mut sha = Sha256::default();
+    sha.update(NUMBERING_TAG);
+    sha.update(&(parts.len() as u64).to_le_bytes());
+    let mut buf: Vec<u8> = Vec::new();
+    for p in parts {
+        buf.clear();
+        buf.push(p.input);
+        buf.extend((p.triangles.len() as u64).to_le_bytes());
+        buf.extend(p.triangles.iter().flat_map(|t| t.to_le_bytes()));
+        sha.update(&buf);
+    }
+    sha.digest()
+}
+
 fn listed(r: &ClashResult) -> bool {
     r.verdict != Verdict::Clear || r.containment != Containment::None
 }
@@ -307,45 +323,37 @@ impl PairReuse {
 
     fn load(&self) -> Loaded {
         let mut l = Loaded::default();
-        let Some(index) = self.store.get::<Index>(&self.index) else {
+        let Some(index) = self.store.get_with(&self.index, pack::decode_index) else {
             return l;
         };
-        for hex in index.packs.iter().take(MAX_INDEX) {
-            let Some(d) = parse_hex(hex) else {
-                let path = self.store.entry_path(&self.index);
-                self.store.warn(format!("cache: ignored entry {}: bad pack key '{hex}'", path.display()));
-                return Loaded::default();
-            };
-            let Some(pack) = self.store.get::<Pack>(&PairKey::from_digest(d)) else { continue };
+        for d in index.into_iter().take(MAX_INDEX) {
+            let Some(p) = self.store.get_with(&PairKey::from_digest(d), pack::decode_pack) else { continue };
             let at = l.packs.len();
-            l.packs.push((hex.clone(), false));
-            for p in pack.pairs {
-                if let Some(k) = parse_hex(&p.key) {
-                    l.pairs.entry(k).or_insert((at, p.result));
-                }
+            l.packs.push((d, false));
+            l.pairs.reserve(p.pairs.len());
+            for (k, stored) in p.pairs {
+                l.pairs.entry(k).or_insert((at, stored));
             }
-            for (k, b) in pack.trees {
-                if let Some(k) = parse_hex(&k) {
-                    l.trees.entry(k).or_insert(b);
-                }
+            for (k, b) in p.trees {
+                l.trees.entry(k).or_insert(b);
             }
         }
         l
     }
 
-    /// Store `pairs` (pair key, result in part triangle numbers) and `trees` as a new pack,
+    /// Store `pairs` (pair key, answer in part triangle numbers) and `trees` as a new pack,
     /// and point the index at it and at the `kept` older packs.
-    fn save(&self, mut pairs: Vec<(Digest, WireResult)>, mut trees: Vec<(Digest, u64)>, kept: Vec<String>) {
+    fn save(&self, mut pairs: Vec<(Digest, Stored)>, mut trees: Vec<(Digest, u64)>, kept: Vec<Digest>) {
         pairs.sort_by_key(|x| x.0);
         pairs.dedup_by(|x, y| x.0 == y.0);
         trees.sort_unstable();
         trees.dedup_by(|x, y| x.0 == y.0);
         // Packs of at most PACK_FINDINGS triangle pairs each (an entry stays far below the
         // entry limit); the tree sizes go with the first.
-        let mut chunks: Vec<Vec<(Digest, WireResult)>> = vec![Vec::new()];
+        let mut chunks: Vec<Vec<(Digest, Stored)>> = vec![Vec::new()];
         let mut size = 0usize;
         for p in pairs {
-            let n = p.1.findings() + 1;
+            let n = p.1.result.pairs.len() + 1;
             if size + n > PACK_FINDINGS && !chunks.last().is_some_and(Vec::is_empty) {
                 chunks.push(Vec::new());
                 size = 0;
@@ -354,11 +362,12 @@ impl PairReuse {
             chunks.last_mut().expect("one chunk").push(p);
         }
         let mut trees = Some(trees);
-        let mut written: Vec<String> = Vec::new();
+        let mut written: Vec<Digest> = Vec::new();
         for chunk in chunks {
             let trees = trees.take().unwrap_or_default();
             let mut sha = Sha256::default();
             sha.update(PACK_TAG);
+            sha.update(&super::FORMAT.to_le_bytes());
             sha.update(self.fingerprint.as_bytes());
             for (k, _) in &chunk {
                 sha.update(k);
@@ -368,26 +377,22 @@ impl PairReuse {
                 sha.update(k);
             }
             let key = PairKey::from_digest(sha.digest());
-            let pack = Pack {
-                pairs: chunk.into_iter().map(|(k, result)| Packed { key: to_hex(&k), result }).collect(),
-                trees: trees.into_iter().map(|(k, b)| (to_hex(&k), b)).collect(),
-            };
-            self.store.put(&key, &pack);
-            written.push(key.hex());
+            self.store.put_bytes(&key, &pack::encode_pack(&chunk, &trees));
+            written.push(*key.as_bytes());
         }
-        let mut packs: Vec<String> = written;
+        let mut packs: Vec<Digest> = written;
         if self.inner.is_some() {
             // A shard: the other shards' packs stay listed (read again now, as they may have
             // written meanwhile).
-            let now = self.store.get::<Index>(&self.index).unwrap_or_default();
-            packs.extend(kept.into_iter().chain(now.packs));
+            let now = self.store.get_with(&self.index, pack::decode_index).unwrap_or_default();
+            packs.extend(kept.into_iter().chain(now));
         } else {
             packs.extend(kept);
         }
         let mut seen = HashSet::new();
-        packs.retain(|k| seen.insert(k.clone()));
+        packs.retain(|k| seen.insert(*k));
         packs.truncate(MAX_INDEX);
-        self.store.put(&self.index, &Index { packs });
+        self.store.put_bytes(&self.index, &pack::encode_index(&packs));
     }
 
     /// The check, by pairs: see the module documentation. `None` when this run cannot be
@@ -439,15 +444,18 @@ impl PairReuse {
             .collect();
         let mut loaded = self.load();
         // Reuse what is stored.
+        let mut beyond: Vec<Option<Beyond>> = vec![None; candidates.len()];
         let mut results: Vec<Option<ClashResult>> = candidates
             .iter()
             .zip(&pair_keys)
-            .map(|(&(a, b), k)| {
-                let (pack, wire) = loaded.pairs.get(k.as_bytes())?;
-                let got = wire.result().and_then(|mut r| to_global(&mut r, &parts[a], &parts[b]).map(|()| r));
-                match got {
-                    Ok(r) => {
+            .zip(&mut beyond)
+            .map(|((&(a, b), k), bound)| {
+                let (pack, stored) = loaded.pairs.get(k.as_bytes())?;
+                let mut r = stored.result.clone();
+                match to_global(&mut r, &parts[a], &parts[b]) {
+                    Ok(()) => {
                         loaded.packs[*pack].1 = true;
+                        *bound = stored.beyond;
                         Some(r)
                     }
                     Err(e) => {
@@ -457,7 +465,9 @@ impl PairReuse {
                 }
             })
             .collect();
-        let mut fresh: Vec<(Digest, WireResult)> = Vec::new();
+        let numbering = std::cell::OnceCell::new();
+        let numbering = || *numbering.get_or_init(|| numbering_digest(parts));
+        let mut fresh: Vec<(Digest, Stored)> = Vec::new();
         let mut timings = Timings::default();
         let mut check = |results: &mut Vec<Option<ClashResult>>, which: &HashSet<(usize, usize)>| {
             if which.is_empty() {
@@ -467,17 +477,30 @@ impl PairReuse {
             let ar = check_parts_kept(meshes, parts.to_vec(), &sa, &sb, pairing, settings, &keep);
             timings.build_ms += ar.build_ms;
             timings.query_ms += ar.query_ms;
+            // The least candidate of the pairs searched together: every clear pair's closest
+            // pair is the one it found, or comes after this one (see `pack::Stored::beyond`).
+            let least = ar
+                .part_pairs
+                .iter()
+                .filter_map(|pp| pp.result.closest)
+                .min_by(|x, y| order(x).total_cmp_key(&order(y)));
+            let bound =
+                least.map(|c| Beyond { numbering: numbering(), a: c.a.0, b: c.b.0, distance: c.distance });
             let at: HashMap<(usize, usize), usize> =
                 candidates.iter().enumerate().map(|(i, &p)| (p, i)).collect();
             for pp in ar.part_pairs {
                 let i = at[&(pp.a, pp.b)];
-                let mut stored = pp.result.clone();
-                if !listed(&stored) {
-                    // A clear pair's distance was searched only as far as the run needed.
-                    stored.closest = None;
+                let clear = !listed(&pp.result);
+                let mut keep = pp.result.clone();
+                if clear && keep.closest != least {
+                    // A clear pair's search may have stopped at a pair that is not its closest
+                    // (the shared bound cut the rest): only the least candidate is known to be
+                    // its pair's closest. The bound says the rest.
+                    keep.closest = None;
                 }
-                if let Some(l) = to_local(&stored, &parts[pp.a], &parts[pp.b]) {
-                    fresh.push((*pair_keys[i].as_bytes(), WireResult::of(&l)));
+                if let Some(l) = to_local(&keep, &parts[pp.a], &parts[pp.b]) {
+                    let stored = Stored { result: l, beyond: if clear { bound } else { None } };
+                    fresh.push((*pair_keys[i].as_bytes(), stored));
                 }
                 results[i] = Some(pp.result);
             }
@@ -486,21 +509,40 @@ impl PairReuse {
             candidates.iter().zip(&results).filter(|(_, r)| r.is_none()).map(|(&p, _)| p).collect();
         let mut checked = missing.len() as u64;
         check(&mut results, &missing);
-        // When nothing touches or crosses, a clear pair may be the scene's closest: the reused
-        // clear pairs are searched again, with the scene's bound (see the module docs).
+        // When nothing touches or crosses, a clear pair may be the scene's closest. Every
+        // result's closest pair is a real candidate; the least of them, `best`, bounds the
+        // scene's. A reused clear pair whose stored bound is not before `best` cannot hold a
+        // closer pair than `best` (or it holds its stored closest pair, a candidate already);
+        // the other reused clear pairs are searched again, together (see the module docs).
         let touching =
             results.iter().flatten().any(|r| listed(r) && r.closest.is_some_and(|c| c.distance == 0.0));
         if !touching {
+            let best = results
+                .iter()
+                .flatten()
+                .filter_map(|r| r.closest)
+                .min_by(|x, y| order(x).total_cmp_key(&order(y)));
+            let settled = |bound: &Option<Beyond>| match (bound, best) {
+                (Some(m), Some(b)) => {
+                    if m.numbering == numbering() {
+                        // The same numbering: the order against `m` holds as stored.
+                        (m.distance, m.a, m.b).total_cmp_key(&order(&b)).is_ge()
+                    } else {
+                        m.distance > b.distance
+                    }
+                }
+                _ => false,
+            };
             let clear: HashSet<(usize, usize)> = candidates
                 .iter()
                 .zip(&results)
-                .filter(|(p, r)| !missing.contains(p) && r.as_ref().is_some_and(|r| !listed(r)))
-                .map(|(&p, _)| p)
+                .zip(&beyond)
+                .filter(|((p, r), bound)| {
+                    !missing.contains(p) && r.as_ref().is_some_and(|r| !listed(r)) && !settled(bound)
+                })
+                .map(|((&p, _), _)| p)
                 .collect();
             checked += clear.len() as u64;
-            // The other clear pairs' results are of no use beside these: drop their
-            // distances so that only the searches below (sharing one bound) and the listed
-            // pairs take part in the minimum.
             check(&mut results, &clear);
         }
         let reused = candidates.len() as u64 - checked;
@@ -530,7 +572,7 @@ impl PairReuse {
         })
         .ok()?;
         let any_new = !fresh.is_empty() || !new_trees.is_empty();
-        let used: Vec<String> = loaded.packs.iter().filter(|(_, u)| *u).map(|(k, _)| k.clone()).collect();
+        let used: Vec<Digest> = loaded.packs.iter().filter(|(_, u)| *u).map(|(k, _)| *k).collect();
         if any_new {
             self.save(fresh, new_trees, used);
         }

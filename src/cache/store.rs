@@ -222,23 +222,35 @@ impl Store {
     /// that is there but not usable adds one warning and is removed (the caller recomputes and
     /// puts it again). A hit marks the entry recently used.
     pub fn get<T: DeserializeOwned>(&self, key: &PairKey) -> Option<T> {
+        self.get_with(key, |p| serde_json::from_slice::<T>(p).map_err(|e| e.to_string()))
+    }
+
+    /// As [`Store::get`], with the payload decoded by `decode` (an error is a payload that
+    /// does not decode: the entry is ignored with one warning and removed).
+    pub fn get_with<T>(
+        &self,
+        key: &PairKey,
+        decode: impl FnOnce(&[u8]) -> std::result::Result<T, String>,
+    ) -> Option<T> {
         let path = self.entry_path(key);
         let found = match read_entry(&path, key, self.max_bytes.min(MAX_ENTRY_BYTES)) {
             Ok(None) => None,
-            Ok(Some((file, bytes))) => match entry::decode(&bytes, key, TOOL_VERSION)
-                .and_then(|p| serde_json::from_slice::<T>(p).map_err(|e| Rejected::Payload(e.to_string())))
-            {
-                Ok(v) => {
-                    // Recently used: eviction goes by modification time. Failing to touch
-                    // (another user's entry) only makes eviction less exact.
-                    let _ = file.set_modified(SystemTime::now());
-                    Some(v)
+            Ok(Some((file, bytes))) => {
+                match entry::decode(&bytes, key, TOOL_VERSION)
+                    .and_then(|p| decode(p).map_err(Rejected::Payload))
+                {
+                    Ok(v) => {
+                        // Recently used: eviction goes by modification time. Failing to touch
+                        // (another user's entry) only makes eviction less exact.
+                        let _ = file.set_modified(SystemTime::now());
+                        Some(v)
+                    }
+                    Err(why) => {
+                        self.ignore(&path, &why);
+                        None
+                    }
                 }
-                Err(why) => {
-                    self.ignore(&path, &why);
-                    None
-                }
-            },
+            }
             Err(why) => {
                 self.ignore(&path, &why);
                 None
@@ -280,7 +292,16 @@ impl Store {
                 return;
             }
         };
-        let bytes = entry::encode(key, TOOL_VERSION, &payload);
+        self.put_bytes(key, &payload);
+    }
+
+    /// Store `payload` (already encoded, in a layout its reader decodes with
+    /// [`Store::get_with`]) for `key`. Never fails the run, as [`Store::put`].
+    pub fn put_bytes(&self, key: &PairKey, payload: &[u8]) {
+        if self.writes_off.load(Ordering::Relaxed) {
+            return;
+        }
+        let bytes = entry::encode(key, TOOL_VERSION, payload);
         let len = bytes.len() as u64;
         let limit = self.max_bytes.min(MAX_ENTRY_BYTES);
         if len > limit {
