@@ -144,20 +144,22 @@ fn merge_output_naming_a_shard_report_is_refused_and_the_report_kept() {
     assert_eq!(std::fs::read(d.path().join("s1.json")).unwrap(), before, "the shard report was rewritten");
 }
 
-/// `meshclash run --plan p.json -o p.json`: the plan is an input, refused (exit 2) and left as
-/// it was. The refusal is right today, but the report of the failed shard is then written to
-/// `-o` anyway (`run_cmd` in src/app/shard.rs writes it whatever the error), replacing the plan.
+/// `meshclash run --plan p.json -o p.json` (or `-o a.obj`, a mesh the plan reads): the plan and
+/// its meshes are inputs, refused (exit 2) before anything is written, and left as they were;
+/// the report a failed shard leaves for the merge is not written over them either.
 #[test]
-#[ignore = "run --plan P -o P still replaces P with the failed shard's report (src/app/shard.rs run_cmd)"]
-fn run_output_naming_its_plan_is_refused_and_the_plan_kept() {
+fn run_output_naming_its_plan_or_a_mesh_is_refused_and_the_input_kept() {
     let d = two_meshes();
     let (code, err) = sh(d.path(), r#""$M" plan a.obj b.obj -o p.json -q"#);
     assert_eq!(code, Some(0), "{err}");
-    let before = std::fs::read(d.path().join("p.json")).unwrap();
-    let (code, err) = sh(d.path(), r#""$M" run --plan p.json --shard 1/1 -o p.json -q"#);
-    assert_eq!(code, Some(2), "{err}");
-    assert!(err.contains("p.json") && err.contains("names the input"), "{err}");
-    assert_eq!(std::fs::read(d.path().join("p.json")).unwrap(), before, "the plan was rewritten");
+    for input in ["p.json", "a.obj"] {
+        let before = std::fs::read(d.path().join(input)).unwrap();
+        let (code, err) = sh(d.path(), &format!(r#""$M" run --plan p.json --shard 1/1 -o {input} -q"#));
+        assert_eq!(code, Some(2), "{err}");
+        assert_eq!(err.trim_end().lines().count(), 1, "{err}");
+        assert!(err.contains(input) && err.contains("names the input"), "{err}");
+        assert_eq!(std::fs::read(d.path().join(input)).unwrap(), before, "{input} was rewritten");
+    }
 }
 
 /// `--format text -o t.json > /dev/full`: the summary is lost, so the run is exit 2 and writes

@@ -308,6 +308,12 @@ fn read_plan(path: &Path) -> Result<(Plan, String)> {
 fn run_cmd(a: RunArgs) -> Result<u8> {
     let (plan, plan_hash) = read_plan(&a.plan)?;
     let (i, n) = shard_index(a.shard.as_deref(), a.shards)?;
+    // An output naming an input is refused before anything is written: the failure report
+    // below must never replace the plan or a model.
+    let cfg = config_of(&plan.args).ok();
+    let mut inputs = cfg.as_ref().map(|c| c.input_paths()).unwrap_or_default();
+    inputs.push(&a.plan);
+    write::check_outputs(&[("-o", &a.output)], &inputs)?;
     match run_shard(&a, &plan, &plan_hash, i, n) {
         Ok(()) => Ok(0),
         Err(e) => {
