@@ -40,29 +40,34 @@ pub struct Topology {
 }
 
 /// Merge exactly coincident vertices (+0 and −0 are the same point) and count edge uses.
+///
+/// Linear passes over the triangles: merged ids numbered in order of first occurrence (one hash
+/// table, [`crate::scene::bodies::merge_vertices_in_order`]; ids then follow the file's vertex
+/// order, so the union–find and the edge buckets below touch memory mostly in order), edges of
+/// the proper triangles bucketed by their lower end (a counting sort), components by a
+/// union–find whose roots are flattened in one ascending pass.
 pub fn topology<M: TriMesh + ?Sized>(mesh: &M) -> Topology {
     use rayon::prelude::*;
-    // Merge exactly coincident vertices by sorting their bit patterns (parallel; a hash map of
-    // millions of keys was most of the cost of a check on large inputs).
-    let (merged, distinct) = crate::scene::bodies::merge_vertices(&mesh.positions());
-    use crate::scene::bodies::{find, union};
-    let mut parent: Vec<u32> = (0..distinct as u32).collect();
-    let proper: Vec<bool> = (0..mesh.triangle_count() as u32)
+    let (merged, distinct) = crate::scene::bodies::merge_vertices_in_order(&mesh.positions());
+    use crate::scene::bodies::union;
+    let n = mesh.triangle_count();
+    // Per triangle: its merged vertex ids, and whether it is proper (non-zero area).
+    let tris: Vec<([u32; 3], bool)> = (0..n as u32)
         .into_par_iter()
-        .map(|t| !Shape::of(&mesh.triangle(t)).is_degenerate())
+        .map(|t| {
+            let ids = mesh.indices(t).map(|i| merged[i as usize]);
+            (ids, !Shape::of(&mesh.triangle(t)).is_degenerate())
+        })
         .collect();
+    let mut parent: Vec<u32> = (0..distinct as u32).collect();
     // Undirected edges (lo, hi) of the proper triangles, bucketed by lo (a counting sort: two
-    // passes over the triangles, 4 bytes per edge; a comparison sort of 64-bit edge keys was
-    // most of this function's time on large meshes).
-    let ids = |t: usize| mesh.indices(t as u32).map(|i| merged[i as usize]);
+    // passes over the triangles, 4 bytes per edge).
     let lo_hi = |v: [u32; 3], k: usize| (v[k].min(v[(k + 1) % 3]), v[k].max(v[(k + 1) % 3]));
     let mut start = vec![0u32; distinct + 1];
-    for (t, &is_proper) in proper.iter().enumerate() {
-        let v = ids(t);
+    for &(v, is_proper) in &tris {
         // Two unions join all three vertices.
-        for k in 0..2 {
-            union(&mut parent, v[k], v[k + 1]);
-        }
+        union(&mut parent, v[0], v[1]);
+        union(&mut parent, v[1], v[2]);
         if is_proper {
             for k in 0..3 {
                 start[lo_hi(v, k).0 as usize + 1] += 1;
@@ -74,8 +79,7 @@ pub fn topology<M: TriMesh + ?Sized>(mesh: &M) -> Topology {
     }
     let mut fill = start.clone();
     let mut hi = vec![0u32; start[distinct] as usize];
-    for (t, _) in proper.iter().enumerate().filter(|x| *x.1) {
-        let v = ids(t);
+    for &(v, _) in tris.iter().filter(|x| x.1) {
         for k in 0..3 {
             let (a, b) = lo_hi(v, k);
             hi[fill[a as usize] as usize] = b;
@@ -90,25 +94,31 @@ pub fn topology<M: TriMesh + ?Sized>(mesh: &M) -> Topology {
             bucket.sort_unstable();
             bucket.chunk_by(|x, y| x == y).all(|run| run.len() == 2)
         });
+    // Every parent is below its child (a union hangs the larger root under the smaller, path
+    // halving only shortens), so one ascending pass turns `parent` into each id's root.
+    for x in 0..distinct {
+        let p = parent[x] as usize;
+        parent[x] = parent[p];
+    }
+    let root = parent;
     // The first vertex (in triangle order) of each component.
-    let mut comp_of_root = vec![u32::MAX; parent.len()];
+    let mut comp_of_root = vec![u32::MAX; distinct];
     let mut component_seeds = Vec::new();
-    for t in 0..mesh.triangle_count() as u32 {
-        let v = mesh.indices(t)[0];
-        let root = find(&mut parent, merged[v as usize]) as usize;
-        if comp_of_root[root] == u32::MAX {
-            comp_of_root[root] = component_seeds.len() as u32;
-            component_seeds.push(v);
+    for (t, &(v, _)) in tris.iter().enumerate() {
+        let r = root[v[0] as usize] as usize;
+        if comp_of_root[r] == u32::MAX {
+            comp_of_root[r] = component_seeds.len() as u32;
+            component_seeds.push(mesh.indices(t as u32)[0]);
         }
     }
     let mut used = vec![false; mesh.vertex_count()];
-    for t in 0..mesh.triangle_count() as u32 {
+    for t in 0..n as u32 {
         for v in mesh.indices(t) {
             used[v as usize] = true;
         }
     }
     let component_of = (0..mesh.vertex_count())
-        .map(|v| if used[v] { comp_of_root[find(&mut parent, merged[v]) as usize] } else { u32::MAX })
+        .map(|v| if used[v] { comp_of_root[root[merged[v] as usize] as usize] } else { u32::MAX })
         .collect();
     Topology { closed, component_seeds, component_of, merged }
 }

@@ -208,25 +208,20 @@ fn add_instance(
         }
         let base = mesh.positions.len() as u32;
         bases[k] = Some(base);
-        for (i, &v) in prims[owner].positions.iter().enumerate() {
-            let w = world.transform_point3(v);
-            if let Some(value) = super::non_finite(w.to_array()) {
-                let at = Location::Placed { mesh: inst.mesh, position: i, node: inst.node, instance };
-                return Err(Error::at(
-                    path,
-                    at,
-                    InputProblem::NonFiniteAfterTransform { value: Some(value) },
-                ));
-            }
-            mesh.positions.push(w);
+        // Transform all, then look for the first non-finite result (one tight loop each).
+        mesh.positions.extend(prims[owner].positions.iter().map(|&v| world.transform_point3(v)));
+        let placed = &mesh.positions[base as usize..];
+        if let Some((i, value)) =
+            placed.iter().enumerate().find_map(|(i, w)| Some((i, super::non_finite(w.to_array())?)))
+        {
+            let at = Location::Placed { mesh: inst.mesh, position: i, node: inst.node, instance };
+            return Err(Error::at(path, at, InputProblem::NonFiniteAfterTransform { value: Some(value) }));
         }
     }
     for (p, base) in prims.iter().zip(bases) {
         let Some(base) = base else { continue };
-        for t in &p.triangles {
-            mesh.triangles.push([base + t[0], base + t[1], base + t[2]]);
-            mesh.tri_object.push(object);
-        }
+        mesh.triangles.extend(p.triangles.iter().map(|t| t.map(|i| base + i)));
+        mesh.tri_object.resize(mesh.tri_object.len() + p.triangles.len(), object);
     }
     Ok(())
 }

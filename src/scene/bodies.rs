@@ -43,6 +43,53 @@ pub fn merge_vertices(positions: &[DVec3]) -> (Vec<u32>, usize) {
     (merged, distinct)
 }
 
+/// Exactly-coincident-vertex ids numbered in order of first occurrence (the first position
+/// gets 0, the next position with a new value 1, …), and the number of distinct values. The
+/// same classes as [`merge_vertices`] (whose ids follow the sorted bit patterns instead), found
+/// with one open-addressing hash table: one pass over the positions, no sort.
+pub fn merge_vertices_in_order(positions: &[DVec3]) -> (Vec<u32>, usize) {
+    let n = positions.len();
+    // At most half full. A slot holds (hash tag << 32 | position index + 1); 0 is empty.
+    let bits = (usize::BITS - (2 * n).max(16).leading_zeros()).min(40);
+    let mask = (1usize << bits) - 1;
+    let mut table = vec![0u64; 1 << bits];
+    let mut merged = Vec::with_capacity(n);
+    let mut next = 0u32;
+    for (i, p) in positions.iter().enumerate() {
+        let key = vertex_key(p);
+        let h = hash_key(&key);
+        let tag = h >> 32;
+        let mut slot = (h as usize) & mask;
+        let id = loop {
+            let s = table[slot];
+            if s == 0 {
+                table[slot] = tag << 32 | (i as u64 + 1);
+                next += 1;
+                break next - 1;
+            }
+            if s >> 32 == tag {
+                let j = (s as u32 - 1) as usize;
+                if vertex_key(&positions[j]) == key {
+                    break merged[j];
+                }
+            }
+            slot = (slot + 1) & mask;
+        };
+        merged.push(id);
+    }
+    (merged, next as usize)
+}
+
+/// A 64-bit mix of a vertex key (high half: the tag [`merge_vertices_in_order`] compares
+/// first; low bits: the slot).
+fn hash_key(k: &[u64; 3]) -> u64 {
+    const M: u64 = 0x9E37_79B9_7F4A_7C15;
+    let mut h = k[0].wrapping_mul(M);
+    h = (h.rotate_left(29) ^ k[1]).wrapping_mul(M);
+    h = (h.rotate_left(29) ^ k[2]).wrapping_mul(M);
+    h ^ (h >> 31)
+}
+
 /// The exact identity of a position: its coordinates' bit patterns, −0 taken as +0.
 pub fn vertex_key(p: &DVec3) -> [u64; 3] {
     [p.x + 0.0, p.y + 0.0, p.z + 0.0].map(f64::to_bits)
@@ -257,6 +304,40 @@ mod tests {
         assert_eq!(d, 2);
         assert_eq!(m[0], m[1]);
         assert_ne!(m[0], m[2]);
+        assert_eq!(merge_vertices_in_order(&p), (vec![0, 0, 1], 2));
+    }
+
+    /// The hash merge finds the classes of the sort merge, numbered by first occurrence, on
+    /// points with many exact repeats (few distinct coordinates, signed zeros, a colliding
+    /// table's worth of values).
+    #[test]
+    fn merge_in_order_has_the_classes_of_the_sorted_merge() {
+        let mut next = crate::load::test_rng(7);
+        for (n, spread) in [(0usize, 1usize), (1, 1), (50, 3), (3000, 5), (20_000, 40)] {
+            let coord = |r: usize| match r % 4 {
+                0 => 0.0,
+                1 => -0.0,
+                _ => (r / 4) as f64 * 0.125 - 1.0,
+            };
+            let p: Vec<DVec3> = (0..n)
+                .map(|_| {
+                    DVec3::new(coord(next(4 * spread)), coord(next(4 * spread)), coord(next(4 * spread)))
+                })
+                .collect();
+            let (sorted, ds) = merge_vertices(&p);
+            let (ordered, dordered) = merge_vertices_in_order(&p);
+            assert_eq!(ds, dordered, "{n}");
+            let mut first = vec![u32::MAX; ds];
+            let mut count = 0u32;
+            for i in 0..n {
+                let s = sorted[i] as usize;
+                if first[s] == u32::MAX {
+                    first[s] = count;
+                    count += 1;
+                }
+                assert_eq!(ordered[i], first[s], "{n} {i}");
+            }
+        }
     }
 
     #[test]

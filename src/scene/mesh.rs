@@ -37,13 +37,25 @@ impl Mesh {
     /// The given triangles (in that order) re-indexed to the vertices they use, numbered in
     /// order of first use, and for each new index the vertex it stands for.
     pub fn reindex(&self, tris: &[u32]) -> (Vec<[u32; 3]>, Vec<u32>) {
-        let mut remap: std::collections::HashMap<u32, u32> = std::collections::HashMap::new();
+        // A table over every vertex when the triangles may use a good share of them (one array
+        // lookup each); a hash map for a few triangles of a large mesh (the table would cost
+        // more to fill than it saves). The numbering is the same either way.
+        self.reindex_by(tris, tris.len().saturating_mul(24) >= self.positions.len())
+    }
+
+    /// [`Mesh::reindex`] with a table (`table`) or a hash map.
+    fn reindex_by(&self, tris: &[u32], table: bool) -> (Vec<[u32; 3]>, Vec<u32>) {
+        let mut remap = if table {
+            Remap::Table(vec![u32::MAX; self.positions.len()])
+        } else {
+            Remap::Map(std::collections::HashMap::new())
+        };
         let mut vmap = Vec::new();
         let triangles = tris
             .iter()
             .map(|&t| {
                 self.triangles[t as usize].map(|v| {
-                    *remap.entry(v).or_insert_with(|| {
+                    remap.get_or_insert(v, || {
                         vmap.push(v);
                         (vmap.len() - 1) as u32
                     })
@@ -114,6 +126,28 @@ impl TriMesh for Mesh {
     }
 }
 
+/// Old vertex index -> new, for [`Mesh::reindex`].
+enum Remap {
+    /// Indexed by the old vertex; `u32::MAX` where not yet numbered.
+    Table(Vec<u32>),
+    Map(std::collections::HashMap<u32, u32>),
+}
+
+impl Remap {
+    fn get_or_insert(&mut self, v: u32, new: impl FnOnce() -> u32) -> u32 {
+        match self {
+            Remap::Table(t) => {
+                let slot = &mut t[v as usize];
+                if *slot == u32::MAX {
+                    *slot = new();
+                }
+                *slot
+            }
+            Remap::Map(m) => *m.entry(v).or_insert_with(new),
+        }
+    }
+}
+
 /// One object of a file: an OBJ `o`/`g` group, an STL `solid`, or a glTF mesh instance
 /// (node × mesh).
 #[derive(Debug, Clone, Default, PartialEq)]
@@ -152,6 +186,29 @@ mod tests {
             triangles: vec![[0, 1, 2]],
             tri_object: vec![0],
             objects: vec![Object { name: "o".into(), ..Object::default() }],
+        }
+    }
+
+    /// Both ways of [`Mesh::reindex`] number the vertices alike, on a random subset and order
+    /// of the triangles of a mesh with unused vertices.
+    #[test]
+    fn reindex_by_table_and_by_map_agree() {
+        let mut next = crate::load::test_rng(3);
+        let n = 400;
+        let m = Mesh {
+            positions: (0..n).map(|i| DVec3::splat(i as f64)).collect(),
+            triangles: (0..600).map(|_| [next(n), next(n), next(n)].map(|v| v as u32)).collect(),
+            tri_object: vec![0; 600],
+            objects: vec![Object { name: "o".into(), ..Object::default() }],
+        };
+        for k in [0usize, 1, 7, 150, 600] {
+            let tris: Vec<u32> = (0..k).map(|_| next(600) as u32).collect();
+            let (table, map) = (m.reindex_by(&tris, true), m.reindex_by(&tris, false));
+            assert_eq!(table, map, "{k}");
+            assert_eq!(m.reindex(&tris), map);
+            for (t, r) in tris.iter().zip(&table.0) {
+                assert_eq!(m.triangles[*t as usize], r.map(|v| table.1[v as usize]));
+            }
         }
     }
 
