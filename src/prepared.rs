@@ -7,6 +7,8 @@
 //! is exactly what a tree built on the world coordinates would give; only the tree statistics
 //! differ (they describe the prepared tree).
 
+pub mod broad;
+
 use crate::bvh::traverse::{MappedTree, Tree};
 use crate::bvh::{BuildOptions, Bvh, Node};
 use crate::check::containment::{self, Containment, Topology};
@@ -33,6 +35,9 @@ pub struct Prepared {
     surface: OnceLock<Option<Surface>>,
     convex: OnceLock<bool>,
     topology: OnceLock<Arc<Topology>>,
+    /// The ball of the mesh's own vertices, and whether their box lies in the tree's root box
+    /// (where a box map's slack covers every vertex).
+    ball: OnceLock<(Ball, bool)>,
 }
 
 impl Prepared {
@@ -47,6 +52,21 @@ impl Prepared {
             surface: OnceLock::new(),
             convex: OnceLock::new(),
             topology: OnceLock::new(),
+            ball: OnceLock::new(),
+        })
+    }
+
+    /// The bounding ball of the mesh in its own coordinates ([`Ball::of_points`]), found once;
+    /// a placement by a box map derives its ball from it ([`Ball::mapped`]).
+    pub fn ball(&self) -> Ball {
+        self.own_ball().0
+    }
+
+    fn own_ball(&self) -> &(Ball, bool) {
+        self.ball.get_or_init(|| {
+            let pos = &self.mesh.positions;
+            let root = Aabb::of_points(pos);
+            (Ball::of_points(pos, &root), self.tree.bounds().contains(&root))
         })
     }
 
@@ -185,6 +205,36 @@ pub struct Ball {
 }
 
 impl Ball {
+    /// The ball of `pos` around the center of their box `root`: the largest f64 distance to
+    /// the center, rounded up by the search margin of the coordinates' scale.
+    pub fn of_points(pos: &[DVec3], root: &Aabb) -> Ball {
+        let center = root.center();
+        let slack = predicates::distance_rounding_slack(root.max_abs());
+        let r = pos.iter().map(|v| (*v - center).length_squared()).fold(0.0f64, f64::max).sqrt();
+        Ball { center, radius: r + slack, slack }
+    }
+
+    /// A ball holding every target vertex of `map` whose source vertex lies in `self` (a ball of
+    /// the source coordinates), `root` the targets' exact box (its scale gives the slack), with
+    /// no pass over the vertices. The center is the f64 image of the source center. Every
+    /// target `w` of a source `p` lies within `map.slack` (per axis) of the exact image
+    /// `R p + t`, and so does the center's f64 image of the exact image of the source center
+    /// (`map.slack` covers that rounding too, see [`BoxMap`]); so
+    /// `|w - center| <= |R (p - c)| + 2 |slack| <= σ(R) r + 2 |slack|`, with `σ(R)` the largest
+    /// singular value of `R`, bounded above by [`singular_bound`]. The sum is rounded up by the
+    /// search margin of the targets' scale (its f64 rounding is a few ulps of it).
+    pub fn mapped(&self, map: &BoxMap, root: &Aabb) -> Ball {
+        let r = map.rows;
+        let center = DVec3::new(
+            r[0][0] * self.center.x + r[0][1] * self.center.y + r[0][2] * self.center.z + r[0][3],
+            r[1][0] * self.center.x + r[1][1] * self.center.y + r[1][2] * self.center.z + r[1][3],
+            r[2][0] * self.center.x + r[2][1] * self.center.y + r[2][2] * self.center.z + r[2][3],
+        );
+        let slack = predicates::distance_rounding_slack(root.max_abs());
+        let radius = singular_bound(&r) * self.radius + 2.0 * map.slack.length() + slack;
+        Ball { center, radius, slack }
+    }
+
     /// A lower bound of the distance between any point of `self` and any point of `o`
     /// (negative when the balls overlap): the f64 distance of the centers less both radii and
     /// the rounding of that distance.
@@ -196,6 +246,27 @@ impl Ball {
     pub fn apart(&self, o: &Ball) -> bool {
         self.gap(o) > 0.0
     }
+}
+
+/// An upper bound of the largest singular value of the linear part of `rows` (the map's 3x3
+/// matrix `R`): the square root of Gershgorin's bound on the largest eigenvalue of `G = RᵀR`,
+/// `max_j Σ_k |G_jk|`. Each f64 entry `Ĝ_jk` (three products, two sums) is within
+/// `γ_3 · H_jk` of `G_jk`, `H_jk = Σ_i |r_ij| |r_ik|` (Higham, §3.1): `4u · H_jk` is added to
+/// every entry; the final sums and the square root round by a few ulps, covered by the factor
+/// `1 + 16u`. 1 (to a few ulps) for a rotation, the largest scale for a scaled rotation.
+fn singular_bound(rows: &[[f64; 4]; 3]) -> f64 {
+    let u = f64::EPSILON / 2.0;
+    let mut worst = 0.0f64;
+    for j in 0..3 {
+        let mut sum = 0.0;
+        for k in 0..3 {
+            let g: f64 = (0..3).map(|i| rows[i][j] * rows[i][k]).sum();
+            let h: f64 = (0..3).map(|i| (rows[i][j] * rows[i][k]).abs()).sum();
+            sum += g.abs() + 4.0 * u * h;
+        }
+        worst = worst.max(sum);
+    }
+    worst.sqrt() * (1.0 + 16.0 * u)
 }
 
 /// A placed mesh as the checks read it (world coordinates; nothing copied).
@@ -286,15 +357,16 @@ impl Placed {
         self.id
     }
 
-    /// The bounding ball of the world vertices ([`Ball`]), found once.
+    /// The bounding ball of the world vertices ([`Ball`]), found once: the prepared mesh's own
+    /// ball for the identity placement, its image ([`Ball::mapped`], no pass over the vertices)
+    /// when the tree is mapped, else the ball of the world vertices.
     pub fn ball(&self) -> Ball {
-        *self.ball.get_or_init(|| {
-            let center = self.root.center();
-            let pos = self.positions();
-            let scale = self.root.min.abs().max(self.root.max.abs()).max_element();
-            let slack = predicates::distance_rounding_slack(scale);
-            let r = pos.iter().map(|v| (*v - center).length_squared()).fold(0.0f64, f64::max).sqrt();
-            Ball { center, radius: r + slack, slack }
+        *self.ball.get_or_init(|| match &self.tree {
+            Mapping::Own => self.prepared.ball(),
+            Mapping::Mapped(map) if self.prepared.own_ball().1 => {
+                self.prepared.ball().mapped(map, &self.root)
+            }
+            Mapping::Mapped(_) | Mapping::Refit(_) => Ball::of_points(self.positions(), &self.root),
         })
     }
 
