@@ -723,22 +723,19 @@ fn filter_map_all<T: Sync, R: Send>(items: &[T], f: impl Fn(&T) -> Option<R> + S
     }
 }
 
-/// Some item for which `f` answers (any: the caller needs only one).
+/// Some item for which `f` answers (any: the caller needs only one). The first
+/// [`SEQUENTIAL_PAIRS`] items are tried on the calling thread (an answer among them costs no
+/// wake-up of the pool), the rest in parallel.
 fn find_any<T: Sync, R: Send>(items: &[T], f: impl Fn(&T) -> Option<R> + Sync + Send) -> Option<R> {
-    if items.len() <= SEQUENTIAL_PAIRS {
-        items.iter().find_map(f)
-    } else {
-        items.par_iter().find_map_any(f)
-    }
+    let (head, rest) = items.split_at(items.len().min(SEQUENTIAL_PAIRS));
+    head.iter().find_map(&f).or_else(|| rest.par_iter().find_map_any(&f))
 }
 
-/// The first item (in order) for which `f` answers.
+/// The first item (in order) for which `f` answers: the first [`SEQUENTIAL_PAIRS`] items on the
+/// calling thread, then the first of the rest, found in parallel.
 fn find_first<T: Sync, R: Send>(items: &[T], f: impl Fn(&T) -> Option<R> + Sync + Send) -> Option<R> {
-    if items.len() <= SEQUENTIAL_PAIRS {
-        items.iter().find_map(f)
-    } else {
-        items.par_iter().find_map_first(f)
-    }
+    let (head, rest) = items.split_at(items.len().min(SEQUENTIAL_PAIRS));
+    head.iter().find_map(&f).or_else(|| rest.par_iter().find_map_first(&f))
 }
 
 /// Exact collision of every candidate pair `(i, j)`, sorted by (i, j); pairs whose boxes or
