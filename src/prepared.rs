@@ -7,6 +7,8 @@
 //! is exactly what a tree built on the world coordinates would give; only the tree statistics
 //! differ (they describe the prepared tree).
 
+pub mod broad;
+
 use crate::bvh::traverse::{MappedTree, Tree};
 use crate::bvh::{BuildOptions, Bvh, Node};
 use crate::check::containment::{self, Containment, Topology};
@@ -33,7 +35,108 @@ pub struct Prepared {
     surface: OnceLock<Option<Surface>>,
     convex: OnceLock<bool>,
     topology: OnceLock<Arc<Topology>>,
+    /// The ball of the mesh's own vertices, and whether their box lies in the tree's root box
+    /// (where a box map's slack covers every vertex).
+    ball: OnceLock<(Ball, bool)>,
+    /// How far rounding may move the vertices before the topology could change ([`Margins`]).
+    margins: OnceLock<Option<Margins>>,
 }
+
+/// How robust a mesh's topology ([`containment::topology`]) is to moving its vertices: lower
+/// bounds of the distance between any two vertices that are not exactly coincident, and of
+/// every height of every triangle whose three vertices are not exactly coincident. `None` when
+/// some such triangle is exactly or nearly collinear (no useful bound).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Margins {
+    /// At most the distance between any two distinct vertices (capped, see
+    /// [`Margins::of`]).
+    pub separation: f64,
+    /// At most every height of every triangle with three distinct vertices.
+    pub height: f64,
+}
+
+impl Margins {
+    /// The margins of `positions` and `triangles`, their exact coincidences `merged` (as
+    /// [`containment::topology`] finds them). Every bound is a lower bound whatever the f64
+    /// rounding:
+    /// * separation: distinct vertices are hashed into a grid of cells of side `c`
+    ///   (`MARGIN_CELL` of the coordinates' scale); pairs in the same or adjacent cells are
+    ///   measured (f64 distance, `4u` relative error at most, lowered by `8u`); two points whose
+    ///   cells are not adjacent differ by more than `c / 2` in some coordinate (the f64 quotient
+    ///   by `c` is off by a few ulps at most), so the result is capped at `c / 2`.
+    /// * height: twice the area over the longest edge, `|(b - a) × (c - a)| / L`; the f64 cross
+    ///   product is within `16u L²` of the exact one (two rounded differences per factor, two
+    ///   products and a difference per component: a few `u` of `L²` each), lowered by that and
+    ///   by `4u` relative for the norm and the quotient.
+    pub fn of(positions: &[DVec3], triangles: &[[u32; 3]], merged: &[u32]) -> Option<Margins> {
+        let u = f64::EPSILON / 2.0;
+        let mut height = f64::INFINITY;
+        for t in triangles {
+            let ids = t.map(|v| merged[v as usize]);
+            if ids[0] == ids[1] || ids[1] == ids[2] || ids[0] == ids[2] {
+                continue;
+            }
+            let [a, b, c] = t.map(|v| positions[v as usize]);
+            let l2 = (b - a).length_squared().max((c - a).length_squared()).max((c - b).length_squared());
+            let cross = (b - a).cross(c - a).length();
+            let area2 = cross * (1.0 - 4.0 * u) - 16.0 * u * l2 * (1.0 + 4.0 * u);
+            let h = area2 / (l2.sqrt() * (1.0 + 4.0 * u)) * (1.0 - 4.0 * u);
+            if h.is_nan() || h <= 0.0 {
+                return None;
+            }
+            height = height.min(h);
+        }
+        let scale = positions.iter().fold(0.0f64, |m, p| m.max(p.abs().max_element()));
+        let cell = scale * MARGIN_CELL;
+        let mut separation = cell * 0.5;
+        if cell <= 0.0 || !cell.is_finite() {
+            return None;
+        }
+        let mut seen = vec![false; merged.iter().map(|&m| m as usize + 1).max().unwrap_or(0)];
+        let mut grid: std::collections::HashMap<[i64; 3], Vec<DVec3>> = std::collections::HashMap::new();
+        for (v, p) in positions.iter().enumerate() {
+            let m = merged[v] as usize;
+            if std::mem::replace(&mut seen[m], true) {
+                continue;
+            }
+            let key = (*p / cell).floor().to_array().map(|x| x as i64);
+            for dx in -1..=1 {
+                for dy in -1..=1 {
+                    for dz in -1..=1 {
+                        if let Some(near) = grid.get(&[key[0] + dx, key[1] + dy, key[2] + dz]) {
+                            for q in near {
+                                separation = separation.min((*p - *q).length() * (1.0 - 8.0 * u));
+                            }
+                        }
+                    }
+                }
+            }
+            grid.entry(key).or_default().push(*p);
+        }
+        Some(Margins { separation, height })
+    }
+
+    /// Certainly the same topology after a placement by `map` (every vertex within `map.slack`
+    /// per axis, so within `δ = |slack|`, of the exact affine image `R p + t`): with `σ_min`,
+    /// `σ_max` bounds of `R`'s extreme singular values, the exact images of two distinct
+    /// vertices are at least `σ_min · separation` apart and stay distinct if that exceeds `2δ`;
+    /// a triangle's exact image has every height at least `σ_min² / σ_max · height` (area
+    /// scales by at least `σ_min²`, edges by at most `σ_max`), and a triangle with every height
+    /// above `5δ` cannot be made collinear by moving each vertex by `δ` (its area, half its
+    /// longest edge `L` times its smallest height, would have to drop by at most
+    /// `2δ (L + δ)`). So exactly coincident vertices, and degenerate triangles, are the same
+    /// before and after: the closedness and components are the same. The tests use `3δ` and
+    /// `6δ` (room for the rounding of the comparison itself).
+    pub fn hold_under(&self, map: &BoxMap) -> bool {
+        let (lo, hi) = singular_bounds(&map.rows);
+        let delta = map.slack.length();
+        lo * self.separation > 3.0 * delta && lo * lo / hi * self.height > 6.0 * delta
+    }
+}
+
+/// The grid cell of [`Margins::of`], relative to the coordinates' scale: a separation below it
+/// is measured, above it only `cell / 2` is claimed (far above the rounding of any placement).
+const MARGIN_CELL: f64 = 1.0 / (1u64 << 20) as f64;
 
 impl Prepared {
     /// Build the tree of `mesh` (validated by [`mesh_from_arrays`] or a loader).
@@ -47,6 +150,29 @@ impl Prepared {
             surface: OnceLock::new(),
             convex: OnceLock::new(),
             topology: OnceLock::new(),
+            ball: OnceLock::new(),
+            margins: OnceLock::new(),
+        })
+    }
+
+    /// The topology's robustness to moving the vertices ([`Margins`]), found once.
+    fn margins(&self) -> Option<&Margins> {
+        self.margins
+            .get_or_init(|| Margins::of(&self.mesh.positions, &self.mesh.triangles, &self.topology().merged))
+            .as_ref()
+    }
+
+    /// The bounding ball of the mesh in its own coordinates ([`Ball::of_points`]), found once;
+    /// a placement by a box map derives its ball from it ([`Ball::mapped`]).
+    pub fn ball(&self) -> Ball {
+        self.own_ball().0
+    }
+
+    fn own_ball(&self) -> &(Ball, bool) {
+        self.ball.get_or_init(|| {
+            let pos = &self.mesh.positions;
+            let root = Aabb::of_points(pos);
+            (Ball::of_points(pos, &root), self.tree.bounds().contains(&root))
         })
     }
 
@@ -185,6 +311,36 @@ pub struct Ball {
 }
 
 impl Ball {
+    /// The ball of `pos` around the center of their box `root`: the largest f64 distance to
+    /// the center, rounded up by the search margin of the coordinates' scale.
+    pub fn of_points(pos: &[DVec3], root: &Aabb) -> Ball {
+        let center = root.center();
+        let slack = predicates::distance_rounding_slack(root.max_abs());
+        let r = pos.iter().map(|v| (*v - center).length_squared()).fold(0.0f64, f64::max).sqrt();
+        Ball { center, radius: r + slack, slack }
+    }
+
+    /// A ball holding every target vertex of `map` whose source vertex lies in `self` (a ball of
+    /// the source coordinates), `root` the targets' exact box (its scale gives the slack), with
+    /// no pass over the vertices. The center is the f64 image of the source center. Every
+    /// target `w` of a source `p` lies within `map.slack` (per axis) of the exact image
+    /// `R p + t`, and so does the center's f64 image of the exact image of the source center
+    /// (`map.slack` covers that rounding too, see [`BoxMap`]); so
+    /// `|w - center| <= |R (p - c)| + 2 |slack| <= σ(R) r + 2 |slack|`, with `σ(R)` the largest
+    /// singular value of `R`, bounded above by [`singular_bounds`]. The sum is rounded up by the
+    /// search margin of the targets' scale (its f64 rounding is a few ulps of it).
+    pub fn mapped(&self, map: &BoxMap, root: &Aabb) -> Ball {
+        let r = map.rows;
+        let center = DVec3::new(
+            r[0][0] * self.center.x + r[0][1] * self.center.y + r[0][2] * self.center.z + r[0][3],
+            r[1][0] * self.center.x + r[1][1] * self.center.y + r[1][2] * self.center.z + r[1][3],
+            r[2][0] * self.center.x + r[2][1] * self.center.y + r[2][2] * self.center.z + r[2][3],
+        );
+        let slack = predicates::distance_rounding_slack(root.max_abs());
+        let radius = singular_bounds(&r).1 * self.radius + 2.0 * map.slack.length() + slack;
+        Ball { center, radius, slack }
+    }
+
     /// A lower bound of the distance between any point of `self` and any point of `o`
     /// (negative when the balls overlap): the f64 distance of the centers less both radii and
     /// the rounding of that distance.
@@ -196,6 +352,33 @@ impl Ball {
     pub fn apart(&self, o: &Ball) -> bool {
         self.gap(o) > 0.0
     }
+}
+
+/// Bounds of the smallest and largest singular values of the linear part of `rows` (the map's
+/// 3x3 matrix `R`): square roots of Gershgorin's bounds on the eigenvalues of `G = RᵀR`,
+/// `min_j (G_jj - Σ_{k≠j} |G_jk|)` and `max_j Σ_k |G_jk|`. Each f64 entry `Ĝ_jk` (three
+/// products, two sums) is within `γ_3 · H_jk` of `G_jk`, `H_jk = Σ_i |r_ij| |r_ik|` (Higham,
+/// §3.1): `4u · H_jk` widens every entry; the final sums and square roots round by a few ulps,
+/// covered by the factors `1 ∓ 16u`. Both 1 (to a few ulps) for a rotation.
+fn singular_bounds(rows: &[[f64; 4]; 3]) -> (f64, f64) {
+    let u = f64::EPSILON / 2.0;
+    let (mut low, mut high) = (f64::INFINITY, 0.0f64);
+    for j in 0..3 {
+        let (mut diag, mut off, mut widen) = (0.0, 0.0, 0.0);
+        for k in 0..3 {
+            let g: f64 = (0..3).map(|i| rows[i][j] * rows[i][k]).sum();
+            let h: f64 = (0..3).map(|i| (rows[i][j] * rows[i][k]).abs()).sum();
+            widen += 4.0 * u * h;
+            if k == j {
+                diag = g;
+            } else {
+                off += g.abs();
+            }
+        }
+        high = high.max(diag.abs() + off + widen);
+        low = low.min(diag - off - widen);
+    }
+    (low.max(0.0).sqrt() * (1.0 - 16.0 * u), high.sqrt() * (1.0 + 16.0 * u))
 }
 
 /// A placed mesh as the checks read it (world coordinates; nothing copied).
@@ -286,15 +469,16 @@ impl Placed {
         self.id
     }
 
-    /// The bounding ball of the world vertices ([`Ball`]), found once.
+    /// The bounding ball of the world vertices ([`Ball`]), found once: the prepared mesh's own
+    /// ball for the identity placement, its image ([`Ball::mapped`], no pass over the vertices)
+    /// when the tree is mapped, else the ball of the world vertices.
     pub fn ball(&self) -> Ball {
-        *self.ball.get_or_init(|| {
-            let center = self.root.center();
-            let pos = self.positions();
-            let scale = self.root.min.abs().max(self.root.max.abs()).max_element();
-            let slack = predicates::distance_rounding_slack(scale);
-            let r = pos.iter().map(|v| (*v - center).length_squared()).fold(0.0f64, f64::max).sqrt();
-            Ball { center, radius: r + slack, slack }
+        *self.ball.get_or_init(|| match &self.tree {
+            Mapping::Own => self.prepared.ball(),
+            Mapping::Mapped(map) if self.prepared.own_ball().1 => {
+                self.prepared.ball().mapped(map, &self.root)
+            }
+            Mapping::Mapped(_) | Mapping::Refit(_) => Ball::of_points(self.positions(), &self.root),
         })
     }
 
@@ -323,11 +507,20 @@ impl Placed {
         })
     }
 
-    /// Closedness and components ([`containment::topology`]): the prepared mesh's when
-    /// [`Placed::translated`], else found on the world coordinates. Found once.
+    /// Closedness and components ([`containment::topology`]): the prepared mesh's for the
+    /// identity placement, for a box-mapped placement whose rounding cannot change them
+    /// ([`Margins::hold_under`]) and when [`Placed::translated`]; else found on the world
+    /// coordinates. Found once.
     fn topology(&self) -> &Topology {
         self.topology.get_or_init(|| {
-            if self.translated() {
+            let kept = match &self.tree {
+                Mapping::Own => true,
+                Mapping::Mapped(map) => {
+                    self.prepared.own_ball().1 && self.prepared.margins().is_some_and(|m| m.hold_under(map))
+                }
+                Mapping::Refit(_) => false,
+            };
+            if kept || self.translated() {
                 self.prepared.topology().clone()
             } else {
                 Arc::new(containment::topology(&self.mesh()))
@@ -488,11 +681,16 @@ pub fn collide(a: &Placed, b: &Placed, all: bool) -> Collision {
         return Collision { contacts, containment: Containment::None };
     }
     // Every vertex of a contained component lies in the other mesh's box: with no vertex of
-    // either mesh in the other's box, no containment is possible (exact test), and the
-    // topology and ray casts are skipped.
+    // either mesh's triangles in the other's box, no containment is possible (exact test), and
+    // the topology and ray casts are skipped. (A vertex no triangle uses belongs to no
+    // component.) The walk visits only the triangles in tree nodes that meet the other box.
     let any_inside = |p: &Placed, q: &Placed| {
-        let bq = q.bounds();
-        p.positions().iter().any(|v| bq.contains(&Aabb { min: *v, max: *v }))
+        let (bq, pos, tris) = (q.bounds(), p.positions(), &p.prepared.mesh.triangles);
+        crate::bvh::traverse::any_in_box(&p.tree(), &bq, |t| {
+            tris[t as usize]
+                .iter()
+                .any(|&v| bq.contains(&Aabb { min: pos[v as usize], max: pos[v as usize] }))
+        })
     };
     if !any_inside(a, b) && !any_inside(b, a) {
         return none;
@@ -701,6 +899,63 @@ mod tests {
                     assert!(!c && d > 0.0);
                 }
             }
+        }
+    }
+
+    /// Under rotations and scalings (box-mapped placements), the prepared topology is taken
+    /// only where rounding cannot change it, and then it is the one found on the world
+    /// coordinates; two vertices a rounding apart, or a sliver, leave the world's to be found.
+    #[test]
+    fn mapped_topology_is_kept_only_where_it_holds() {
+        let same = |p: &Placed| {
+            let (t, fresh) = (p.topology(), containment::topology(&p.mesh()));
+            assert_eq!(
+                (t.closed, &t.component_seeds, &t.component_of),
+                (fresh.closed, &fresh.component_seeds, &fresh.component_of)
+            );
+        };
+        // Two cubes (two components), one open (a face removed).
+        let mut two = cube(DVec3::ZERO);
+        let far = cube(DVec3::new(3.0, 0.5, 0.25));
+        two.triangles.extend(far.triangles.iter().skip(2).map(|t| t.map(|v| v + 8)));
+        two.positions.extend(far.positions);
+        two.tri_object = vec![0; two.triangles.len()];
+        let two = prepared(two);
+        assert!(two.margins().is_some());
+        let mut kept = 0;
+        for k in 0..40 {
+            let a = k as f64 * 0.37;
+            let m = DMat4::from_translation(DVec3::new(a, -2.0 * a, 0.5))
+                * DMat4::from_rotation_x(a)
+                * DMat4::from_rotation_y(1.3 * a)
+                * DMat4::from_scale(DVec3::new(1.0 + a, 1.0, 0.5 + a));
+            let p = two.place(m).unwrap();
+            if let Mapping::Mapped(map) = &p.tree {
+                kept += two.margins().unwrap().hold_under(map) as usize;
+            }
+            same(&p);
+            assert!(!p.topology().closed);
+            assert_eq!(p.topology().component_seeds.len(), 2);
+        }
+        assert!(kept > 30, "{kept}");
+        // A vertex 2^-50 away from another (distinct, but a rotation may merge them) and a
+        // sliver triangle: never kept.
+        let mut near = cube(DVec3::ZERO);
+        near.positions.push(DVec3::new(1.0, 1.0, 1.0 + 2f64.powi(-50)));
+        let near = prepared(near);
+        assert!(near.margins().unwrap().separation <= 2f64.powi(-50));
+        let mut sliver = cube(DVec3::ZERO);
+        sliver.positions.push(DVec3::new(0.5, 0.0, 2f64.powi(-60)));
+        sliver.triangles.push([0, 8, 1]);
+        sliver.tri_object.push(0);
+        assert!(prepared(sliver).margins().is_none());
+        for k in 0..10 {
+            let m = DMat4::from_rotation_z(0.3 + k as f64);
+            let p = near.place(m).unwrap();
+            if let Mapping::Mapped(map) = &p.tree {
+                assert!(!near.margins().unwrap().hold_under(map));
+            }
+            same(&p);
         }
     }
 

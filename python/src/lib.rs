@@ -12,6 +12,7 @@ use meshclash::check::query::{Detail, DistanceError, Mode};
 use meshclash::geom::Aabb;
 use meshclash::pipeline::{Gate, Unit};
 use meshclash::prepared;
+use meshclash::prepared::broad::{self, ObjectTree};
 use meshclash::report::self_report::SelfFailOn;
 use meshclash::Error;
 use numpy::{PyReadonlyArray2, PyUntypedArrayMethods};
@@ -722,22 +723,19 @@ fn filter_map_all<T: Sync, R: Send>(items: &[T], f: impl Fn(&T) -> Option<R> + S
     }
 }
 
-/// Some item for which `f` answers (any: the caller needs only one).
+/// Some item for which `f` answers (any: the caller needs only one). The first
+/// [`SEQUENTIAL_PAIRS`] items are tried on the calling thread (an answer among them costs no
+/// wake-up of the pool), the rest in parallel.
 fn find_any<T: Sync, R: Send>(items: &[T], f: impl Fn(&T) -> Option<R> + Sync + Send) -> Option<R> {
-    if items.len() <= SEQUENTIAL_PAIRS {
-        items.iter().find_map(f)
-    } else {
-        items.par_iter().find_map_any(f)
-    }
+    let (head, rest) = items.split_at(items.len().min(SEQUENTIAL_PAIRS));
+    head.iter().find_map(&f).or_else(|| rest.par_iter().find_map_any(&f))
 }
 
-/// The first item (in order) for which `f` answers.
+/// The first item (in order) for which `f` answers: the first [`SEQUENTIAL_PAIRS`] items on the
+/// calling thread, then the first of the rest, found in parallel.
 fn find_first<T: Sync, R: Send>(items: &[T], f: impl Fn(&T) -> Option<R> + Sync + Send) -> Option<R> {
-    if items.len() <= SEQUENTIAL_PAIRS {
-        items.iter().find_map(f)
-    } else {
-        items.par_iter().find_map_first(f)
-    }
+    let (head, rest) = items.split_at(items.len().min(SEQUENTIAL_PAIRS));
+    head.iter().find_map(&f).or_else(|| rest.par_iter().find_map_first(&f))
 }
 
 /// Exact collision of every candidate pair `(i, j)`, sorted by (i, j); pairs whose boxes or
@@ -816,11 +814,24 @@ fn near(d: prepared::Signed, i: usize, j: usize) -> Near {
     (d.distance, i, j, d.a.0, d.b.0, d.a.1.to_array(), d.b.1.to_array())
 }
 
-/// `candidates`: the pairs whose boxes meet, sorted (only they can collide); `all`: every pair
-/// the query is about (made only when no candidate collides).
+/// Which object pairs a distance query is about.
+#[derive(Debug, Clone, Copy)]
+enum Among {
+    /// Every pair `(i, j)`, `i < j`, of one list (`a` and `b` are the same list).
+    Internal,
+    /// `(k, j)` for every `j != k` of one list.
+    Named(usize),
+    /// Every pair of one object of `a` and one of `b`.
+    Across,
+}
+
+/// `candidates`: the pairs whose boxes meet, sorted (only they can collide); `among`: every pair
+/// the query is about, searched best-first (by [`Placed::gap`]) only when no candidate
+/// collides; `tree`: the tree of `b`'s objects (all of them), when the caller keeps one.
 fn nearest(
     candidates: &[(usize, usize)],
-    all: impl FnOnce() -> Vec<(usize, usize)>,
+    among: Among,
+    tree: Option<&ObjectTree>,
     a: &[Arc<Placed>],
     b: &[Arc<Placed>],
     memo: Memory<'_>,
@@ -885,31 +896,59 @@ fn nearest(
     let key3 = |x: &(f64, usize, usize), y: &(f64, usize, usize)| {
         x.0.total_cmp(&y.0).then((x.1, x.2).cmp(&(y.1, y.2)))
     };
-    let mut by_bound: Vec<(f64, usize, usize)> =
-        all().into_iter().map(|(i, j)| (a[i].gap(&b[j]), i, j)).collect();
-    // Only pairs whose lower bound is at most the smallest bound's true distance can win.
-    let (_, i0, j0) = *by_bound.iter().min_by(|x, y| key3(x, y))?;
-    let cap = signed(i0, j0, f64::INFINITY).map_or(f64::INFINITY, |c| c.distance);
-    by_bound.retain(|x| x.0 <= cap);
-    by_bound.sort_by(key3);
-    // The best (distance, i, j) so far: a pair can only beat it if its (lower bound, i, j)
-    // comes first, so the answer (smallest distance, then smallest (i, j)) does not depend on
-    // the order the threads finish in.
-    let best = Mutex::new((f64::INFINITY, usize::MAX, usize::MAX));
-    let eval = |&(lb, i, j): &(f64, usize, usize)| {
-        let bound = *best.lock().unwrap();
-        if key3(&(lb, i, j), &bound).is_gt() {
-            return None;
+    // Best-first over object pairs by their lower bound: every pair whose bound is at most the
+    // best distance so far is evaluated, so the smallest (distance, i, j) is the answer a scan
+    // of all pairs gives. A node pair's bound (its boxes' distance less the largest search
+    // margin of all objects) is at most the bound of every object pair below it: boxes of
+    // nodes hold their objects' boxes, and each step of the box distance is monotone.
+    let margin = a.iter().chain(b).map(|p| p.ball().slack).fold(0.0f64, f64::max);
+    let boxes = |l: &[Arc<Placed>]| l.iter().map(|p| p.bounds()).collect::<Vec<Aabb>>();
+    let (bb, own_b);
+    let tb = match tree {
+        Some(t) => t,
+        None => {
+            bb = boxes(b);
+            own_b = ObjectTree::build(&bb, (0..b.len()).collect());
+            &own_b
         }
-        let c = signed(i, j, bound.0)?;
-        let mut g = best.lock().unwrap();
-        if key3(&(c.distance, i, j), &g).is_lt() {
-            *g = (c.distance, i, j);
-        }
-        Some(near(c, i, j))
     };
-    let found = filter_map_all(&by_bound, eval);
-    found.into_iter().min_by(|x, y| key3(&(x.0, x.1, x.2), &(y.0, y.1, y.2)))
+    let own_a;
+    let (ta, same) = match among {
+        Among::Internal => (tb, true),
+        Among::Named(k) => {
+            own_a = ObjectTree::build(&boxes(a), vec![k]);
+            (&own_a, false)
+        }
+        Among::Across => {
+            own_a = ObjectTree::build(&boxes(a), (0..a.len()).collect());
+            (&own_a, false)
+        }
+    };
+    let mut best = (f64::INFINITY, usize::MAX, usize::MAX);
+    let mut found = None;
+    broad::best_first(
+        ta,
+        tb,
+        same,
+        |x, y| x.distance_sq(y).sqrt() - margin,
+        |i, j| {
+            if matches!(among, Among::Named(k) if j == k) {
+                return best.0;
+            }
+            let lb = a[i].gap(&b[j]);
+            if key3(&(lb, i, j), &best).is_gt() {
+                return best.0;
+            }
+            if let Some(c) = signed(i, j, best.0) {
+                if key3(&(c.distance, i, j), &best).is_lt() {
+                    best = (c.distance, i, j);
+                    found = Some(near(c, i, j));
+                }
+            }
+            best.0
+        },
+    );
+    found
 }
 
 /// A sweep-and-prune broad phase over the objects' world boxes, kept across queries: the
@@ -918,6 +957,9 @@ fn nearest(
 struct Sweep {
     /// (box min x, object index), ascending.
     order: Vec<(f64, usize)>,
+    /// At least the x extent of every box inserted so far (never lowered: an upper bound is
+    /// all [`Sweep::against`] needs).
+    widest: f64,
 }
 
 impl Sweep {
@@ -925,6 +967,7 @@ impl Sweep {
         let k = (b.min.x, i);
         let at = self.order.partition_point(|x| x.0.total_cmp(&k.0).then(x.1.cmp(&k.1)).is_lt());
         self.order.insert(at, k);
+        self.widest = self.widest.max(b.max.x - b.min.x);
     }
     fn remove(&mut self, i: usize, b: &Aabb) {
         let k = (b.min.x, i);
@@ -957,11 +1000,19 @@ impl Sweep {
         out.sort_unstable();
         out
     }
-    /// The objects whose boxes meet `q`, ascending.
+    /// The objects whose boxes meet `q`, ascending: those whose lower x lies in
+    /// `[q.min.x - 2 widest, q.max.x]` are looked at (a box that meets `q` has its upper x at
+    /// least `q.min.x`, and its lower x within its width of it; twice the widest width leaves
+    /// room for the rounding of the subtractions).
     fn against(&self, objs: &[Arc<Placed>], q: &Aabb) -> Vec<usize> {
+        let from = q.min.x - 2.0 * self.widest;
+        let start = self.order.partition_point(|x| x.0 < from);
         let end = self.order.partition_point(|x| x.0 <= q.max.x);
-        let mut out: Vec<usize> =
-            self.order[..end].iter().map(|x| x.1).filter(|&i| objs[i].bounds().overlaps(q)).collect();
+        let mut out: Vec<usize> = self.order[start..end.max(start)]
+            .iter()
+            .map(|x| x.1)
+            .filter(|&i| objs[i].bounds().overlaps(q))
+            .collect();
         out.sort_unstable();
         out
     }
@@ -981,6 +1032,9 @@ struct Manager {
     pairs: Mutex<Option<Vec<(usize, usize)>>>,
     /// Pair answers kept across queries ([`Memo`]).
     memo: Mutex<Memo>,
+    /// The tree over every object's box, built by the first distance query that needs it after
+    /// an object was placed or removed.
+    tree: Mutex<Option<Arc<ObjectTree>>>,
 }
 
 impl Manager {
@@ -999,8 +1053,19 @@ impl Manager {
         self.placed(i);
     }
 
+    /// The tree over every object's box (kept until an object is placed or removed).
+    fn object_tree(&self) -> Arc<ObjectTree> {
+        let mut kept = self.tree.lock().unwrap();
+        kept.get_or_insert_with(|| {
+            let boxes: Vec<Aabb> = self.objs.iter().map(|p| p.bounds()).collect();
+            Arc::new(ObjectTree::build(&boxes, (0..boxes.len()).collect()))
+        })
+        .clone()
+    }
+
     /// Object `i` was placed anew (added or moved): its candidate pairs are found again.
     fn placed(&mut self, i: usize) {
+        *self.tree.get_mut().unwrap() = None;
         let Some(pairs) = self.pairs.get_mut().unwrap().as_mut() else { return };
         pairs.retain(|&(x, y)| x != i && y != i);
         let with = self.sweep.against(&self.objs, &self.objs[i].bounds());
@@ -1068,6 +1133,7 @@ impl Manager {
         self.sweep.renumber_after(i);
         self.memo.get_mut().unwrap().forget(self.objs[i].id());
         *self.pairs.get_mut().unwrap() = None;
+        *self.tree.get_mut().unwrap() = None;
         self.names.remove(i);
         self.objs.remove(i);
         self.index = self.names.iter().enumerate().map(|(k, n)| (n.clone(), k)).collect();
@@ -1130,7 +1196,6 @@ impl Manager {
     #[pyo3(signature = (name=None))]
     fn distance_internal(&self, py: Python<'_>, name: Option<String>) -> PyResult<Option<NamedNear>> {
         let objs = &self.objs;
-        let n = objs.len();
         let k = name.as_deref().map(|n| self.find(n)).transpose()?;
         let mut candidates = self.candidate_pairs();
         if let Some(k) = k {
@@ -1143,14 +1208,9 @@ impl Manager {
             }
             candidates.sort_unstable();
         }
-        let all = || -> Vec<(usize, usize)> {
-            match k {
-                None => (0..n).flat_map(|i| (i + 1..n).map(move |j| (i, j))).collect(),
-                Some(k) => (0..n).filter(|&j| j != k).map(|j| (k, j)).collect(),
-            }
-        };
-        let memo = &self.memo;
-        let near = py.detach(|| nearest(&candidates, all, objs, objs, Memory(Some(memo))));
+        let among = k.map_or(Among::Internal, Among::Named);
+        let (tree, memo) = (self.object_tree(), &self.memo);
+        let near = py.detach(|| nearest(&candidates, among, Some(&tree), objs, objs, Memory(Some(memo))));
         Ok(near.map(|(d, i, j, fi, fj, pi, pj)| {
             (d, self.names[i].clone(), self.names[j].clone(), fi, fj, pi, pj)
         }))
@@ -1159,9 +1219,9 @@ impl Manager {
     fn distance_other(&self, py: Python<'_>, other: PyRef<'_, Manager>) -> Option<NamedNear> {
         let (a, b) = (&self.objs, &other.objs);
         let candidates = self.pairs_with(b);
-        let all = || (0..a.len()).flat_map(|i| (0..b.len()).map(move |j| (i, j))).collect();
         let memo = &self.memo;
-        let near = py.detach(|| nearest(&candidates, all, a, b, Memory(Some(memo))));
+        let tree = other.object_tree();
+        let near = py.detach(|| nearest(&candidates, Among::Across, Some(&tree), a, b, Memory(Some(memo))));
         near.map(|(d, i, j, fi, fj, pi, pj)| {
             (d, self.names[i].clone(), other.names[j].clone(), fi, fj, pi, pj)
         })
@@ -1177,8 +1237,7 @@ impl Manager {
         let single = vec![place(py, &mesh.inner, transform_of(transform)?)?];
         let a = &self.objs;
         let candidates = self.pairs_with(&single);
-        let all = || (0..a.len()).map(|i| (i, 0)).collect();
-        let near = py.detach(|| nearest(&candidates, all, a, &single, Memory(None)));
+        let near = py.detach(|| nearest(&candidates, Among::Across, None, a, &single, Memory(None)));
         Ok(near.map(|(d, i, _, fi, fj, pi, pj)| (d, self.names[i].clone(), fi, fj, pi, pj)))
     }
 }

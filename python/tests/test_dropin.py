@@ -152,6 +152,20 @@ def test_stubs_type_check_the_common_calls(tmp_path):
     assert p.returncode == 1 and f"snippet.py:{line}: error: Incompatible types" in p.stdout, p.stdout
 
 
+def test_stubs_type_check_under_pyright(tmp_path):
+    if importlib.util.find_spec("pyright") is None:
+        pytest.skip("pyright is not installed")
+    src = tmp_path / "snippet.py"
+    src.write_text(textwrap.dedent(SNIPPET))
+    run = [sys.executable, "-m", "pyright", "--pythonpath", sys.executable, str(src)]
+    p = subprocess.run(run, capture_output=True, text=True, cwd=tmp_path)
+    assert p.returncode == 0, p.stdout + p.stderr
+    src.write_text(textwrap.dedent(SNIPPET) + "wrong: bool = m.in_collision_internal(return_names=True)\n")
+    p = subprocess.run(run, capture_output=True, text=True, cwd=tmp_path)
+    line = len(textwrap.dedent(SNIPPET).splitlines()) + 1
+    assert p.returncode == 1 and f"snippet.py:{line}:" in p.stdout, p.stdout
+
+
 LIMITED = """
 import resource, sys
 import numpy as np
