@@ -35,7 +35,7 @@ if [ ! -x "$venv/bin/python" ]; then
     "$py" -m venv "$venv"
 fi
 "$venv/bin/python" -m pip install --quiet --upgrade pip
-"$venv/bin/python" -m pip install --quiet maturin numpy pytest trimesh python-fcl scipy networkx lxml pillow mypy
+"$venv/bin/python" -m pip install --quiet maturin numpy pytest trimesh python-fcl scipy networkx lxml pillow mypy pyright
 # The one install command (from the repository root), without build isolation (the venv's
 # maturin, found on PATH), the extension in $profile.
 cd "$repo"
