@@ -110,6 +110,14 @@ impl ExactBox {
         (0..3).all(|k| self.inner[k].0 <= v[k] && v[k] <= self.inner[k].1)
     }
 
+    /// True if every point of `b` is strictly inside the box: no point known to lie in `b`
+    /// can move a bound, so its exact coordinates are not needed. `b` holds f64 bounds that
+    /// enclose the candidate points exactly (no rounding is involved: the boxes of a segment
+    /// and of a triangle, both of which contain their crossing point).
+    fn strictly_contains(&self, b: &Aabb) -> bool {
+        (0..3).all(|k| self.inner[k].0 <= b.min[k] && b.max[k] <= self.inner[k].1)
+    }
+
     fn finish(&self) -> Option<Overlap> {
         let base = self.frame.base();
         let bound = |r: &Option<Ratio>| r.as_ref().map(|r| r.round(base));
@@ -266,6 +274,11 @@ where
 }
 
 /// The points where the edges of `m` meet the faces of `other` (tree `tree`).
+///
+/// Every such point lies on its edge and in its triangle, so inside the f64 boxes of both: an
+/// edge (or an edge–triangle pair) whose box lies strictly inside the box found so far cannot
+/// move it and is skipped without a tree walk (or without exact arithmetic). The skipped
+/// points would not have changed any bound, so the box is the same; only work is saved.
 fn edges_against<M, O, T>(acc: &mut ExactBox, m: &M, other: &O, tree: &T)
 where
     M: TriMesh + ?Sized,
@@ -276,12 +289,14 @@ where
     for (i, j) in edges(m) {
         let (p, q) = (m.vertex(i), m.vertex(j));
         let seg = Aabb { min: p.min(q), max: p.max(q) };
-        if !seg.overlaps(&other_box) {
+        if !seg.overlaps(&other_box) || acc.strictly_contains(&seg) {
             continue;
         }
         traverse::any_in_box(tree, &seg, |t| {
             let tri = other.triangle(t);
-            if !Shape::of(&tri).is_degenerate() {
+            let tb = Aabb::of_triangle(&tri);
+            let common = Aabb { min: seg.min.max(tb.min), max: seg.max.min(tb.max) };
+            if !acc.strictly_contains(&common) && !Shape::of(&tri).is_degenerate() {
                 edge_face(acc, p, q, tri);
             }
             false
