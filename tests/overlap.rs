@@ -296,8 +296,8 @@ fn nested_touching_and_clear_pairs() {
     let dir = tempfile::tempdir().unwrap();
     let outer = grid_box([0.0; 3], [4.0; 3], 3);
     // Nested: A ∩ B is the inner part (a clash by containment). Scene mode lists the part
-    // pair; two single-part files report the containment in `summary.contained` alone, with
-    // no part pair to carry a box.
+    // pair and its box; two single-part files have no part pair (no triangles meet) and
+    // report the containment in `summary.contained` with the box in `summary.overlap`.
     let inner = prism([2.0, 2.0], 1.0, 6, 1.0, 3.0, 2);
     let want = oracle(&outer, &inner).unwrap();
     for (x, y) in [(&outer, &inner), (&inner, &outer)] {
@@ -306,7 +306,27 @@ fn nested_touching_and_clear_pairs() {
         let r = run(Request::scene(&ps));
         let o = r.part_pairs[0].overlap.clone().expect("nested parts clash");
         assert_matches(&o, &want, "nested");
+        assert_eq!(r.summary.overlap, None, "scene mode: the part pair carries the box");
+        let (pa, pb) = (dir.path().join("x.obj"), dir.path().join("y.obj"));
+        std::fs::write(&pa, x.obj("X", 0)).unwrap();
+        std::fs::write(&pb, y.obj("Y", 0)).unwrap();
+        let f = run(Request::files(&pa, &pb));
+        assert_eq!(f.verdict, meshclash::report::ReportVerdict::Clash);
+        assert!(f.summary.contained.is_some() && f.part_pairs.is_empty());
+        let fo = f.summary.overlap.clone().expect("two nested single-part files get the box");
+        assert_matches(&fo, &want, "nested files");
+        assert_eq!(fo, o, "two-file and scene mode agree");
     }
+    // Two files of one part each that meet: the part pair carries the box, the summary none.
+    let crossing = grid_box([3.0, 1.0, 1.0], [5.0, 2.0, 2.0], 1);
+    let (pa, pb) = (dir.path().join("x.obj"), dir.path().join("y.obj"));
+    std::fs::write(&pa, outer.obj("X", 0)).unwrap();
+    std::fs::write(&pb, crossing.obj("Y", 0)).unwrap();
+    let f = run(Request::files(&pa, &pb));
+    assert!(f.part_pairs[0].overlap.is_some());
+    assert_eq!(f.summary.overlap, None);
+    let json = serde_json::to_string(&f.summary).unwrap();
+    assert!(!json.contains("overlap"), "absent, not null: {json}");
     // Touching face to face is not a clash: no box. Apart: no pair at all.
     let side = grid_box([4.0, 1.0, 1.0], [5.0, 2.0, 2.0], 1);
     assert_eq!(overlap_of(dir.path(), &outer, &side), None);

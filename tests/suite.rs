@@ -30,6 +30,8 @@ mod cli_subcommands;
 mod common;
 #[path = "contract.rs"]
 mod contract;
+#[path = "convex_penetration.rs"]
+mod convex_penetration;
 #[path = "docs_commands.rs"]
 mod docs_commands;
 #[path = "exactness.rs"]

@@ -110,6 +110,14 @@ impl ExactBox {
         (0..3).all(|k| self.inner[k].0 <= v[k] && v[k] <= self.inner[k].1)
     }
 
+    /// True if every point of `b` is strictly inside the box: no point known to lie in `b`
+    /// can move a bound, so its exact coordinates are not needed. `b` holds f64 bounds that
+    /// enclose the candidate points exactly (no rounding is involved: the boxes of a segment
+    /// and of a triangle, both of which contain their crossing point).
+    fn strictly_contains(&self, b: &Aabb) -> bool {
+        (0..3).all(|k| self.inner[k].0 <= b.min[k] && b.max[k] <= self.inner[k].1)
+    }
+
     fn finish(&self) -> Option<Overlap> {
         let base = self.frame.base();
         let bound = |r: &Option<Ratio>| r.as_ref().map(|r| r.round(base));
@@ -123,11 +131,17 @@ impl ExactBox {
     }
 }
 
-/// The undirected edges (vertex index pairs) of the proper triangles of `m`.
-fn edges<M: TriMesh + ?Sized>(m: &M) -> Vec<(u32, u32)> {
+/// Per triangle of `m`: is it proper (not degenerate)? Decided once per box.
+fn proper<M: TriMesh + ?Sized>(m: &M) -> Vec<bool> {
+    (0..m.triangle_count() as u32).map(|t| !Shape::of(&m.triangle(t)).is_degenerate()).collect()
+}
+
+/// The undirected edges (vertex index pairs) of the proper triangles of `m` (`proper` from
+/// [`proper`]).
+fn edges<M: TriMesh + ?Sized>(m: &M, proper: &[bool]) -> Vec<(u32, u32)> {
     let mut out = Vec::with_capacity(m.triangle_count() * 3);
     for t in 0..m.triangle_count() as u32 {
-        if Shape::of(&m.triangle(t)).is_degenerate() {
+        if !proper[t as usize] {
             continue;
         }
         let v = m.indices(t);
@@ -258,30 +272,38 @@ where
     }
     let frame = Frame::of_points(a.positions().iter().chain(b.positions().iter()));
     let mut acc = ExactBox::new(frame);
-    edges_against(&mut acc, a, b, tb);
-    edges_against(&mut acc, b, a, ta);
-    vertices_inside(&mut acc, a, b, tb)?;
-    vertices_inside(&mut acc, b, a, ta)?;
+    let (pa, pb) = (proper(a), proper(b));
+    edges_against(&mut acc, (a, &pa), (b, &pb), tb);
+    edges_against(&mut acc, (b, &pb), (a, &pa), ta);
+    vertices_inside(&mut acc, (a, &pa), b, tb)?;
+    vertices_inside(&mut acc, (b, &pb), a, ta)?;
     acc.finish()
 }
 
 /// The points where the edges of `m` meet the faces of `other` (tree `tree`).
-fn edges_against<M, O, T>(acc: &mut ExactBox, m: &M, other: &O, tree: &T)
+///
+/// Every such point lies on its edge and in its triangle, so inside the f64 boxes of both: an
+/// edge (or an edge–triangle pair) whose box lies strictly inside the box found so far cannot
+/// move it and is skipped without a tree walk (or without exact arithmetic). The skipped
+/// points would not have changed any bound, so the box is the same; only work is saved.
+fn edges_against<M, O, T>(acc: &mut ExactBox, (m, pm): (&M, &[bool]), (other, po): (&O, &[bool]), tree: &T)
 where
     M: TriMesh + ?Sized,
     O: TriMesh + ?Sized,
     T: Tree + ?Sized,
 {
     let other_box = tree.root_box();
-    for (i, j) in edges(m) {
+    for (i, j) in edges(m, pm) {
         let (p, q) = (m.vertex(i), m.vertex(j));
         let seg = Aabb { min: p.min(q), max: p.max(q) };
-        if !seg.overlaps(&other_box) {
+        if !seg.overlaps(&other_box) || acc.strictly_contains(&seg) {
             continue;
         }
         traverse::any_in_box(tree, &seg, |t| {
             let tri = other.triangle(t);
-            if !Shape::of(&tri).is_degenerate() {
+            let tb = Aabb::of_triangle(&tri);
+            let common = Aabb { min: seg.min.max(tb.min), max: seg.max.min(tb.max) };
+            if po[t as usize] && !acc.strictly_contains(&common) {
                 edge_face(acc, p, q, tri);
             }
             false
@@ -291,7 +313,7 @@ where
 
 /// The vertices of `m` (of its proper triangles) inside or on `other`; None when one cannot be
 /// decided.
-fn vertices_inside<M, O, T>(acc: &mut ExactBox, m: &M, other: &O, tree: &T) -> Option<()>
+fn vertices_inside<M, O, T>(acc: &mut ExactBox, (m, pm): (&M, &[bool]), other: &O, tree: &T) -> Option<()>
 where
     M: TriMesh + ?Sized,
     O: TriMesh + ?Sized,
@@ -299,7 +321,7 @@ where
 {
     let mut used = vec![false; m.vertex_count()];
     for t in 0..m.triangle_count() as u32 {
-        if !Shape::of(&m.triangle(t)).is_degenerate() {
+        if pm[t as usize] {
             m.indices(t).iter().for_each(|&v| used[v as usize] = true);
         }
     }

@@ -24,6 +24,7 @@
 //! vertex on or below every face's plane (exact orientation signs), with positive volume.
 
 mod dyadic;
+pub mod parts;
 
 use crate::geom::predicates::{
     self, FILTER_UNDERFLOW_ALLOWANCE, ORIENT2D_FILTER_BOUND, ORIENT3D_FILTER_BOUND,

@@ -154,6 +154,9 @@ pub fn export(
         let size = rep.settings.model_size * to_m;
         let radius = ((hi - lo).length() * 0.75).max(size * 0.01).max(1e-6);
         let measure = match (r0.penetration, r0.distance) {
+            (Some(p), _) if r0.penetration_exact => {
+                format!(", penetration {} {units} (exact, convex)", crate::output::text::num(p))
+            }
             (Some(p), _) => format!(", penetration at least {} {units}", crate::output::text::num(p)),
             (None, Some(d)) if d > 0.0 => format!(", distance {} {units}", crate::output::text::num(d)),
             _ => String::new(),

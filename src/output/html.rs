@@ -69,6 +69,10 @@ pub struct Row {
     pub distance: Option<f64>,
     /// Penetration estimate, when computed.
     pub penetration: Option<f64>,
+    /// The penetration depth is exact (both objects convex: `method: "exact_convex"`); absent
+    /// for a sampled lower bound.
+    #[serde(skip_serializing_if = "std::ops::Not::not")]
+    pub penetration_exact: bool,
     /// Extent of the exact overlap box of the two parts (clashing closed parts; a region only
     /// when it is its part pair's only region), else absent.
     #[serde(skip_serializing_if = "Option::is_none")]
@@ -217,6 +221,7 @@ pub fn clashes(rep: &Report, result: &ClashResult, a: &Mesh, b: &Mesh) -> Clashe
             crossing: g.crossing as u64,
             distance,
             penetration: gr.penetration.as_ref().map(|p| p.depth),
+            penetration_exact: gr.penetration.as_ref().is_some_and(|p| p.is_exact()),
             overlap: gr.overlap.as_ref().map(|o| o.extent),
             status,
             bounds: [rel(g.bounds.min), rel(g.bounds.max)],
@@ -269,6 +274,7 @@ pub fn clashes(rep: &Report, result: &ClashResult, a: &Mesh, b: &Mesh) -> Clashe
             crossing: pp.crossing_pairs,
             distance: pp.min_distance,
             penetration: None,
+            penetration_exact: false,
             overlap: pp.overlap.as_ref().map(|o| o.extent),
             status: None,
             bounds,
@@ -303,6 +309,7 @@ pub fn clashes(rep: &Report, result: &ClashResult, a: &Mesh, b: &Mesh) -> Clashe
                 crossing: 0,
                 distance: Some(c.distance),
                 penetration: None,
+                penetration_exact: false,
                 overlap: None,
                 status: None,
                 bounds: [rel(p.min(q)), rel(p.max(q))],
@@ -508,6 +515,7 @@ pub fn export_self(rep: &SelfReport, mesh: &Mesh, z_up: bool) -> String {
             crossing: f.crossing,
             distance: is_clash.then_some(0.0),
             penetration: None,
+            penetration_exact: false,
             overlap: None,
             status: None,
             bounds,

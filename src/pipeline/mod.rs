@@ -458,10 +458,17 @@ pub struct Outcome {
     pub cross_check: Option<CrossCheckReport>,
     /// Connected interferences (with penetration estimates when asked).
     pub regions: Vec<crate::check::regions::Region>,
+    /// With `--penetration`, per region (same order): the exact penetration depth of its two
+    /// objects when both are closed and exactly convex and they meet
+    /// ([`crate::narrow::convex::parts`]); empty without `--penetration`.
+    pub convex_penetrations: Vec<Option<crate::narrow::convex::Penetration>>,
     /// The exact box of A ∩ B per part pair (same order as `assembly.part_pairs`): for each pair
     /// whose verdict is clash and whose two parts are closed ([`crate::check::overlap`]); None
     /// for the others.
     pub overlaps: Vec<Option<crate::check::overlap::Overlap>>,
+    /// Two files of one closed part each, clashing by containment with no clashing part pair:
+    /// the exact box of A ∩ B ([`files_overlap`]); None otherwise.
+    pub files_overlap: Option<crate::check::overlap::Overlap>,
     /// Indices into `assembly.result.pairs` of the pairs the report lists: all of them, or when
     /// there are more than `max_pairs`, the worst (crossing, then touching, then within the
     /// touch tolerance, then clearance by distance), sorted by (a, b).
@@ -644,7 +651,19 @@ pub fn run(req: &Request, progress: &(dyn Fn(Phase) + Sync)) -> Result<Outcome> 
         let opts = BuildOptions::default();
         crate::check::regions::estimate_penetration(&mut regions, &result.pairs, &a.mesh, &b.mesh, opts);
     }
+    let convex_penetrations = if req.penetration && !settings.first_hit {
+        let objects: Vec<(u32, u32)> = regions.iter().map(|g| g.objects).collect();
+        crate::narrow::convex::parts::object_pair_penetrations(
+            &a.mesh,
+            &b.mesh,
+            req.selection.scene,
+            &objects,
+        )
+    } else {
+        Vec::new()
+    };
     let overlaps = overlaps(&outcome, &a.mesh, &b.mesh, req.selection.scene, req.settings.bvh);
+    let files_overlap = files_overlap(&outcome, &a.mesh, &b.mesh, req.selection.scene, req.settings.bvh);
     let listed = listed_pairs(&result.pairs, req.max_pairs);
     let cut = listed.len() < result.pairs.len();
     // Every finding's id when the list is cut (the report records the unlisted ones) or a
@@ -697,7 +716,9 @@ pub fn run(req: &Request, progress: &(dyn Fn(Phase) + Sync)) -> Result<Outcome> 
         settings: settings_report,
         cross_check,
         regions,
+        convex_penetrations,
         overlaps,
+        files_overlap,
         listed,
         listed_ids,
         unlisted,
@@ -756,6 +777,37 @@ fn overlaps(
             crate::check::overlap::overlap_box(ma, ta, mb, tb)
         })
         .collect()
+}
+
+/// The exact box of A ∩ B in two-file mode when each file is one part, both closed, and they
+/// clash by containment (one inside the other, or volumes overlapping through coincident faces)
+/// while no part pair is a clash to carry the box (a single part per file gets no part pair
+/// for a containment without meeting triangles); None otherwise.
+fn files_overlap(
+    o: &assembly::Outcome,
+    a: &Mesh,
+    b: &Mesh,
+    scene: bool,
+    opts: BuildOptions,
+) -> Option<crate::check::overlap::Overlap> {
+    let clashing_pair = o.part_pairs.iter().any(|pp| pp.verdict == query::Verdict::Clash);
+    if scene || clashing_pair || !o.result.containment.is_clash() {
+        return None;
+    }
+    let [pa, pb] = o.parts.as_slice() else { return None };
+    if (pa.input, pb.input) != (0, 1) {
+        return None;
+    }
+    let solid = |m: &Mesh, part: &assembly::Part| {
+        let mesh = m.sub_mesh(&part.triangles);
+        crate::check::containment::topology(&mesh).closed.then(|| {
+            let tree = crate::bvh::Bvh::build(&mesh, opts);
+            (mesh, tree)
+        })
+    };
+    let (sa, sb) = rayon::join(|| solid(a, pa), || solid(b, pb));
+    let ((ma, ta), (mb, tb)) = (sa?, sb?);
+    crate::check::overlap::overlap_box(&ma, &ta, &mb, &tb)
 }
 
 /// Read a baseline report: a regular file of bounded size (never blocking on a FIFO), parsed

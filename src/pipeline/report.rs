@@ -101,6 +101,7 @@ pub fn build(o: &Outcome) -> Report {
                 crate::check::containment::Containment::Undecided(why) => Some(why.clone()),
                 _ => None,
             },
+            overlap: o.files_overlap.as_ref().map(OverlapReport::of),
         },
         closest: r.closest.map(|c| ClosestReport {
             distance: c.distance,
@@ -119,7 +120,8 @@ pub fn build(o: &Outcome) -> Report {
             .regions
             .iter()
             .zip(region_overlap)
-            .map(|(g, overlap)| RegionReport {
+            .enumerate()
+            .map(|(i, (g, overlap))| RegionReport {
                 a_name: ia.input.mesh.objects[g.objects.0 as usize].name.clone(),
                 b_name: ib.input.mesh.objects[g.objects.1 as usize].name.clone(),
                 id: g.id.clone(),
@@ -130,11 +132,16 @@ pub fn build(o: &Outcome) -> Report {
                 center: v3(g.center),
                 bounds: Bounds { min: v3(g.bounds.min), max: v3(g.bounds.max) },
                 extent: g.extent,
-                penetration: g.penetration.map(|p| PenetrationReport {
-                    depth: p.depth,
-                    point: v3(p.point),
-                    side: if p.side == 0 { "a_in_b" } else { "b_in_a" }.to_string(),
-                    samples: p.samples,
+                penetration: g.penetration.map(|p| match o.convex_penetrations.get(i).copied().flatten() {
+                    Some(c) => exact_convex(&c),
+                    None => PenetrationReport {
+                        depth: p.depth,
+                        point: v3(p.point),
+                        side: if p.side == 0 { "a_in_b" } else { "b_in_a" }.to_string(),
+                        samples: p.samples,
+                        method: None,
+                        direction: None,
+                    },
                 }),
                 overlap,
             })
@@ -149,6 +156,19 @@ pub fn build(o: &Outcome) -> Report {
         baseline: o.comparison.as_ref().map(|c| c.block.clone()),
         self_check: o.self_check.clone(),
         cache: o.cache.clone(),
+    }
+}
+
+/// The penetration block of an exact convex depth ([`crate::narrow::convex::penetration`]).
+fn exact_convex(p: &crate::narrow::convex::Penetration) -> PenetrationReport {
+    use crate::narrow::convex::Axis;
+    PenetrationReport {
+        depth: p.depth,
+        point: v3(p.point),
+        side: if matches!(p.axis, Axis::FaceA(_)) { "b_in_a" } else { "a_in_b" }.to_string(),
+        samples: 0,
+        method: Some(PenetrationReport::EXACT_CONVEX.to_string()),
+        direction: Some(v3(p.normal)),
     }
 }
 

@@ -326,20 +326,47 @@ pub struct UnlistedFindings {
 }
 
 /// How deep one part reaches into the other at a region.
+///
+/// Two methods: without `method` (the sampled estimate), `depth` is the largest distance from a
+/// sampled point of one part's surface (vertices near the region, the region's triangles'
+/// centroids and edge midpoints), inside the other (closed) part, to the other's surface: a
+/// lower bound on the local interpenetration, 0 when none is. With `method: "exact_convex"`
+/// (both objects closed and exactly convex), `depth` is the exact penetration depth of the two
+/// objects: the length of the shortest translation that separates them, by the separating-axis
+/// theorem with the deepest axis chosen in exact arithmetic (`crate::narrow::convex`) and the
+/// depth along it evaluated in f64 (within a few ulps of the coordinate scale).
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize, schemars::JsonSchema)]
 #[serde(deny_unknown_fields)]
 pub struct PenetrationReport {
-    /// Largest distance from a sampled point of one part's surface (vertices near the region,
-    /// the region's triangles' centroids and edge midpoints), inside the other (closed) part,
-    /// to the other's surface: a lower bound on the local interpenetration; 0 when none is.
+    /// The depth: a sampled lower bound, or with `method: "exact_convex"` the exact minimum
+    /// separating translation of the two objects (0 when they only touch).
     pub depth: f64,
-    /// That point (the region's centre when `depth` is 0).
+    /// Sampled: the deepest sampled point (the region's centre when `depth` is 0). Exact: the
+    /// deepest point of the penetrating vertex or edge moved back by half the depth.
     pub point: [f64; 3],
-    /// `a_in_b` (a point of A's surface inside B) or `b_in_a`.
+    /// `a_in_b` (a point of A's surface inside B) or `b_in_a`. Exact: `b_in_a` when the
+    /// separating axis is a face normal of A (B's deepest vertex is inside A), else `a_in_b`.
     pub side: String,
     /// Points found inside the other part and measured (sampled: at most about 2048 per
-    /// region and side).
+    /// region and side); 0 with `method: "exact_convex"` (nothing is sampled).
     pub samples: usize,
+    /// `exact_convex` when the depth is exact; absent for the sampled estimate.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub method: Option<String>,
+    /// With `method: "exact_convex"`: the unit direction in which moving B by `depth` (or A by
+    /// `-depth`) separates the two objects; absent otherwise.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub direction: Option<[f64; 3]>,
+}
+
+impl PenetrationReport {
+    /// The `method` of an exact depth of two convex objects.
+    pub const EXACT_CONVEX: &'static str = "exact_convex";
+
+    /// Is the depth exact (`method: "exact_convex"`)?
+    pub fn is_exact(&self) -> bool {
+        self.method.as_deref() == Some(Self::EXACT_CONVEX)
+    }
 }
 
 /// A clash region (v2), see [`crate::regions`].
@@ -366,8 +393,9 @@ pub struct RegionReport {
     pub bounds: Bounds,
     /// Diagonal of that box (size of the interference; not a penetration depth).
     pub extent: f64,
-    /// Penetration estimate (with `--penetration`; null otherwise, or when neither part is
-    /// closed): see [`crate::regions::estimate_penetration`].
+    /// Penetration depth (with `--penetration`; null otherwise, or when neither part is
+    /// closed): exact for two convex objects, else a sampled lower bound (see
+    /// [`PenetrationReport`]).
     #[serde(default)]
     pub penetration: Option<PenetrationReport>,
     /// The exact box of A ∩ B when this region is its part pair's only region and the pair
@@ -751,6 +779,11 @@ pub struct Summary {
     pub contained: Option<ReportContainment>,
     /// Why containment is `undecided`, else null.
     pub contained_reason: Option<String>,
+    /// Two files of one closed part each that clash by containment (`contained` is a clash)
+    /// with no clashing part pair to carry the box: the exact box of A ∩ B, as
+    /// [`PartPairReport::overlap`]. Absent otherwise (a clashing part pair carries its own).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub overlap: Option<OverlapReport>,
 }
 
 /// The closest pair.
