@@ -254,7 +254,8 @@ pub fn penetration(a: &Polytope<'_>, b: &Polytope<'_>) -> Option<Penetration> {
             axis
         }
     };
-    let depth = float_depth(a, b, winner).max(0.0);
+    let (h, n2) = exact_axis(a, b, winner);
+    let depth = rounded_depth(&h, &n2);
     let (normal, point) = witness(a, b, winner, depth);
     Some(Penetration { depth, normal, point, axis: winner })
 }
@@ -632,26 +633,41 @@ fn compare_depths(h1: &Dyadic, n1: &Dyadic, h2: &Dyadic, n2: &Dyadic) -> Orderin
     }
 }
 
-/// The f64 depth along an axis (its unit normal, the deepest vertex's distance behind the face
-/// or the edges' gap).
-fn float_depth(a: &Polytope<'_>, b: &Polytope<'_>, axis: Axis) -> f64 {
-    let (normal, _) = witness(a, b, axis, 0.0);
-    match axis {
-        Axis::FaceA(f) => {
-            let t = a.tri(f);
-            let (v, _) = deepest(&t, b);
-            (t[0] - b.vertex(v)).dot(normal)
+/// `h / √n2` (`n2 > 0`) correctly rounded to f64 (nearest, ties to even), 0 when `h <= 0`: a
+/// bisection over the bit patterns of non-negative floats (ordered as their values), each step an
+/// exact comparison of `x² · n2` with `h²`, then the midpoint rule between the two neighbours.
+fn rounded_depth(h: &Dyadic, n2: &Dyadic) -> f64 {
+    if h.signum() <= 0 {
+        return 0.0;
+    }
+    let h2 = h.mul(h);
+    // Order of x against the depth (x >= 0).
+    let against = |x: f64| {
+        let d = Dyadic::from_f64(x);
+        d.mul(&d).mul(n2).cmp(&h2)
+    };
+    // The largest float not above the depth: bits in [lo, hi], `lo` always not above.
+    let (mut lo, mut hi) = (0u64, f64::MAX.to_bits());
+    while lo < hi {
+        let mid = lo + (hi - lo).div_ceil(2);
+        if against(f64::from_bits(mid)) == Ordering::Greater {
+            hi = mid - 1;
+        } else {
+            lo = mid;
         }
-        Axis::FaceB(f) => {
-            let t = b.tri(f);
-            let (v, _) = deepest(&t, a);
-            (a.vertex(v) - t[0]).dot(normal)
-        }
-        Axis::Edges(i, _) => {
-            let ea = a.surface.edges[i as usize];
-            let (_, p) = edge_points(a, b, axis);
-            (a.vertex(ea.v[0]) - p).dot(normal)
-        }
+    }
+    let down = f64::from_bits(lo);
+    if lo == f64::MAX.to_bits() || against(down) == Ordering::Equal {
+        return down;
+    }
+    let up = f64::from_bits(lo + 1);
+    // The midpoint m = (down + up) / 2 against the depth: (down + up)² · n2 against 4 · h².
+    let sum = Dyadic::from_f64(down).add(&Dyadic::from_f64(up));
+    match sum.mul(&sum).mul(n2).cmp(&h2.mul(&Dyadic::from_f64(4.0))) {
+        Ordering::Less => up,
+        Ordering::Greater => down,
+        Ordering::Equal if down.to_bits() & 1 == 0 => down,
+        Ordering::Equal => up,
     }
 }
 

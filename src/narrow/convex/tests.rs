@@ -360,3 +360,39 @@ proptest! {
         check(&a, &b);
     }
 }
+
+/// `h / √n2` is correctly rounded: the two midpoints around the result bracket the exact value
+/// (compared squared, in rationals), and exact quotients come out exact.
+fn assert_correctly_rounded(h: f64, n2: f64) {
+    let r = rounded_depth(&Dyadic::from_f64(h), &Dyadic::from_f64(n2));
+    if h <= 0.0 {
+        assert_eq!(r, 0.0);
+        return;
+    }
+    let exact = q(h) * q(h) / q(n2); // the depth squared
+    let mid = |x: f64, y: f64| (q(x) + q(y)) / Q::from_integer(BigInt::from(2));
+    let below = if r == 0.0 { Q::zero() } else { mid(f64::from_bits(r.to_bits() - 1), r) };
+    let above = mid(r, f64::from_bits(r.to_bits() + 1));
+    assert!(below.clone() * below <= exact, "{r} is too large for {h} / sqrt({n2})");
+    assert!(exact <= above.clone() * above, "{r} is too small for {h} / sqrt({n2})");
+}
+
+#[test]
+fn depths_are_correctly_rounded() {
+    for (h, n2, want) in [(3.0, 4.0, 1.5), (0.75, 1.0, 0.75), (7.0 * 1e-3, 1.0, 7.0 * 1e-3), (6.0, 9.0, 2.0)]
+    {
+        assert_eq!(rounded_depth(&Dyadic::from_f64(h), &Dyadic::from_f64(n2)), want);
+        assert_correctly_rounded(h, n2);
+    }
+    assert_eq!(rounded_depth(&Dyadic::from_f64(-1.0), &Dyadic::from_f64(2.0)), 0.0);
+    assert_correctly_rounded(1.0, 2.0);
+    assert_correctly_rounded(1e-300, 3.0);
+    assert_correctly_rounded(1e300, 3.0);
+}
+
+proptest! {
+    #[test]
+    fn random_depths_are_correctly_rounded(h in 1e-30f64..1e30, n2 in 1e-30f64..1e30) {
+        assert_correctly_rounded(h, n2);
+    }
+}
