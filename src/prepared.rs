@@ -60,7 +60,7 @@ impl Margins {
     /// [`containment::topology`] finds them). Every bound is a lower bound whatever the f64
     /// rounding:
     /// * separation: distinct vertices are hashed into a grid of cells of side `c`
-    ///   (`MARGIN_CELL` of the coordinates' scale); pairs in the same or adjacent cells are
+    ///   ([`predicates::MARGIN_CELL`] of the coordinates' scale); pairs in the same or adjacent cells are
     ///   measured (f64 distance, `4u` relative error at most, lowered by `8u`); two points whose
     ///   cells are not adjacent differ by more than `c / 2` in some coordinate (the f64 quotient
     ///   by `c` is off by a few ulps at most), so the result is capped at `c / 2`.
@@ -69,25 +69,20 @@ impl Margins {
     ///   products and a difference per component: a few `u` of `L²` each), lowered by that and
     ///   by `4u` relative for the norm and the quotient.
     pub fn of(positions: &[DVec3], triangles: &[[u32; 3]], merged: &[u32]) -> Option<Margins> {
-        let u = f64::EPSILON / 2.0;
         let mut height = f64::INFINITY;
         for t in triangles {
             let ids = t.map(|v| merged[v as usize]);
             if ids[0] == ids[1] || ids[1] == ids[2] || ids[0] == ids[2] {
                 continue;
             }
-            let [a, b, c] = t.map(|v| positions[v as usize]);
-            let l2 = (b - a).length_squared().max((c - a).length_squared()).max((c - b).length_squared());
-            let cross = (b - a).cross(c - a).length();
-            let area2 = cross * (1.0 - 4.0 * u) - 16.0 * u * l2 * (1.0 + 4.0 * u);
-            let h = area2 / (l2.sqrt() * (1.0 + 4.0 * u)) * (1.0 - 4.0 * u);
+            let h = predicates::height_lower_bound(t.map(|v| positions[v as usize]));
             if h.is_nan() || h <= 0.0 {
                 return None;
             }
             height = height.min(h);
         }
         let scale = positions.iter().fold(0.0f64, |m, p| m.max(p.abs().max_element()));
-        let cell = scale * MARGIN_CELL;
+        let cell = scale * predicates::MARGIN_CELL;
         let mut separation = cell * 0.5;
         if cell <= 0.0 || !cell.is_finite() {
             return None;
@@ -105,7 +100,7 @@ impl Margins {
                     for dz in -1..=1 {
                         if let Some(near) = grid.get(&[key[0] + dx, key[1] + dy, key[2] + dz]) {
                             for q in near {
-                                separation = separation.min((*p - *q).length() * (1.0 - 8.0 * u));
+                                separation = separation.min(predicates::distance_lower_bound(*p, *q));
                             }
                         }
                     }
@@ -128,15 +123,11 @@ impl Margins {
     /// before and after: the closedness and components are the same. The tests use `3δ` and
     /// `6δ` (room for the rounding of the comparison itself).
     pub fn hold_under(&self, map: &BoxMap) -> bool {
-        let (lo, hi) = singular_bounds(&map.rows);
+        let (lo, hi) = predicates::singular_value_bounds(&map.rows);
         let delta = map.slack.length();
         lo * self.separation > 3.0 * delta && lo * lo / hi * self.height > 6.0 * delta
     }
 }
-
-/// The grid cell of [`Margins::of`], relative to the coordinates' scale: a separation below it
-/// is measured, above it only `cell / 2` is claimed (far above the rounding of any placement).
-const MARGIN_CELL: f64 = 1.0 / (1u64 << 20) as f64;
 
 impl Prepared {
     /// Build the tree of `mesh` (validated by [`mesh_from_arrays`] or a loader).
@@ -327,7 +318,7 @@ impl Ball {
     /// `R p + t`, and so does the center's f64 image of the exact image of the source center
     /// (`map.slack` covers that rounding too, see [`BoxMap`]); so
     /// `|w - center| <= |R (p - c)| + 2 |slack| <= σ(R) r + 2 |slack|`, with `σ(R)` the largest
-    /// singular value of `R`, bounded above by [`singular_bounds`]. The sum is rounded up by the
+    /// singular value of `R`, bounded above by [`predicates::singular_value_bounds`]. The sum is rounded up by the
     /// search margin of the targets' scale (its f64 rounding is a few ulps of it).
     pub fn mapped(&self, map: &BoxMap, root: &Aabb) -> Ball {
         let r = map.rows;
@@ -337,7 +328,7 @@ impl Ball {
             r[2][0] * self.center.x + r[2][1] * self.center.y + r[2][2] * self.center.z + r[2][3],
         );
         let slack = predicates::distance_rounding_slack(root.max_abs());
-        let radius = singular_bounds(&r).1 * self.radius + 2.0 * map.slack.length() + slack;
+        let radius = predicates::singular_value_bounds(&r).1 * self.radius + 2.0 * map.slack.length() + slack;
         Ball { center, radius, slack }
     }
 
@@ -352,33 +343,6 @@ impl Ball {
     pub fn apart(&self, o: &Ball) -> bool {
         self.gap(o) > 0.0
     }
-}
-
-/// Bounds of the smallest and largest singular values of the linear part of `rows` (the map's
-/// 3x3 matrix `R`): square roots of Gershgorin's bounds on the eigenvalues of `G = RᵀR`,
-/// `min_j (G_jj - Σ_{k≠j} |G_jk|)` and `max_j Σ_k |G_jk|`. Each f64 entry `Ĝ_jk` (three
-/// products, two sums) is within `γ_3 · H_jk` of `G_jk`, `H_jk = Σ_i |r_ij| |r_ik|` (Higham,
-/// §3.1): `4u · H_jk` widens every entry; the final sums and square roots round by a few ulps,
-/// covered by the factors `1 ∓ 16u`. Both 1 (to a few ulps) for a rotation.
-fn singular_bounds(rows: &[[f64; 4]; 3]) -> (f64, f64) {
-    let u = f64::EPSILON / 2.0;
-    let (mut low, mut high) = (f64::INFINITY, 0.0f64);
-    for j in 0..3 {
-        let (mut diag, mut off, mut widen) = (0.0, 0.0, 0.0);
-        for k in 0..3 {
-            let g: f64 = (0..3).map(|i| rows[i][j] * rows[i][k]).sum();
-            let h: f64 = (0..3).map(|i| (rows[i][j] * rows[i][k]).abs()).sum();
-            widen += 4.0 * u * h;
-            if k == j {
-                diag = g;
-            } else {
-                off += g.abs();
-            }
-        }
-        high = high.max(diag.abs() + off + widen);
-        low = low.min(diag - off - widen);
-    }
-    (low.max(0.0).sqrt() * (1.0 - 16.0 * u), high.sqrt() * (1.0 + 16.0 * u))
 }
 
 /// A placed mesh as the checks read it (world coordinates; nothing copied).

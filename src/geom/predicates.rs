@@ -682,6 +682,57 @@ impl Tolerances {
 /// is conservative.
 pub const BOX_MAP_MAX_DEVIATION_ULPS: f64 = 1024.0;
 
+/// The grid cell of the prepared meshes' vertex-separation bound, relative to the coordinates'
+/// scale: a separation below it is measured, above it only `cell / 2` is claimed (far above the
+/// rounding of any placement).
+pub const MARGIN_CELL: f64 = 1.0 / (1u64 << 20) as f64;
+
+/// A lower bound of every height of the triangle `[a, b, c]` whatever the f64 rounding: twice
+/// the area over the longest edge, `|(b - a) × (c - a)| / L`. The f64 cross product is within
+/// `16u L²` of the exact one (two rounded differences per factor, two products and a difference
+/// per component: a few `u` of `L²` each); the result is lowered by that and by `4u` relative for
+/// the norm and the quotient. Not positive (or NaN) when the triangle may be degenerate.
+pub fn height_lower_bound([a, b, c]: [DVec3; 3]) -> f64 {
+    let u = UNIT_ROUNDOFF;
+    let l2 = (b - a).length_squared().max((c - a).length_squared()).max((c - b).length_squared());
+    let cross = (b - a).cross(c - a).length();
+    let area2 = cross * (1.0 - 4.0 * u) - 16.0 * u * l2 * (1.0 + 4.0 * u);
+    area2 / (l2.sqrt() * (1.0 + 4.0 * u)) * (1.0 - 4.0 * u)
+}
+
+/// A lower bound of the exact distance between `p` and `q`: the f64 distance (`4u` relative
+/// error at most) lowered by `8u`.
+pub fn distance_lower_bound(p: DVec3, q: DVec3) -> f64 {
+    (p - q).length() * (1.0 - 8.0 * UNIT_ROUNDOFF)
+}
+
+/// Bounds of the smallest and largest singular values of the linear part of `rows` (the map's
+/// 3x3 matrix `R`): square roots of Gershgorin's bounds on the eigenvalues of `G = RᵀR`,
+/// `min_j (G_jj - Σ_{k≠j} |G_jk|)` and `max_j Σ_k |G_jk|`. Each f64 entry `Ĝ_jk` (three
+/// products, two sums) is within `γ_3 · H_jk` of `G_jk`, `H_jk = Σ_i |r_ij| |r_ik|` (Higham,
+/// §3.1): `4u · H_jk` widens every entry; the final sums and square roots round by a few ulps,
+/// covered by the factors `1 ∓ 16u`. Both 1 (to a few ulps) for a rotation.
+pub fn singular_value_bounds(rows: &[[f64; 4]; 3]) -> (f64, f64) {
+    let u = UNIT_ROUNDOFF;
+    let (mut low, mut high) = (f64::INFINITY, 0.0f64);
+    for j in 0..3 {
+        let (mut diag, mut off, mut widen) = (0.0, 0.0, 0.0);
+        for k in 0..3 {
+            let g: f64 = (0..3).map(|i| rows[i][j] * rows[i][k]).sum();
+            let h: f64 = (0..3).map(|i| (rows[i][j] * rows[i][k]).abs()).sum();
+            widen += 4.0 * u * h;
+            if k == j {
+                diag = g;
+            } else {
+                off += g.abs();
+            }
+        }
+        high = high.max(diag.abs() + off + widen);
+        low = low.min(diag - off - widen);
+    }
+    (low.max(0.0).sqrt() * (1.0 - 16.0 * u), high.sqrt() * (1.0 + 16.0 * u))
+}
+
 /// A conservative affine map of boxes, so that instances of one mesh can share one tree: the
 /// tree is built over one instance's coordinates `x` (the *source*), and another instance's
 /// coordinates `w` (the *target*, computed independently, e.g. by the loader from the mesh's
