@@ -5,7 +5,7 @@
 
 use super::{LoadedInput, Outcome};
 use crate::check::query::{MeshInfo, PairFinding, TreeStats};
-use crate::geom::Aabb;
+use crate::geom::{Aabb, DVec3};
 use crate::report::*;
 use glam::DMat4;
 
@@ -168,7 +168,8 @@ fn exact_convex(p: &crate::narrow::convex::Penetration) -> PenetrationReport {
         side: if matches!(p.axis, Axis::FaceA(_)) { "b_in_a" } else { "a_in_b" }.to_string(),
         samples: 0,
         method: Some(PenetrationReport::EXACT_CONVEX.to_string()),
-        direction: Some(v3(p.normal)),
+        // A direction along an axis reads as such: no negative zeros.
+        direction: Some(v3(p.normal + DVec3::ZERO)),
     }
 }
 

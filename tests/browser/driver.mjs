@@ -2,14 +2,14 @@
 // the DevTools protocol over --remote-debugging-pipe (fds 3 and 4, NUL-separated JSON), and a
 // small PNG decoder on Node's zlib.
 //
-//   node tests/browser/driver.mjs REPORT.html OVERVIEW.png CLASH.png [--rows N]
+//   node tests/browser/driver.mjs REPORT.html OVERVIEW.png CLASH.png [--rows N] [--text S]
 //   node tests/browser/driver.mjs --glb SCENE.glb OVERVIEW.png CLASH.png
 //
 // Fails (exit 1, a line on stderr) unless: the page reaches WebGL ready; the overview frame and
 // the frame after clicking the first clash row both contain the A colour (orange) and the B
 // colour (blue) in the canvas, and the selected frame the contact colour (magenta) when that row
 // has contact segments; the page made no request other than the report file itself; the console
-// and the log have no error and no exception was thrown. `--rows N` also asserts the table rows.
+// and the log have no error and no exception was thrown. `--rows N` also asserts the table rows, `--text S` that the clash table shows S.
 //
 // With --glb: the GLB is embedded in tests/browser/glb_viewer.html (a minimal viewer written for
 // this test) and drawn through the file's own cameras: `camera overview` on white and on a dark
@@ -27,8 +27,10 @@ const args = process.argv.slice(glbMode ? 3 : 2);
 const [htmlPath, overviewPng, clashPng] = args;
 const rowsIdx = args.indexOf('--rows');
 const wantRows = rowsIdx >= 0 ? Number(args[rowsIdx + 1]) : null;
+const textIdx = args.indexOf('--text');
+const wantText = textIdx >= 0 ? args[textIdx + 1] : null;
 if (!htmlPath || !overviewPng || !clashPng) {
-  console.error('usage: driver.mjs REPORT.html OVERVIEW.png CLASH.png [--rows N]');
+  console.error('usage: driver.mjs REPORT.html OVERVIEW.png CLASH.png [--rows N] [--text S]');
   process.exit(2);
 }
 const CHROMIUM = process.env.CHROMIUM || '/usr/bin/chromium';
@@ -173,6 +175,10 @@ async function main() {
   const rows = await evaluate('document.querySelectorAll("#clashes tbody tr").length');
   if (wantRows !== null && rows !== wantRows) fail(`${rows} table rows, expected ${wantRows}`);
   if (rows < 1) fail('the clash table is empty');
+  if (wantText !== null) {
+    const table = await evaluate('document.querySelector("#clashes tbody").textContent');
+    if (!String(table).includes(wantText)) fail(`the clash table does not show "${wantText}": ${table}`);
+  }
   const rect = await evaluate('(() => { const r = document.getElementById("gl").getBoundingClientRect(); return {x: r.x, y: r.y, width: r.width, height: r.height}; })()');
   const shot = async (file) => {
     await evaluate('new Promise((r) => requestAnimationFrame(() => requestAnimationFrame(r)))');

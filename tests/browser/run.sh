@@ -30,8 +30,10 @@ trap 'rm -rf "$out"' EXIT
 shots="$out/shots"
 mkdir -p "$shots"
 
-# check NAME ROWS -- meshclash arguments...   (ROWS: expected table rows, or - for any)
+# check NAME ROWS -- meshclash arguments...   (ROWS: expected table rows, or - for any; when TEXT
+# is set, the clash table must show it)
 pages=0
+TEXT=
 check() {
   name=$1; rows=$2; shift 3
   pages=$((pages + 1))
@@ -41,17 +43,24 @@ check() {
   set -e
   [ "$code" -le 1 ] || { echo "meshclash failed on $name (exit $code)" >&2; exit 1; }
   if [ "$rows" = "-" ]; then
-    node tests/browser/driver.mjs "$out/$name.html" "$shots/$name-overview.png" "$shots/$name-clash.png"
+    node tests/browser/driver.mjs "$out/$name.html" "$shots/$name-overview.png" "$shots/$name-clash.png" ${TEXT:+--text} ${TEXT:+"$TEXT"}
   else
-    node tests/browser/driver.mjs "$out/$name.html" "$shots/$name-overview.png" "$shots/$name-clash.png" --rows "$rows"
+    node tests/browser/driver.mjs "$out/$name.html" "$shots/$name-overview.png" "$shots/$name-clash.png" --rows "$rows" ${TEXT:+--text} ${TEXT:+"$TEXT"}
   fi
 }
 
 check fcl 1 -- meshes/fcl_env.obj meshes/fcl_rob.obj
 check pins 6 -- scene meshes/pins.glb
 check pins-apart 1 -- meshes/pins.glb meshes/pins.glb --translate-b 300,0,0
+# Two unit cubes overlapping by 0.75: an exact convex depth, labelled so.
+TEXT='depth 0.75 (exact)'
+check cubes-exact 1 -- meshes/Box.glb meshes/Box.glb --translate-b 0.25,0,0 --penetration
+TEXT=
 if [ -f ../shared/meshes/2CylinderEngine.glb ]; then
+  # No engine part is convex: its depths are sampled lower bounds.
+  TEXT='depth ≥'
   check engine - -- scene ../shared/meshes/2CylinderEngine.glb --penetration
+  TEXT=
 fi
 # `meshclash self` pages: a strip folded back through itself (tests/glb.rs: 2 crossing and 2
 # touching pairs, inconsistent winding, open), and the robot (self-touching, non-manifold, open).

@@ -38,7 +38,11 @@
 
   function measureText(r) {
     var o = r.overlap ? ', overlap ' + r.overlap.map(fmt).join(' \u00d7 ') + unit() : '';
-    if (r.penetration !== null) return 'depth ' + fmt(r.penetration) + unit() + o;
+    if (r.penetration !== null) {
+      // An exact convex depth, or a sampled lower bound.
+      if (r.penetration_exact) return 'depth ' + fmt(r.penetration) + unit() + ' (exact)' + o;
+      return 'depth \u2265 ' + fmt(r.penetration) + unit() + o;
+    }
     if (r.distance === null) return o.slice(2);
     return (r.distance === 0 ? 'contact' : 'd ' + fmt(r.distance) + unit()) + o;
   }
