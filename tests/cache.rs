@@ -354,11 +354,7 @@ fn closest_clear_pair_changes_when_one_part_moves_away() {
 
 #[test]
 fn engine_scene_warm_equals_cold() {
-    let engine = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../shared/meshes/2CylinderEngine.glb");
-    if !engine.is_file() {
-        println!("skipped: {} is absent", engine.display());
-        return;
-    }
+    let Some(engine) = crate::common::corpus("2CylinderEngine.glb") else { return };
     let d = tempfile::tempdir().unwrap();
     std::fs::copy(&engine, d.path().join("engine.glb")).unwrap();
     let args = ["scene", "engine.glb", "--no-timings", "--detail", "parts"];

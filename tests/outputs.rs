@@ -369,7 +369,7 @@ fn a_terminal_gets_the_summary_in_colour_unless_no_color() {
     let json = dir.path().join("r.json").display().to_string();
     let args = vec![shipped("fcl_env.obj"), shipped("fcl_rob.obj"), "-o".to_string(), json];
     let Some(tty) = on_a_terminal(&args, &[]) else {
-        eprintln!("skipped: no usable `script` for a pseudo-terminal");
+        crate::common::say("skipped a_terminal_gets_the_summary_in_colour_unless_no_color: no usable `script` (util-linux) for a pseudo-terminal");
         return;
     };
     assert!(tty.contains("192"), "{tty}");
