@@ -5,38 +5,14 @@
 //! smallest support overlap over those axes). Non-convex parts keep the sampled estimate (no
 //! `method`). Both part orders, two-file and scene mode.
 
+use crate::solids::{both_modes, Solid, V};
 use meshclash::pipeline::{self, Request};
 use meshclash::report::{PenetrationReport, Report};
 use num_rational::BigRational;
 use num_traits::{Signed, Zero};
 use std::path::Path;
 
-type V = [f64; 3];
 type Q = BigRational;
-
-/// A closed triangle mesh with outward winding.
-#[derive(Clone)]
-struct Solid {
-    points: Vec<V>,
-    tris: Vec<[usize; 3]>,
-}
-
-impl Solid {
-    fn obj(&self, name: &str, offset: usize) -> String {
-        let mut s = format!("o {name}\n");
-        for p in &self.points {
-            s += &format!("v {:?} {:?} {:?}\n", p[0], p[1], p[2]);
-        }
-        for t in &self.tris {
-            s += &format!("f {} {} {}\n", t[0] + 1 + offset, t[1] + 1 + offset, t[2] + 1 + offset);
-        }
-        s
-    }
-
-    fn map(&self, f: impl Fn(V) -> V) -> Solid {
-        Solid { points: self.points.iter().map(|&p| f(p)).collect(), tris: self.tris.clone() }
-    }
-}
 
 /// An axis-aligned box (12 triangles, outward).
 fn cuboid(lo: V, hi: V) -> Solid {
@@ -186,20 +162,9 @@ fn assert_depth(depth: f64, want_sq: &Q, scale: f64, what: &str) {
 // ---------------------------------------------------------------------------------------------
 // Running the check.
 
-fn run(req: Request) -> Report {
-    let req = Request { deterministic: true, penetration: true, ..req };
-    let o = pipeline::run(&req, &|_| {}).expect("check runs");
-    pipeline::report::build(&o)
-}
-
 /// The penetration blocks of every region, two-file and scene mode (which must agree).
 fn penetrations(dir: &Path, a: &Solid, b: &Solid) -> Vec<PenetrationReport> {
-    let (pa, pb, ps) = (dir.join("a.obj"), dir.join("b.obj"), dir.join("scene.obj"));
-    std::fs::write(&pa, a.obj("A", 0)).unwrap();
-    std::fs::write(&pb, b.obj("B", 0)).unwrap();
-    std::fs::write(&ps, a.obj("A", 0) + &b.obj("B", a.points.len())).unwrap();
-    let files = run(Request::files(&pa, &pb));
-    let scene = run(Request::scene(&ps));
+    let (files, scene) = both_modes(dir, a, b, |r: Request| Request { penetration: true, ..r });
     let blocks = |r: &Report| -> Vec<PenetrationReport> {
         r.regions
             .iter()

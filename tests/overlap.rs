@@ -6,40 +6,12 @@
 //! in two-file and in scene mode, and the same at every tessellation of the same solids (12 to
 //! about 1000 triangles per part).
 
-use meshclash::pipeline::{self, Request};
+use crate::solids::{both_modes, run, Solid, V};
+use meshclash::pipeline::Request;
 use meshclash::report::OverlapReport;
 use num_rational::BigRational;
 use num_traits::{Signed, Zero};
 use std::path::Path;
-
-type V = [f64; 3];
-
-/// A closed triangle mesh with outward winding.
-#[derive(Clone)]
-struct Solid {
-    points: Vec<V>,
-    tris: Vec<[usize; 3]>,
-}
-
-impl Solid {
-    fn flipped(&self) -> Solid {
-        Solid {
-            points: self.points.clone(),
-            tris: self.tris.iter().rev().map(|t| [t[0], t[2], t[1]]).collect(),
-        }
-    }
-
-    fn obj(&self, name: &str, offset: usize) -> String {
-        let mut s = format!("o {name}\n");
-        for p in &self.points {
-            s += &format!("v {:?} {:?} {:?}\n", p[0], p[1], p[2]);
-        }
-        for t in &self.tris {
-            s += &format!("f {} {} {}\n", t[0] + 1 + offset, t[1] + 1 + offset, t[2] + 1 + offset);
-        }
-        s
-    }
-}
 
 /// An axis-aligned box, each face cut into `n × n` squares (12 n² triangles): the same solid
 /// for every `n` (inner grid points are rounded within the face's plane).
@@ -220,20 +192,10 @@ fn assert_matches(o: &OverlapReport, want: &[[Q; 3]; 2], what: &str) {
 // ---------------------------------------------------------------------------------------------
 // Running the check.
 
-fn run(req: Request) -> meshclash::report::Report {
-    let o = pipeline::run(&Request { deterministic: true, ..req }, &|_| {}).expect("check runs");
-    pipeline::report::build(&o)
-}
-
 /// The overlap box of the one clashing part pair, two-file mode and scene mode (which must
 /// agree), and of its only region.
 fn overlap_of(dir: &Path, a: &Solid, b: &Solid) -> Option<OverlapReport> {
-    let (pa, pb, ps) = (dir.join("a.obj"), dir.join("b.obj"), dir.join("scene.obj"));
-    std::fs::write(&pa, a.obj("A", 0)).unwrap();
-    std::fs::write(&pb, b.obj("B", 0)).unwrap();
-    std::fs::write(&ps, a.obj("A", 0) + &b.obj("B", a.points.len())).unwrap();
-    let files = run(Request::files(&pa, &pb));
-    let scene = run(Request::scene(&ps));
+    let (files, scene) = both_modes(dir, a, b, |r: Request| r);
     let pick = |r: &meshclash::report::Report| {
         assert!(r.part_pairs.len() <= 1);
         let o = r.part_pairs.first().and_then(|p| p.overlap.clone());

@@ -76,6 +76,8 @@ mod self_scene;
 mod shard;
 #[path = "shard_limits.rs"]
 mod shard_limits;
+#[path = "solids.rs"]
+mod solids;
 #[path = "tri_tri_oracle.rs"]
 mod tri_tri_oracle;
 #[path = "trust.rs"]
