@@ -321,14 +321,10 @@ impl Ball {
     /// singular value of `R`, bounded above by [`predicates::singular_value_bounds`]. The sum is rounded up by the
     /// search margin of the targets' scale (its f64 rounding is a few ulps of it).
     pub fn mapped(&self, map: &BoxMap, root: &Aabb) -> Ball {
-        let r = map.rows;
-        let center = DVec3::new(
-            r[0][0] * self.center.x + r[0][1] * self.center.y + r[0][2] * self.center.z + r[0][3],
-            r[1][0] * self.center.x + r[1][1] * self.center.y + r[1][2] * self.center.z + r[1][3],
-            r[2][0] * self.center.x + r[2][1] * self.center.y + r[2][2] * self.center.z + r[2][3],
-        );
+        let center = map.image(self.center);
         let slack = predicates::distance_rounding_slack(root.max_abs());
-        let radius = predicates::singular_value_bounds(&r).1 * self.radius + 2.0 * map.slack.length() + slack;
+        let radius =
+            predicates::singular_value_bounds(&map.rows).1 * self.radius + 2.0 * map.slack.length() + slack;
         Ball { center, radius, slack }
     }
 

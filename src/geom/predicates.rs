@@ -809,6 +809,13 @@ impl BoxMap {
         Some(BoxMap { rows, slack: DVec3::from_array(slack) })
     }
 
+    /// The f64 image of `p` (each row evaluated in the fixed order the slack bound assumes): within
+    /// `slack` per axis of the exact image of `p` for points in the source root box.
+    pub fn image(&self, p: DVec3) -> DVec3 {
+        let x = p.to_array();
+        DVec3::new(Self::eval(&self.rows[0], x), Self::eval(&self.rows[1], x), Self::eval(&self.rows[2], x))
+    }
+
     /// A box containing every target vertex whose source vertex lies in `b` (which must lie in
     /// the source root given to [`BoxMap::fit`]).
     #[inline]
