@@ -111,12 +111,12 @@ impl Ord for Pending {
 /// Best-first search over the object pairs of two trees (or, with `same`, the pairs `i < j`
 /// of one tree: `tb` is then `ta`), in increasing order of a lower bound of their distance.
 ///
-/// `node_bound(x, y)` must be at most `pair_bound(i, j)` for every object `i` under box `x`
-/// and `j` under box `y` (boxes of nodes hold their objects' boxes); `visit(i, j, bound)` is
-/// called for each pair not pruned and answers the best distance so far. The search stops when
-/// the next node pair's bound exceeds that best distance: every pair with
-/// `pair_bound(i, j) <= best` is visited (in no particular order), so a caller that keeps the
-/// smallest (distance, i, j) gets the same answer as a scan of all pairs.
+/// `node_bound(x, y)` must be at most the distance of every object `i` under box `x` and `j`
+/// under box `y` (boxes of nodes hold their objects' boxes); `visit(i, j)` is called for each
+/// pair not pruned and answers the best distance so far. The search stops when the next node
+/// pair's bound exceeds that best distance: every pair whose node bound is at most the best is
+/// visited (in no particular order), so a caller that keeps the smallest (distance, i, j) gets
+/// the same answer as a scan of all pairs.
 pub fn best_first(
     ta: &ObjectTree,
     tb: &ObjectTree,
@@ -178,13 +178,8 @@ mod tests {
     /// smallest (bound, i, j) it keeps is the brute-force minimum.
     #[test]
     fn best_first_finds_the_brute_force_minimum() {
-        let mut s = 0x2545_f491_4f6c_dd1du64;
-        let mut rnd = || {
-            s ^= s << 13;
-            s ^= s >> 7;
-            s ^= s << 17;
-            (s >> 11) as f64 / (1u64 << 53) as f64
-        };
+        let mut next = crate::load::test_rng(0x2545_f491_4f6c_dd1d);
+        let mut rnd = || next(1 << 30) as f64 / (1u64 << 30) as f64;
         for n in [1usize, 2, 3, 5, 17, 100] {
             let boxes: Vec<Aabb> = (0..n)
                 .map(|_| {
@@ -194,51 +189,37 @@ mod tests {
                 })
                 .collect();
             let d = |i: usize, j: usize| boxes[i].distance_sq(&boxes[j]).sqrt();
-            let t = ObjectTree::build(&boxes, (0..n).collect());
+            let order = |x: &(f64, usize, usize), y: &(f64, usize, usize)| {
+                x.0.total_cmp(&y.0).then((x.1, x.2).cmp(&(y.1, y.2)))
+            };
+            // The smallest (distance, i, j) the search keeps, against the brute-force minimum
+            // over `pairs`.
+            let check = |ta: &ObjectTree, tb: &ObjectTree, same: bool, pairs: Vec<(usize, usize)>| {
+                let mut best = (f64::INFINITY, usize::MAX, usize::MAX);
+                best_first(
+                    ta,
+                    tb,
+                    same,
+                    |x, y| x.distance_sq(y).sqrt(),
+                    |i, j| {
+                        assert!(!same || i < j);
+                        let c = (d(i, j), i, j);
+                        if order(&c, &best).is_lt() {
+                            best = c;
+                        }
+                        best.0
+                    },
+                );
+                let brute = pairs.into_iter().map(|(i, j)| (d(i, j), i, j)).min_by(order);
+                assert_eq!(Some(best).filter(|b| b.1 != usize::MAX), brute, "n = {n}");
+            };
             // Internal pairs.
-            let mut best = (f64::INFINITY, usize::MAX, usize::MAX);
-            best_first(
-                &t,
-                &t,
-                true,
-                |x, y| x.distance_sq(y).sqrt(),
-                |i, j| {
-                    assert!(i < j);
-                    let c = (d(i, j), i, j);
-                    if c.0.total_cmp(&best.0).then((c.1, c.2).cmp(&(best.1, best.2))).is_lt() {
-                        best = c;
-                    }
-                    best.0
-                },
-            );
-            let brute = (0..n)
-                .flat_map(|i| (i + 1..n).map(move |j| (i, j)))
-                .map(|(i, j)| (d(i, j), i, j))
-                .min_by(|x, y| x.0.total_cmp(&y.0).then((x.1, x.2).cmp(&(y.1, y.2))));
-            assert_eq!(Some(best).filter(|b| b.1 != usize::MAX), brute, "n = {n}");
+            let t = ObjectTree::build(&boxes, (0..n).collect());
+            check(&t, &t, true, (0..n).flat_map(|i| (i + 1..n).map(move |j| (i, j))).collect());
             // Pairs between two lists (the first half against the rest).
             let (a, b): (Vec<usize>, Vec<usize>) = (0..n).partition(|&i| i < n / 2);
             let (ta, tb) = (ObjectTree::build(&boxes, a.clone()), ObjectTree::build(&boxes, b.clone()));
-            let mut best = (f64::INFINITY, usize::MAX, usize::MAX);
-            best_first(
-                &ta,
-                &tb,
-                false,
-                |x, y| x.distance_sq(y).sqrt(),
-                |i, j| {
-                    let c = (d(i, j), i, j);
-                    if c.0.total_cmp(&best.0).then((c.1, c.2).cmp(&(best.1, best.2))).is_lt() {
-                        best = c;
-                    }
-                    best.0
-                },
-            );
-            let brute = a
-                .iter()
-                .flat_map(|&i| b.iter().map(move |&j| (i, j)))
-                .map(|(i, j)| (d(i, j), i, j))
-                .min_by(|x, y| x.0.total_cmp(&y.0).then((x.1, x.2).cmp(&(y.1, y.2))));
-            assert_eq!(Some(best).filter(|b| b.1 != usize::MAX), brute, "n = {n}");
+            check(&ta, &tb, false, a.iter().flat_map(|&i| b.iter().map(move |&j| (i, j))).collect());
         }
     }
 }
