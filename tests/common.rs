@@ -88,6 +88,33 @@ pub fn shared_str(name: &str) -> String {
     shared(name).display().to_string()
 }
 
+/// OBJ text with one `o` per named axis-aligned box (min corner, max corner): 8 vertices and 12
+/// outward-facing triangles each, the boxes numbered on in file order.
+pub fn boxes_obj_text(boxes: &[(&str, [f64; 3], [f64; 3])]) -> String {
+    use std::fmt::Write;
+    let mut s = String::new();
+    for (k, (name, lo, hi)) in boxes.iter().enumerate() {
+        writeln!(s, "o {name}").unwrap();
+        for i in 0..8 {
+            let c = |axis: usize| if i >> axis & 1 == 1 { hi[axis] } else { lo[axis] };
+            writeln!(s, "v {} {} {}", c(0), c(1), c(2)).unwrap();
+        }
+        let o = 8 * k + 1;
+        for q in [[0, 2, 3, 1], [4, 5, 7, 6], [0, 1, 5, 4], [2, 6, 7, 3], [0, 4, 6, 2], [1, 3, 7, 5]] {
+            let [a, b, c, d] = q.map(|v| v + o);
+            writeln!(s, "f {a} {b} {c}\nf {a} {c} {d}").unwrap();
+        }
+    }
+    s
+}
+
+/// [`boxes_obj_text`] written to `dir/file`; returns the path as a string.
+pub fn boxes_obj(dir: &Path, file: &str, boxes: &[(&str, [f64; 3], [f64; 3])]) -> String {
+    let path = dir.join(file);
+    std::fs::write(&path, boxes_obj_text(boxes)).unwrap();
+    path.display().to_string()
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -2,10 +2,11 @@
 //! against real reports), JUnit XML, baseline diff with stable ids and `--fail-on new`, the GLB
 //! scene, text summary, completions and man page, and a quiet stderr when it is not a terminal.
 
+use crate::common::boxes_obj;
 use assert_cmd::Command;
 use meshclash::report::Report;
 use std::collections::BTreeSet;
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 
 fn root() -> PathBuf {
     PathBuf::from(env!("CARGO_MANIFEST_DIR"))
@@ -21,26 +22,6 @@ fn bin() -> Command {
 
 fn report(stdout: &[u8]) -> Report {
     serde_json::from_slice(stdout).expect("stdout is a report")
-}
-
-/// One OBJ file with one closed, outward-oriented box per object.
-fn boxes_obj(dir: &Path, file: &str, boxes: &[(&str, [f64; 3], [f64; 3])]) -> String {
-    let mut s = String::new();
-    for (k, (name, lo, hi)) in boxes.iter().enumerate() {
-        s += &format!("o {name}\n");
-        for i in 0..8 {
-            let c = |bit: usize, axis: usize| if i & bit != 0 { hi[axis] } else { lo[axis] };
-            s += &format!("v {} {} {}\n", c(1, 0), c(2, 1), c(4, 2));
-        }
-        let quads = [[0, 2, 3, 1], [4, 5, 7, 6], [0, 1, 5, 4], [2, 6, 7, 3], [0, 4, 6, 2], [1, 3, 7, 5]];
-        let o = 8 * k + 1;
-        for [a, b, c, d] in quads {
-            s += &format!("f {} {} {}\nf {} {} {}\n", a + o, b + o, c + o, a + o, c + o, d + o);
-        }
-    }
-    let path = dir.join(file);
-    std::fs::write(&path, s).unwrap();
-    path.display().to_string()
 }
 
 const SLAB: (&str, [f64; 3], [f64; 3]) = ("slab", [0.0, 0.0, 0.0], [10.0, 10.0, 1.0]);

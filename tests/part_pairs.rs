@@ -1,29 +1,10 @@
 //! Part-pair results through the real binary on constructed assemblies: verdict, counts,
 //! minimum distance with witness points, and each pair's triangle pairs capped with a flag.
 
+use crate::common::boxes_obj_text as boxes_obj;
 use serde_json::Value;
-use std::fmt::Write;
 use std::path::Path;
 use std::process::Command;
-
-/// An OBJ with one `o` per named box (min, max), 12 triangles each.
-fn boxes_obj(boxes: &[(&str, [f64; 3], [f64; 3])]) -> String {
-    let mut s = String::new();
-    let mut base = 1;
-    for (name, lo, hi) in boxes {
-        writeln!(s, "o {name}").unwrap();
-        for i in 0..8 {
-            let c = |k: usize| if i >> k & 1 == 1 { hi[k] } else { lo[k] };
-            writeln!(s, "v {} {} {}", c(0), c(1), c(2)).unwrap();
-        }
-        for q in [[0, 2, 3, 1], [4, 5, 7, 6], [0, 1, 5, 4], [2, 6, 7, 3], [0, 4, 6, 2], [1, 3, 7, 5]] {
-            let v = q.map(|k| k + base);
-            writeln!(s, "f {} {} {}\nf {} {} {}", v[0], v[1], v[2], v[0], v[2], v[3]).unwrap();
-        }
-        base += 8;
-    }
-    s
-}
 
 fn run(args: &[&str]) -> (i32, Value) {
     let out = Command::new(env!("CARGO_BIN_EXE_meshclash")).args(args).arg("--no-timings").output().unwrap();
