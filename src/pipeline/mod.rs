@@ -663,8 +663,14 @@ pub fn run(req: &Request, progress: &(dyn Fn(Phase) + Sync)) -> Result<Outcome> 
     } else {
         Vec::new()
     };
-    let overlaps =
-        overlaps::overlaps(&outcome, &a.mesh, &b.mesh, req.selection.scene, req.settings.bvh, |_| true);
+    let compute = |need: &(dyn Fn(usize) -> bool + Sync)| {
+        overlaps::overlaps(&outcome, &a.mesh, &b.mesh, req.selection.scene, req.settings.bvh, need)
+    };
+    // With the cache, the boxes of reused pairs come from it (and the new ones are stored).
+    let overlaps = match &cache {
+        Some(c) => c.overlaps(&outcome, compute),
+        None => compute(&|_| true),
+    };
     let files_overlap =
         overlaps::files_overlap(&outcome, &a.mesh, &b.mesh, req.selection.scene, req.settings.bvh);
     let listed = listed_pairs(&result.pairs, req.max_pairs);
