@@ -614,3 +614,21 @@ fn reused_overlap_boxes_equal_the_cold_report_also_after_a_move() {
     assert_eq!((body.as_str(), reused, checked), (cold2.as_str(), n - 2, 2));
     assert_eq!(boxes(&body), n as usize);
 }
+
+#[test]
+fn a_model_saved_under_another_name_reuses_its_pairs() {
+    let d = tempfile::tempdir().unwrap();
+    let args = |f: &str| with(&["scene", f, "--no-timings", "--clearance", "0.01"], &["--cache", "c"]);
+    write(d.path(), "chain.obj", &chain_obj(&chain(5)));
+    let first = split(&run_s(d.path(), &args("chain.obj")));
+    let n = candidates(&first.0);
+    assert_eq!((first.1 .0, first.1 .1), (0, n));
+    std::fs::create_dir(d.path().join("elsewhere")).unwrap();
+    std::fs::rename(d.path().join("chain.obj"), d.path().join("elsewhere/renamed.obj")).unwrap();
+    let cold = run_s(
+        d.path(),
+        &with(&["scene", "elsewhere/renamed.obj", "--no-timings", "--clearance", "0.01"], &[]),
+    );
+    let (body, (reused, checked, _)) = split(&run_s(d.path(), &args("elsewhere/renamed.obj")));
+    assert_eq!((body.as_str(), reused, checked), (cold.as_str(), n, 0), "the index is found by content");
+}

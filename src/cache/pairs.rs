@@ -48,7 +48,9 @@
 //! holds results of pairs the run checked (keyed by their pair keys; at most
 //! [`PACK_FINDINGS`] triangle pairs a pack) and the tree sizes it measured (keyed by part key;
 //! the report's memory figures need them); the *index* of the run's lineage (its settings,
-//! input file names and selection) lists the packs to read, newest first. A later run reads
+//! what the inputs are and the selection) lists the packs to read, newest first. The pipeline
+//! names the inputs by content, the digest of their object names, not by file name: a model
+//! saved under a new name, or one of whose parts moved, finds its earlier runs. A later run reads
 //! the index and its packs (at most [`MAX_INDEX`]), reuses what it finds, writes packs of what
 //! it checked and a new index (its packs, then the old packs it reused from; a shard also
 //! keeps the other shards' packs). A lost index or pack (evicted, corrupt, removed, written by
@@ -133,8 +135,8 @@ impl CheckCache {
     /// The cache of a check under `settings` (tolerances resolved) and `sel`, over `store`.
     /// `active` false (the parry cross-check is in the way) checks everything and stores
     /// nothing. A hook already in `sel` (a shard's) is kept: its pairs are the candidates, and
-    /// a stand-in outcome (a merge's) is not cached. `lineage` names the inputs (their file names: the index
-    /// of earlier runs is found by it, never a result).
+    /// a stand-in outcome (a merge's) is not cached. `lineage` names the inputs (the index of
+    /// earlier runs is found by it, never a result).
     pub fn new(
         store: Arc<Store>,
         settings: &Settings,
