@@ -588,3 +588,47 @@ fn clear_scene_warm_run_searches_nothing_and_keeps_the_closest_pair() {
     assert_eq!(reused + checked, n);
     step(&even, &[2, 0, 4, 1, 5, 3]);
 }
+
+#[test]
+fn reused_overlap_boxes_equal_the_cold_report_also_after_a_move() {
+    let d = tempfile::tempdir().unwrap();
+    let mut cubes = chain(5);
+    let args = ["scene", "chain.obj", "--no-timings", "--clearance", "0.01"];
+    write(d.path(), "chain.obj", &chain_obj(&cubes));
+    let cold = run_s(d.path(), &with(&args, &[]));
+    let boxes = |r: &str| {
+        let v: serde_json::Value = serde_json::from_str(r).unwrap();
+        v["part_pairs"].as_array().unwrap().iter().filter(|pp| pp["overlap"].is_object()).count()
+    };
+    let n = candidates(&cold);
+    assert_eq!(boxes(&cold), n as usize, "every neighbour pair has its overlap box");
+    run_s(d.path(), &with(&args, &["--cache", "c"]));
+    let (body, (reused, checked, _)) = split(&run_s(d.path(), &with(&args, &["--cache", "c"])));
+    assert_eq!((body.as_str(), reused, checked), (cold.as_str(), n, 0));
+    // The middle cube grows into its neighbours: its two boxes change, the others are reused.
+    cubes[2].1[0] -= 0.125;
+    write(d.path(), "chain.obj", &chain_obj(&cubes));
+    let cold2 = run_s(d.path(), &with(&args, &[]));
+    assert_ne!(cold2, cold);
+    let (body, (reused, checked, _)) = split(&run_s(d.path(), &with(&args, &["--cache", "c"])));
+    assert_eq!((body.as_str(), reused, checked), (cold2.as_str(), n - 2, 2));
+    assert_eq!(boxes(&body), n as usize);
+}
+
+#[test]
+fn a_model_saved_under_another_name_reuses_its_pairs() {
+    let d = tempfile::tempdir().unwrap();
+    let args = |f: &str| with(&["scene", f, "--no-timings", "--clearance", "0.01"], &["--cache", "c"]);
+    write(d.path(), "chain.obj", &chain_obj(&chain(5)));
+    let first = split(&run_s(d.path(), &args("chain.obj")));
+    let n = candidates(&first.0);
+    assert_eq!((first.1 .0, first.1 .1), (0, n));
+    std::fs::create_dir(d.path().join("elsewhere")).unwrap();
+    std::fs::rename(d.path().join("chain.obj"), d.path().join("elsewhere/renamed.obj")).unwrap();
+    let cold = run_s(
+        d.path(),
+        &with(&["scene", "elsewhere/renamed.obj", "--no-timings", "--clearance", "0.01"], &[]),
+    );
+    let (body, (reused, checked, _)) = split(&run_s(d.path(), &args("elsewhere/renamed.obj")));
+    assert_eq!((body.as_str(), reused, checked), (cold.as_str(), n, 0), "the index is found by content");
+}

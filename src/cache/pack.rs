@@ -27,6 +27,8 @@
 //! | 8 + 2 × 28 | the closest pair: distance bits, then for A and B the triangle (u32) and the witness point (3 × f64 bits) |
 //! | 1 | 1 when a bound follows, else 0 (see [`Stored::beyond`]) |
 //! | 48 | the bound: the 32-byte numbering digest, the triangles in A and B (u32 each), the distance bits |
+//! | 1 | the overlap box (see [`Stored::overlap`]): 0 not known, 1 known to be none, 2 a box follows |
+//! | 48 | the box: its lower, then its upper corner (3 × f64 bits each; finite, lower ≤ upper) |
 //! | 8 | the number of triangle pairs `t` (u64) |
 //! | t × … | each: triangle in A and in B (u32 each), kind (1 byte: 0 crossing, 1 touching, 2 clearance), contact (1 byte: 0 none, 1 point, 2 segment, 3 coplanar area, 4 coplanar boundary), distance bits (u64), 1 when a segment follows (1 byte), the segment (6 × f64 bits) |
 //!
@@ -39,6 +41,7 @@
 //! but does not decode (a foreign or damaged writer) is an error naming the first bad field.
 
 use crate::check::containment::Containment;
+use crate::check::overlap::Overlap;
 use crate::check::query::{ClashResult, Closest, Counts, PairFinding, PairKind, Timings, Verdict};
 use crate::geom::DVec3;
 use crate::narrow::tri_tri::Contact;
@@ -47,13 +50,13 @@ use super::key::Digest;
 
 /// The payload layout byte of packs and indexes; bump it (with [`super::FORMAT`]) when a
 /// layout below changes.
-pub const PACK_LAYOUT: u8 = 1;
+pub const PACK_LAYOUT: u8 = 2;
 
 const PACK_TAG: &[u8; 7] = b"MCLPACK";
 const INDEX_TAG: &[u8; 7] = b"MCLINDX";
 
 /// The fewest bytes one stored result takes (no reason, no closest pair, no triangle pairs).
-const MIN_RESULT: usize = 1 + 32 + 1 + 1 + 1 + 8;
+const MIN_RESULT: usize = 1 + 32 + 1 + 1 + 1 + 1 + 8;
 /// The fewest bytes one triangle pair takes.
 const MIN_FINDING: usize = 4 + 4 + 1 + 1 + 8 + 1;
 
@@ -68,6 +71,11 @@ pub struct Stored {
     /// in the order the scene's closest pair is chosen by (distance, then triangle in A, then
     /// in B, in the input meshes' numbering). `None`: nothing is known.
     pub beyond: Option<Beyond>,
+    /// The exact box of the two parts' common volume, as the report carries it for a clashing
+    /// pair ([`crate::check::overlap::overlap_box`] over the two parts): `Some(None)` known to
+    /// be none (a part is open, or nothing is common), `Some(Some(box))` that box, `None` not
+    /// known (a pair that is not a clash, or whose box was not computed).
+    pub overlap: Option<Option<Overlap>>,
 }
 
 /// The least closest-pair candidate a check found over the part pairs it searched together
@@ -188,6 +196,15 @@ impl Writer {
                 self.f64(x.distance);
             }
         }
+        match &s.overlap {
+            None => self.u8(0),
+            Some(None) => self.u8(1),
+            Some(Some(o)) => {
+                self.u8(2);
+                self.point(o.min);
+                self.point(o.max);
+            }
+        }
         self.u64(r.pairs.len() as u64);
         for p in &r.pairs {
             self.u32(p.a);
@@ -222,6 +239,7 @@ fn pack_len(pairs: &[(Digest, Stored)], trees: usize) -> usize {
                 + why
                 + if r.closest.is_some() { 8 + 56 } else { 0 }
                 + if s.beyond.is_some() { 48 } else { 0 }
+                + if matches!(s.overlap, Some(Some(_))) { 48 } else { 0 }
                 + r.pairs.len() * MIN_FINDING
                 + segs * 48
         })
@@ -373,6 +391,18 @@ impl<'a> Reader<'a> {
             }),
             f => return Err(format!("bad bound flag {f}")),
         };
+        let overlap = match self.u8("overlap flag")? {
+            0 => None,
+            1 => Some(None),
+            2 => {
+                let (min, max) = (self.point("overlap")?, self.point("overlap")?);
+                if !(min.is_finite() && max.is_finite() && min.cmple(max).all()) {
+                    return Err(format!("overlap box {min} to {max} is not a box"));
+                }
+                Some(Some(Overlap { min, max }))
+            }
+            f => return Err(format!("bad overlap flag {f}")),
+        };
         let n = self.count(MIN_FINDING, "triangle pairs")?;
         let mut pairs = Vec::with_capacity(n);
         for _ in 0..n {
@@ -410,7 +440,7 @@ impl<'a> Reader<'a> {
             trees: Default::default(),
             timings: Timings::default(),
         };
-        Ok(Stored { result, beyond })
+        Ok(Stored { result, beyond, overlap })
     }
 }
 
@@ -498,7 +528,15 @@ mod tests {
             .map(|(i, c)| {
                 let beyond =
                     (i % 2 == 0).then_some(Beyond { numbering: [i as u8; 32], a: 1, b: 2, distance: 0.5 });
-                ([i as u8 + 1; 32], Stored { result: result(i as u32, c), beyond })
+                let overlap = [
+                    None,
+                    Some(None),
+                    Some(Some(Overlap {
+                        min: DVec3::new(-0.0, 1e-310, -2.0),
+                        max: DVec3::new(0.0, 1.0, 0.1),
+                    })),
+                ][i % 3];
+                ([i as u8 + 1; 32], Stored { result: result(i as u32, c), beyond, overlap })
             })
             .collect();
         Pack { pairs, trees: vec![([9; 32], 123), ([10; 32], u64::MAX)] }

@@ -32,6 +32,12 @@
 //!   The other reused clear pairs are checked again, together, and count as checked; so the
 //!   scene's closest pair is the one a run without the cache finds. A warm re-run of an
 //!   unchanged clear scene searches nothing.
+//! - A clashing pair of two closed parts carries the exact box of their common volume in the
+//!   report ([`crate::check::overlap`]), a function of the two parts alone: it is stored with
+//!   the pair's result (after the check, once the boxes are computed: [`CheckCache::overlaps`])
+//!   and reused with it, so a warm run computes the boxes of the checked pairs only. A reused
+//!   clash whose box is not stored, or whose box does not lie within both parts' boxes, is not
+//!   reused: it is checked again.
 //! - A run where reuse by pair could differ from a whole check falls back to caching the
 //!   whole check ([`WholeCheck`]): file mode (one unit), `--first-hit` (a stop rule),
 //!   a distance error allowance (the reported distance may depend on which pairs are searched
@@ -42,7 +48,9 @@
 //! holds results of pairs the run checked (keyed by their pair keys; at most
 //! [`PACK_FINDINGS`] triangle pairs a pack) and the tree sizes it measured (keyed by part key;
 //! the report's memory figures need them); the *index* of the run's lineage (its settings,
-//! input file names and selection) lists the packs to read, newest first. A later run reads
+//! what the inputs are and the selection) lists the packs to read, newest first. The pipeline
+//! names the inputs by content, the digest of their object names, not by file name: a model
+//! saved under a new name, or one of whose parts moved, finds its earlier runs. A later run reads
 //! the index and its packs (at most [`MAX_INDEX`]), reuses what it finds, writes packs of what
 //! it checked and a new index (its packs, then the old packs it reused from; a shard also
 //! keeps the other shards' packs). A lost index or pack (evicted, corrupt, removed, written by
@@ -70,6 +78,7 @@ use crate::check::assembly::{
     Selection, MAX_CANDIDATE_PART_PAIRS,
 };
 use crate::check::containment::Containment;
+use crate::check::overlap::Overlap;
 use crate::check::query::{ClashResult, Closest, PairFinding, Settings, Timings, Verdict};
 use crate::scene::mesh::Mesh;
 use crate::shard::sha256::Sha256;
@@ -126,8 +135,8 @@ impl CheckCache {
     /// The cache of a check under `settings` (tolerances resolved) and `sel`, over `store`.
     /// `active` false (the parry cross-check is in the way) checks everything and stores
     /// nothing. A hook already in `sel` (a shard's) is kept: its pairs are the candidates, and
-    /// a stand-in outcome (a merge's) is not cached. `lineage` names the inputs (their file names: the index
-    /// of earlier runs is found by it, never a result).
+    /// a stand-in outcome (a merge's) is not cached. `lineage` names the inputs (the index of
+    /// earlier runs is found by it, never a result).
     pub fn new(
         store: Arc<Store>,
         settings: &Settings,
@@ -170,6 +179,7 @@ impl CheckCache {
             delegated: AtomicBool::new(false),
             reused: AtomicU64::new(0),
             checked: AtomicU64::new(0),
+            pending: Mutex::new(None),
         }))
     }
 
@@ -186,6 +196,21 @@ impl CheckCache {
         match self {
             CheckCache::Whole(w) => w.summary(o),
             CheckCache::Pairs(p) => p.summary(o),
+        }
+    }
+
+    /// The overlap boxes of the check's outcome `o` (one per part pair, as
+    /// [`crate::pipeline::Outcome::overlaps`] holds them). `compute` computes the boxes of the
+    /// part pairs (by index in `o.part_pairs`) its argument accepts, None for the others; the
+    /// boxes of reused pairs come from the cache. Then what this run checked is stored, with
+    /// the boxes of its clashing pairs.
+    pub fn overlaps<F>(&self, o: &Outcome, compute: F) -> Vec<Option<Overlap>>
+    where
+        F: FnOnce(&(dyn Fn(usize) -> bool + Sync)) -> Vec<Option<Overlap>>,
+    {
+        match self {
+            CheckCache::Whole(_) => compute(&|_| true),
+            CheckCache::Pairs(p) => p.overlaps(o, compute),
         }
     }
 
@@ -215,6 +240,24 @@ pub struct PairReuse {
     delegated: AtomicBool,
     reused: AtomicU64,
     checked: AtomicU64,
+    /// What the check left for [`PairReuse::overlaps`] to complete and store.
+    pending: Mutex<Option<Pending>>,
+}
+
+/// A run's new results, kept until their overlap boxes are known ([`CheckCache::overlaps`]),
+/// and the boxes of the reused pairs.
+#[derive(Debug, Default)]
+struct Pending {
+    /// (pair key, answer) of the pairs this run checked.
+    fresh: Vec<(Digest, Stored)>,
+    /// Part pair (a, b) -> its place in `fresh` (the last, when checked twice).
+    fresh_at: HashMap<(usize, usize), usize>,
+    /// Tree sizes measured (part key, bytes).
+    trees: Vec<(Digest, u64)>,
+    /// The older packs a pair was reused from.
+    used: Vec<Digest>,
+    /// Part pair (a, b) -> the stored box of each reused clashing pair.
+    boxes: HashMap<(usize, usize), Option<Overlap>>,
 }
 
 /// What a run read from the cache.
@@ -309,6 +352,32 @@ fn listed(r: &ClashResult) -> bool {
     r.verdict != Verdict::Clear || r.containment != Containment::None
 }
 
+/// The overlap box a stored result carries, checked against its two parts: `Ok(None)` for a
+/// pair that is not a clash (no box is reported), `Ok(Some(b))` the stored box `b` of a
+/// clashing pair (`b` None: known to have none). A clashing pair without a known box, or whose
+/// box does not lie within both parts' boxes (where A ∩ B lies, and its bounds correctly
+/// rounded too), is an error: the pair is not reused.
+fn stored_box(s: &Stored, pa: &Part, pb: &Part) -> Result<Option<Option<Overlap>>, String> {
+    if s.result.verdict != Verdict::Clash {
+        return Ok(None);
+    }
+    match s.overlap {
+        None => Err("a clash stored without its overlap box".into()),
+        Some(None) => Ok(Some(None)),
+        Some(Some(o)) => {
+            let within = |b: &crate::geom::Aabb| b.min.cmple(o.min).all() && o.max.cmple(b.max).all();
+            if within(&pa.bounds) && within(&pb.bounds) {
+                Ok(Some(Some(o)))
+            } else {
+                Err(format!(
+                    "overlap box {} to {} outside the parts {} and {}",
+                    o.min, o.max, pa.name, pb.name
+                ))
+            }
+        }
+    }
+}
+
 impl PairReuse {
     fn summary(&self, o: &Outcome) -> CacheSummary {
         if self.delegated.load(Ordering::Relaxed) {
@@ -319,6 +388,33 @@ impl PairReuse {
             part_pairs_checked: self.checked.load(Ordering::Relaxed),
             dir: self.store.dir().to_string_lossy().into_owned(),
         }
+    }
+
+    fn overlaps<F>(&self, o: &Outcome, compute: F) -> Vec<Option<Overlap>>
+    where
+        F: FnOnce(&(dyn Fn(usize) -> bool + Sync)) -> Vec<Option<Overlap>>,
+    {
+        let pending = self.pending.lock().unwrap_or_else(|p| p.into_inner()).take();
+        let Some(mut pending) = pending else {
+            // The check was not by pairs (delegated, or stood in for by a merge).
+            return compute(&|_| true);
+        };
+        let stored: Vec<Option<Option<Overlap>>> =
+            o.part_pairs.iter().map(|pp| pending.boxes.get(&(pp.a, pp.b)).copied()).collect();
+        let mut out = compute(&|k| stored.get(k).is_none_or(Option::is_none));
+        for (k, pp) in o.part_pairs.iter().enumerate() {
+            if let Some(b) = stored[k] {
+                out[k] = b;
+            } else if pp.verdict == Verdict::Clash {
+                if let Some(&i) = pending.fresh_at.get(&(pp.a, pp.b)) {
+                    pending.fresh[i].1.overlap = Some(out[k]);
+                }
+            }
+        }
+        if !pending.fresh.is_empty() || !pending.trees.is_empty() {
+            self.save(pending.fresh, pending.trees, pending.used);
+        }
+        out
     }
 
     fn load(&self) -> Loaded {
@@ -445,6 +541,7 @@ impl PairReuse {
         let mut loaded = self.load();
         // Reuse what is stored.
         let mut beyond: Vec<Option<Beyond>> = vec![None; candidates.len()];
+        let mut boxes: HashMap<(usize, usize), Option<Overlap>> = HashMap::new();
         let mut results: Vec<Option<ClashResult>> = candidates
             .iter()
             .zip(&pair_keys)
@@ -452,10 +549,15 @@ impl PairReuse {
             .map(|((&(a, b), k), bound)| {
                 let (pack, stored) = loaded.pairs.get(k.as_bytes())?;
                 let mut r = stored.result.clone();
-                match to_global(&mut r, &parts[a], &parts[b]) {
-                    Ok(()) => {
+                let fits = to_global(&mut r, &parts[a], &parts[b])
+                    .and_then(|()| stored_box(stored, &parts[a], &parts[b]));
+                match fits {
+                    Ok(overlap) => {
                         loaded.packs[*pack].1 = true;
                         *bound = stored.beyond;
+                        if let Some(o) = overlap {
+                            boxes.insert((a, b), o);
+                        }
                         Some(r)
                     }
                     Err(e) => {
@@ -468,6 +570,7 @@ impl PairReuse {
         let numbering = std::cell::OnceCell::new();
         let numbering = || *numbering.get_or_init(|| numbering_digest(parts));
         let mut fresh: Vec<(Digest, Stored)> = Vec::new();
+        let mut fresh_at: HashMap<(usize, usize), usize> = HashMap::new();
         let mut timings = Timings::default();
         let mut check = |results: &mut Vec<Option<ClashResult>>, which: &HashSet<(usize, usize)>| {
             if which.is_empty() {
@@ -499,7 +602,10 @@ impl PairReuse {
                     keep.closest = None;
                 }
                 if let Some(l) = to_local(&keep, &parts[pp.a], &parts[pp.b]) {
-                    let stored = Stored { result: l, beyond: if clear { bound } else { None } };
+                    // The overlap box is added when it is known (`PairReuse::overlaps`).
+                    let stored =
+                        Stored { result: l, beyond: if clear { bound } else { None }, overlap: None };
+                    fresh_at.insert((pp.a, pp.b), fresh.len());
                     fresh.push((*pair_keys[i].as_bytes(), stored));
                 }
                 results[i] = Some(pp.result);
@@ -571,11 +677,10 @@ impl PairReuse {
             Ok(sizes)
         })
         .ok()?;
-        let any_new = !fresh.is_empty() || !new_trees.is_empty();
         let used: Vec<Digest> = loaded.packs.iter().filter(|(_, u)| *u).map(|(k, _)| *k).collect();
-        if any_new {
-            self.save(fresh, new_trees, used);
-        }
+        // Stored once the overlap boxes of the clashing pairs are known.
+        let pending = Pending { fresh, fresh_at, trees: new_trees, used, boxes };
+        *self.pending.lock().unwrap_or_else(|p| p.into_inner()) = Some(pending);
         self.reused.store(reused, Ordering::Relaxed);
         self.checked.store(checked, Ordering::Relaxed);
         let info = AssemblyInfo {

@@ -774,3 +774,97 @@ fn check_fingerprint_changes_with_every_setting() {
     let distinct: std::collections::HashSet<_> = all.iter().map(|f| f.hex()).collect();
     assert_eq!(distinct.len(), all.len());
 }
+
+/// Closed cubes (OBJ, one `o` group each) of edge 1 at `mins`.
+fn cubes_obj(mins: &[[f64; 3]]) -> String {
+    let faces = [[0, 2, 3, 1], [4, 5, 7, 6], [0, 1, 5, 4], [2, 6, 7, 3], [0, 4, 6, 2], [1, 3, 7, 5]];
+    let mut out = String::new();
+    for (k, m) in mins.iter().enumerate() {
+        out += &format!("o c{k}\n");
+        for i in 0..8 {
+            let [x, y, z] = [i & 1, (i >> 1) & 1, (i >> 2) & 1].map(f64::from);
+            out += &format!("v {} {} {}\n", m[0] + x, m[1] + y, m[2] + z);
+        }
+        for f in faces {
+            let v = f.map(|i| i + 8 * k + 1);
+            out += &format!("f {} {} {}\nf {} {} {}\n", v[0], v[1], v[2], v[0], v[2], v[3]);
+        }
+    }
+    out
+}
+
+/// Every pack in the cache at `dir`: (its key, its payload decoded).
+fn packs_in(dir: &Path) -> Vec<(PairKey, pack::Pack)> {
+    let mut out = Vec::new();
+    for fan in fs::read_dir(dir).unwrap().flatten().filter(|e| e.path().is_dir()) {
+        for e in fs::read_dir(fan.path()).unwrap().flatten() {
+            let hex = format!("{}{}", fan.file_name().to_string_lossy(), e.file_name().to_string_lossy());
+            if hex.len() != 64 {
+                continue;
+            }
+            let mut d = [0u8; 32];
+            for (i, b) in d.iter_mut().enumerate() {
+                *b = u8::from_str_radix(&hex[2 * i..2 * i + 2], 16).unwrap();
+            }
+            let key = PairKey::from_digest(d);
+            let bytes = fs::read(e.path()).unwrap();
+            let payload = entry::decode(&bytes, &key, TOOL_VERSION).unwrap();
+            if let Ok(p) = pack::decode_pack(payload) {
+                out.push((key, p));
+            }
+        }
+    }
+    out
+}
+
+#[test]
+fn overlap_boxes_are_reused_and_a_wrong_stored_box_is_recomputed() {
+    use crate::pipeline::{run, Request};
+    let d = tempfile::tempdir().unwrap();
+    let path = d.path().join("cubes.obj");
+    // A chain of overlapping cubes (each pair of neighbours has an overlap box) and one apart.
+    let mins = [[0.0, 0.0, 0.0], [0.5, 0.25, 0.0], [1.25, 0.5, 0.125], [1.75, 0.75, 0.5], [9.0, 0.0, 0.0]];
+    fs::write(&path, cubes_obj(&mins)).unwrap();
+    let mut req = Request::scene(&path);
+    req.deterministic = true;
+    let bits = |o: &crate::pipeline::Outcome| format!("{:?}", o.overlaps);
+    let cold = run(&req, &|_| {}).unwrap();
+    let boxes = cold.overlaps.iter().flatten().count();
+    assert_eq!(boxes, 3, "each neighbour pair has a box: {:?}", cold.overlaps);
+    let n = cold.assembly.info.candidate_part_pairs as u64;
+    let cache = d.path().join("c");
+    req.cache = Some(CacheConfig { dir: cache.clone(), max_bytes: DEFAULT_MAX_BYTES });
+    let counts = |o: &crate::pipeline::Outcome| {
+        let c = o.cache.as_ref().unwrap();
+        (c.part_pairs_reused, c.part_pairs_checked)
+    };
+    let first = run(&req, &|_| {}).unwrap();
+    assert_eq!((bits(&first), counts(&first)), (bits(&cold), (0, n)));
+    // Every clashing pair is stored with its box.
+    let stored: Vec<Option<Option<crate::check::overlap::Overlap>>> =
+        packs_in(&cache).into_iter().flat_map(|(_, p)| p.pairs).map(|(_, s)| s.overlap).collect();
+    assert_eq!(stored.iter().filter(|o| matches!(o, Some(Some(_)))).count(), boxes, "{stored:?}");
+    let warm = run(&req, &|_| {}).unwrap();
+    assert_eq!((bits(&warm), counts(&warm)), (bits(&cold), (n, 0)));
+    assert!(warm.cache_warnings.is_empty(), "{:?}", warm.cache_warnings);
+    // A stored box moved off its parts (the entry resealed, so its checksum holds): the pair is
+    // not reused, it is checked again and its box recomputed.
+    let s = store(&cache);
+    for (key, mut p) in packs_in(&cache) {
+        for (_, st) in &mut p.pairs {
+            if let Some(Some(o)) = &mut st.overlap {
+                o.min.x += 100.0;
+                o.max.x += 100.0;
+            }
+        }
+        s.put_bytes(&key, &pack::encode_pack(&p.pairs, &p.trees));
+    }
+    let spoiled = run(&req, &|_| {}).unwrap();
+    assert_eq!((bits(&spoiled), counts(&spoiled)), (bits(&cold), (n - boxes as u64, boxes as u64)));
+    assert_eq!(spoiled.cache_warnings.len(), boxes, "{:?}", spoiled.cache_warnings);
+    assert!(spoiled.cache_warnings.iter().all(|w| w.contains("overlap box")), "{:?}", spoiled.cache_warnings);
+    // The recomputed boxes were stored again: the next run reuses everything.
+    let again = run(&req, &|_| {}).unwrap();
+    assert_eq!((bits(&again), counts(&again)), (bits(&cold), (n, 0)));
+    assert!(again.cache_warnings.is_empty(), "{:?}", again.cache_warnings);
+}

@@ -614,14 +614,21 @@ pub fn run(req: &Request, progress: &(dyn Fn(Phase) + Sync)) -> Result<Outcome> 
     progress(Phase::Check);
     let cache = store.map(|s| {
         let active = !req.cross_check;
-        // The inputs' file names: the cache finds its index of earlier runs by them (never a
-        // result: results are found by content), wherever the files sit.
-        let lineage: Vec<String> = req
-            .inputs
-            .iter()
-            .map(|i| i.path().file_name().map_or_else(String::new, |n| n.to_string_lossy().into_owned()))
-            .map(|p| format!("{}:{p}", p.len()))
-            .collect();
+        // What the inputs are, by content rather than file name: the names of their objects
+        // (each input's object count, then each name's length and text). The cache finds its
+        // index of earlier runs by it (never a result: results are found by their geometry),
+        // so a model saved under another name or moved elsewhere finds its earlier runs, and
+        // a moved or reshaped part keeps its model's index.
+        let mut sha = crate::shard::sha256::Sha256::default();
+        let sides = if req.selection.scene { 1 } else { 2 };
+        for mesh in [&a.mesh, &b.mesh].into_iter().take(sides) {
+            sha.update(&(mesh.objects.len() as u64).to_le_bytes());
+            for o in &mesh.objects {
+                sha.update(&(o.name.len() as u64).to_le_bytes());
+                sha.update(o.name.as_bytes());
+            }
+        }
+        let lineage: String = sha.digest().iter().map(|b| format!("{b:02x}")).collect();
         crate::cache::CheckCache::new(
             std::sync::Arc::new(s),
             &settings,
@@ -629,7 +636,7 @@ pub fn run(req: &Request, progress: &(dyn Fn(Phase) + Sync)) -> Result<Outcome> 
             req.split_bodies,
             req.penetration,
             active,
-            &lineage.join(","),
+            &format!("objects:{lineage}"),
         )
     });
     let selection = cache.as_ref().map(|c| c.selection(&req.selection));
@@ -663,8 +670,14 @@ pub fn run(req: &Request, progress: &(dyn Fn(Phase) + Sync)) -> Result<Outcome> 
     } else {
         Vec::new()
     };
-    let overlaps =
-        overlaps::overlaps(&outcome, &a.mesh, &b.mesh, req.selection.scene, req.settings.bvh, |_| true);
+    let compute = |need: &(dyn Fn(usize) -> bool + Sync)| {
+        overlaps::overlaps(&outcome, &a.mesh, &b.mesh, req.selection.scene, req.settings.bvh, need)
+    };
+    // With the cache, the boxes of reused pairs come from it (and the new ones are stored).
+    let overlaps = match &cache {
+        Some(c) => c.overlaps(&outcome, compute),
+        None => compute(&|_| true),
+    };
     let files_overlap =
         overlaps::files_overlap(&outcome, &a.mesh, &b.mesh, req.selection.scene, req.settings.bvh);
     let listed = listed_pairs(&result.pairs, req.max_pairs);
