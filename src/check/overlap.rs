@@ -60,6 +60,7 @@ struct Point {
 
 /// The exact box of the candidate points seen so far, with f64 bounds that let most vertices
 /// be skipped without exact arithmetic.
+#[derive(Clone)]
 struct ExactBox {
     frame: Frame,
     lo: [Option<Ratio>; 3],
@@ -81,23 +82,38 @@ impl ExactBox {
 
     fn add(&mut self, p: Point) {
         for k in 0..3 {
-            let r = || Ratio::new(p.num[k].clone(), p.den.clone());
-            let mut changed = false;
-            if self.lo[k].as_ref().is_none_or(|lo| r().cmp_value(lo).is_lt()) {
-                self.lo[k] = Some(r());
-                changed = true;
-            }
-            if self.hi[k].as_ref().is_none_or(|hi| r().cmp_value(hi).is_gt()) {
-                self.hi[k] = Some(r());
-                changed = true;
-            }
-            if changed {
-                let base = self.frame.base();
-                let lo = self.lo[k].as_ref().map_or(f64::INFINITY, |r| r.round(base).next_up());
-                let hi = self.hi[k].as_ref().map_or(f64::NEG_INFINITY, |r| r.round(base).next_down());
-                self.inner[k] = (lo, hi);
+            let r = Ratio::new(p.num[k].clone(), p.den.clone());
+            self.extend(k, &r, &r);
+        }
+    }
+
+    /// Widen axis `k` to take in `[lo, hi]`.
+    fn extend(&mut self, k: usize, lo: &Ratio, hi: &Ratio) {
+        let mut changed = false;
+        if self.lo[k].as_ref().is_none_or(|cur| lo.cmp_value(cur).is_lt()) {
+            self.lo[k] = Some(lo.clone());
+            changed = true;
+        }
+        if self.hi[k].as_ref().is_none_or(|cur| hi.cmp_value(cur).is_gt()) {
+            self.hi[k] = Some(hi.clone());
+            changed = true;
+        }
+        if changed {
+            let base = self.frame.base();
+            let lo = self.lo[k].as_ref().map_or(f64::INFINITY, |r| r.round(base).next_up());
+            let hi = self.hi[k].as_ref().map_or(f64::NEG_INFINITY, |r| r.round(base).next_down());
+            self.inner[k] = (lo, hi);
+        }
+    }
+
+    /// The box of both boxes' points (same frame).
+    fn merge(mut self, other: ExactBox) -> ExactBox {
+        for k in 0..3 {
+            if let (Some(lo), Some(hi)) = (&other.lo[k], &other.hi[k]) {
+                self.extend(k, lo, hi);
             }
         }
+        self
     }
 
     fn add_vertex(&mut self, v: DVec3) {
@@ -133,26 +149,12 @@ impl ExactBox {
 
 /// Per triangle of `m`: is it proper (not degenerate)? Decided once per box.
 fn proper<M: TriMesh + ?Sized>(m: &M) -> Vec<bool> {
-    (0..m.triangle_count() as u32).map(|t| !Shape::of(&m.triangle(t)).is_degenerate()).collect()
-}
-
-/// The undirected edges (vertex index pairs) of the proper triangles of `m` (`proper` from
-/// [`proper`]).
-fn edges<M: TriMesh + ?Sized>(m: &M, proper: &[bool]) -> Vec<(u32, u32)> {
-    let mut out = Vec::with_capacity(m.triangle_count() * 3);
-    for t in 0..m.triangle_count() as u32 {
-        if !proper[t as usize] {
-            continue;
-        }
-        let v = m.indices(t);
-        for k in 0..3 {
-            let (a, b) = (v[k], v[(k + 1) % 3]);
-            out.push((a.min(b), a.max(b)));
-        }
-    }
-    out.sort_unstable();
-    out.dedup();
-    out
+    use rayon::prelude::*;
+    (0..m.triangle_count() as u32)
+        .into_par_iter()
+        .with_min_len(4096)
+        .map(|t| !Shape::of(&m.triangle(t)).is_degenerate())
+        .collect()
 }
 
 /// The point `p + t (q - p)` for `t = n / d` (`d != 0`).
@@ -271,54 +273,82 @@ where
         return None;
     }
     let frame = Frame::of_points(a.positions().iter().chain(b.positions().iter()));
-    let mut acc = ExactBox::new(frame);
-    let (pa, pb) = (proper(a), proper(b));
-    edges_against(&mut acc, (a, &pa), (b, &pb), tb);
-    edges_against(&mut acc, (b, &pb), (a, &pa), ta);
-    vertices_inside(&mut acc, (a, &pa), b, tb)?;
-    vertices_inside(&mut acc, (b, &pb), a, ta)?;
+    let (pa, pb) = rayon::join(|| proper(a), || proper(b));
+    let (ea, eb) = rayon::join(
+        || edges_against(&ExactBox::new(frame), (a, &pa), (b, &pb), tb),
+        || edges_against(&ExactBox::new(frame), (b, &pb), (a, &pa), ta),
+    );
+    let mut acc = ea.merge(eb);
+    let mut cand = Vec::new();
+    candidates(&acc, 0, (a, &pa), &tb.root_box(), &mut cand);
+    candidates(&acc, 1, (b, &pb), &ta.root_box(), &mut cand);
+    vertices_inside(&mut acc, &cand, [&|p| inside_or_on(p, b, tb), &|p| inside_or_on(p, a, ta)])?;
     acc.finish()
 }
 
-/// The points where the edges of `m` meet the faces of `other` (tree `tree`).
+/// The points where the edges of `m` meet the faces of `other` (tree `tree`), added to a copy
+/// of `start`.
 ///
 /// Every such point lies on its edge and in its triangle, so inside the f64 boxes of both: an
 /// edge (or an edge–triangle pair) whose box lies strictly inside the box found so far cannot
 /// move it and is skipped without a tree walk (or without exact arithmetic). The skipped
-/// points would not have changed any bound, so the box is the same; only work is saved.
-fn edges_against<M, O, T>(acc: &mut ExactBox, (m, pm): (&M, &[bool]), (other, po): (&O, &[bool]), tree: &T)
+/// points would not have changed any bound, so the box is the same; only work is saved. Runs
+/// of triangles go in parallel, each into its own box, and the boxes are merged: the exact box
+/// of all the points whatever the split. An edge shared by two triangles is visited from both
+/// (the same points twice change nothing).
+fn edges_against<M, O, T>(
+    start: &ExactBox,
+    (m, pm): (&M, &[bool]),
+    (other, po): (&O, &[bool]),
+    tree: &T,
+) -> ExactBox
 where
     M: TriMesh + ?Sized,
     O: TriMesh + ?Sized,
     T: Tree + ?Sized,
 {
+    use rayon::prelude::*;
+    const RUN: u32 = 8192;
     let other_box = tree.root_box();
-    for (i, j) in edges(m, pm) {
-        let (p, q) = (m.vertex(i), m.vertex(j));
-        let seg = Aabb { min: p.min(q), max: p.max(q) };
-        if !seg.overlaps(&other_box) || acc.strictly_contains(&seg) {
-            continue;
-        }
-        traverse::any_in_box(tree, &seg, |t| {
-            let tri = other.triangle(t);
-            let tb = Aabb::of_triangle(&tri);
-            let common = Aabb { min: seg.min.max(tb.min), max: seg.max.min(tb.max) };
-            if po[t as usize] && !acc.strictly_contains(&common) {
-                edge_face(acc, p, q, tri);
+    let n = m.triangle_count() as u32;
+    let run = |first: u32| {
+        let mut acc = start.clone();
+        for t in first..(first + RUN).min(n) {
+            if !pm[t as usize] {
+                continue;
             }
-            false
-        });
-    }
+            let v = m.indices(t);
+            for k in 0..3 {
+                let (p, q) = (m.vertex(v[k]), m.vertex(v[(k + 1) % 3]));
+                let seg = Aabb { min: p.min(q), max: p.max(q) };
+                if !seg.overlaps(&other_box) || acc.strictly_contains(&seg) {
+                    continue;
+                }
+                traverse::any_in_box(tree, &seg, |t| {
+                    let tri = other.triangle(t);
+                    let tb = Aabb::of_triangle(&tri);
+                    let common = Aabb { min: seg.min.max(tb.min), max: seg.max.min(tb.max) };
+                    if po[t as usize] && !acc.strictly_contains(&common) {
+                        edge_face(&mut acc, p, q, tri);
+                    }
+                    false
+                });
+            }
+        }
+        acc
+    };
+    (0..n.div_ceil(RUN)).into_par_iter().map(|r| run(r * RUN)).reduce(|| start.clone(), ExactBox::merge)
 }
 
-/// The vertices of `m` (of its proper triangles) inside or on `other`; None when one cannot be
-/// decided.
-fn vertices_inside<M, O, T>(acc: &mut ExactBox, (m, pm): (&M, &[bool]), other: &O, tree: &T) -> Option<()>
-where
-    M: TriMesh + ?Sized,
-    O: TriMesh + ?Sized,
-    T: Tree + ?Sized,
-{
+/// Into `out`: the vertices of `m` (part `s`; of its proper triangles) outside the box so far
+/// and inside the other part's box `other_box`, as (part, vertex, point).
+fn candidates<M: TriMesh + ?Sized>(
+    acc: &ExactBox,
+    s: usize,
+    (m, pm): (&M, &[bool]),
+    other_box: &Aabb,
+    out: &mut Vec<(usize, u32, DVec3)>,
+) {
     let mut used = vec![false; m.vertex_count()];
     for t in 0..m.triangle_count() as u32 {
         if pm[t as usize] {
@@ -327,11 +357,53 @@ where
     }
     for v in (0..used.len()).filter(|&v| used[v]) {
         let p = m.vertex(v as u32);
-        if acc.strictly_inside(p) {
-            continue;
+        if !acc.strictly_inside(p) && other_box.contains(&Aabb { min: p, max: p }) {
+            out.push((s, v as u32, p));
         }
-        if inside_or_on(p, other, tree)? {
-            acc.add_vertex(p);
+    }
+}
+
+/// Add the vertices of A inside or on B and of B inside or on A that can move a bound; None
+/// when one of those cannot be decided.
+///
+/// `cand` is from [`candidates`] (only those vertices can move the box) and
+/// `inside_other[s]` tests a point of part `s` against the other part. For each side of each axis, those beyond that side are
+/// tested from the most extreme inwards: the first one inside fixes the side (every later one
+/// lies at or inside it), so a side costs one point query when its extreme vertex is inside,
+/// and vertices that cannot move any side cost none. The box is the box of all inside
+/// vertices, as if every vertex were tested.
+fn vertices_inside(
+    acc: &mut ExactBox,
+    cand: &[(usize, u32, DVec3)],
+    inside_other: [&dyn Fn(DVec3) -> Option<bool>; 2],
+) -> Option<()> {
+    // Per candidate: 0 untested, 1 inside or on, 2 outside.
+    let mut state = vec![0u8; cand.len()];
+    for k in 0..3 {
+        for upper in [false, true] {
+            // Beyond the side now (the side only moves outwards, so this is a superset of the
+            // candidates beyond it later), most extreme first; ties by part and vertex.
+            let beyond =
+                |p: DVec3, acc: &ExactBox| if upper { p[k] > acc.inner[k].1 } else { p[k] < acc.inner[k].0 };
+            let mut order: Vec<usize> = (0..cand.len()).filter(|&i| beyond(cand[i].2, acc)).collect();
+            order.sort_unstable_by(|&i, &j| {
+                let (x, y) = (cand[i].2[k], cand[j].2[k]);
+                let by = if upper { y.total_cmp(&x) } else { x.total_cmp(&y) };
+                by.then((cand[i].0, cand[i].1).cmp(&(cand[j].0, cand[j].1)))
+            });
+            for i in order {
+                let (s, _, p) = cand[i];
+                if !beyond(p, acc) {
+                    break;
+                }
+                if state[i] == 0 {
+                    state[i] = if inside_other[s](p)? { 1 } else { 2 };
+                }
+                if state[i] == 1 {
+                    acc.add_vertex(p);
+                    break;
+                }
+            }
         }
     }
     Some(())
