@@ -147,14 +147,10 @@ impl ExactBox {
     }
 }
 
-/// Per triangle of `m`: is it proper (not degenerate)? Decided once per box.
-fn proper<M: TriMesh + ?Sized>(m: &M) -> Vec<bool> {
-    use rayon::prelude::*;
-    (0..m.triangle_count() as u32)
-        .into_par_iter()
-        .with_min_len(4096)
-        .map(|t| !Shape::of(&m.triangle(t)).is_degenerate())
-        .collect()
+/// Is triangle `t` of `m` proper (not degenerate)? Asked only of the triangles an edge or a
+/// vertex of the box needs.
+fn proper<M: TriMesh + ?Sized>(m: &M, t: u32) -> bool {
+    !Shape::of(&m.triangle(t)).is_degenerate()
 }
 
 /// The point `p + t (q - p)` for `t = n / d` (`d != 0`).
@@ -273,15 +269,20 @@ where
         return None;
     }
     let frame = Frame::of_points(a.positions().iter().chain(b.positions().iter()));
-    let (pa, pb) = rayon::join(|| proper(a), || proper(b));
-    let (ea, eb) = rayon::join(
-        || edges_against(&ExactBox::new(frame), (a, &pa), (b, &pb), tb),
-        || edges_against(&ExactBox::new(frame), (b, &pb), (a, &pa), ta),
-    );
-    let mut acc = ea.merge(eb);
+    // Every 8th run of triangles first, from nothing; then the rest from the box they found,
+    // so most edges of the rest lie strictly inside it and need no tree walk.
+    let empty = ExactBox::new(frame);
+    let seed = |r: u32| r.is_multiple_of(8);
+    let rest = |r: u32| !r.is_multiple_of(8);
+    let (sa, sb) =
+        rayon::join(|| edges_against(&empty, a, (b, tb), seed), || edges_against(&empty, b, (a, ta), seed));
+    let seeded = sa.merge(sb);
+    let (ra, rb) =
+        rayon::join(|| edges_against(&seeded, a, (b, tb), rest), || edges_against(&seeded, b, (a, ta), rest));
+    let mut acc = ra.merge(rb);
     let mut cand = Vec::new();
-    candidates(&acc, 0, (a, &pa), &tb.root_box(), &mut cand);
-    candidates(&acc, 1, (b, &pb), &ta.root_box(), &mut cand);
+    candidates(&acc, 0, a, &tb.root_box(), &mut cand);
+    candidates(&acc, 1, b, &ta.root_box(), &mut cand);
     vertices_inside(&mut acc, &cand, [&|p| inside_or_on(p, b, tb), &|p| inside_or_on(p, a, ta)])?;
     acc.finish()
 }
@@ -298,9 +299,9 @@ where
 /// (the same points twice change nothing).
 fn edges_against<M, O, T>(
     start: &ExactBox,
-    (m, pm): (&M, &[bool]),
-    (other, po): (&O, &[bool]),
-    tree: &T,
+    m: &M,
+    (other, tree): (&O, &T),
+    runs: impl Fn(u32) -> bool + Sync,
 ) -> ExactBox
 where
     M: TriMesh + ?Sized,
@@ -308,27 +309,28 @@ where
     T: Tree + ?Sized,
 {
     use rayon::prelude::*;
-    const RUN: u32 = 8192;
+    const RUN: u32 = 4096;
     let other_box = tree.root_box();
     let n = m.triangle_count() as u32;
     let run = |first: u32| {
         let mut acc = start.clone();
         for t in first..(first + RUN).min(n) {
-            if !pm[t as usize] {
-                continue;
-            }
             let v = m.indices(t);
+            let mut is_proper = None;
             for k in 0..3 {
                 let (p, q) = (m.vertex(v[k]), m.vertex(v[(k + 1) % 3]));
                 let seg = Aabb { min: p.min(q), max: p.max(q) };
                 if !seg.overlaps(&other_box) || acc.strictly_contains(&seg) {
                     continue;
                 }
+                if !*is_proper.get_or_insert_with(|| proper(m, t)) {
+                    break;
+                }
                 traverse::any_in_box(tree, &seg, |t| {
                     let tri = other.triangle(t);
                     let tb = Aabb::of_triangle(&tri);
                     let common = Aabb { min: seg.min.max(tb.min), max: seg.max.min(tb.max) };
-                    if po[t as usize] && !acc.strictly_contains(&common) {
+                    if !acc.strictly_contains(&common) && proper(other, t) {
                         edge_face(&mut acc, p, q, tri);
                     }
                     false
@@ -337,30 +339,45 @@ where
         }
         acc
     };
-    (0..n.div_ceil(RUN)).into_par_iter().map(|r| run(r * RUN)).reduce(|| start.clone(), ExactBox::merge)
+    (0..n.div_ceil(RUN))
+        .into_par_iter()
+        .filter(|&r| runs(r))
+        .map(|r| run(r * RUN))
+        .reduce(|| start.clone(), ExactBox::merge)
 }
 
 /// Into `out`: the vertices of `m` (part `s`; of its proper triangles) outside the box so far
-/// and inside the other part's box `other_box`, as (part, vertex, point).
+/// and inside the other part's box `other_box`, as (part, vertex, point). Only the triangles
+/// at such vertices are asked whether they are proper.
 fn candidates<M: TriMesh + ?Sized>(
     acc: &ExactBox,
     s: usize,
-    (m, pm): (&M, &[bool]),
+    m: &M,
     other_box: &Aabb,
     out: &mut Vec<(usize, u32, DVec3)>,
 ) {
-    let mut used = vec![false; m.vertex_count()];
+    // 0: unused or cannot move the box, 1: a candidate if a proper triangle uses it, 2: one does.
+    let mut state = vec![0u8; m.vertex_count()];
     for t in 0..m.triangle_count() as u32 {
-        if pm[t as usize] {
-            m.indices(t).iter().for_each(|&v| used[v as usize] = true);
-        }
+        m.indices(t).iter().for_each(|&v| state[v as usize] = 1);
     }
-    for v in (0..used.len()).filter(|&v| used[v]) {
+    for (v, st) in state.iter_mut().enumerate() {
         let p = m.vertex(v as u32);
-        if !acc.strictly_inside(p) && other_box.contains(&Aabb { min: p, max: p }) {
-            out.push((s, v as u32, p));
+        if *st == 1 && (acc.strictly_inside(p) || !other_box.contains(&Aabb { min: p, max: p })) {
+            *st = 0;
         }
     }
+    for t in 0..m.triangle_count() as u32 {
+        let v = m.indices(t);
+        if v.iter().any(|&v| state[v as usize] == 1) && proper(m, t) {
+            for &v in &v {
+                if state[v as usize] == 1 {
+                    state[v as usize] = 2;
+                }
+            }
+        }
+    }
+    out.extend((0..state.len()).filter(|&v| state[v] == 2).map(|v| (s, v as u32, m.vertex(v as u32))));
 }
 
 /// Add the vertices of A inside or on B and of B inside or on A that can move a bound; None
