@@ -3,6 +3,7 @@
 
 use super::*;
 use crate::bvh::lazy::LazyBvh;
+use crate::bvh::traverse::Tree;
 use std::borrow::Cow;
 
 /// The exact overlap box of every clashing part pair of two closed parts (None for the other
@@ -37,10 +38,10 @@ pub fn overlaps(
             (i, part_mesh(if part.input == 0 || scene { a } else { b }, part))
         })
         .collect();
-    let solids: std::collections::HashMap<usize, (&Mesh, LazyBvh<'_, Mesh>)> = meshes
+    let solids: std::collections::HashMap<usize, (&Mesh, PartTree<'_>)> = meshes
         .par_iter()
         .filter(|(_, mesh)| crate::check::containment::topology(mesh.as_ref()).closed)
-        .map(|(i, mesh)| (*i, (mesh.as_ref(), LazyBvh::new(mesh.as_ref(), opts))))
+        .map(|(i, mesh)| (*i, (mesh.as_ref(), PartTree::new(mesh.as_ref(), opts))))
         .collect();
     o.part_pairs
         .par_iter()
@@ -82,7 +83,7 @@ pub fn files_overlap<'m>(
     };
     let (sa, sb) = rayon::join(|| solid(a, pa), || solid(b, pb));
     let (ma, mb) = (sa?, sb?);
-    let (ta, tb) = rayon::join(|| LazyBvh::new(ma.as_ref(), opts), || LazyBvh::new(mb.as_ref(), opts));
+    let (ta, tb) = rayon::join(|| PartTree::new(ma.as_ref(), opts), || PartTree::new(mb.as_ref(), opts));
     crate::check::overlap::overlap_box(ma.as_ref(), &ta, mb.as_ref(), &tb)
 }
 
@@ -96,5 +97,60 @@ fn part_mesh<'m>(m: &'m Mesh, part: &assembly::Part) -> Cow<'m, Mesh> {
         Cow::Borrowed(m)
     } else {
         Cow::Owned(m.sub_mesh(&part.triangles))
+    }
+}
+
+/// Parts with fewer triangles get an eager tree: for them the lazy tree's passes cost more than
+/// building the whole tree. A cost knob only (the box does not depend on the tree).
+const EAGER_BELOW: usize = 4096;
+
+/// A part's tree for its overlap boxes: eager when small, lazy otherwise (only the cells the
+/// edge and point queries open get built).
+enum PartTree<'m> {
+    Eager(crate::bvh::Bvh),
+    Lazy(LazyBvh<'m, Mesh>),
+}
+
+impl<'m> PartTree<'m> {
+    fn new(m: &'m Mesh, opts: BuildOptions) -> PartTree<'m> {
+        if m.triangles.len() < EAGER_BELOW {
+            PartTree::Eager(crate::bvh::Bvh::build(m, opts))
+        } else {
+            PartTree::Lazy(LazyBvh::new(m, opts))
+        }
+    }
+
+    fn tree(&self) -> &dyn Tree {
+        match self {
+            PartTree::Eager(t) => t,
+            PartTree::Lazy(t) => t,
+        }
+    }
+}
+
+impl Tree for PartTree<'_> {
+    fn is_empty(&self) -> bool {
+        self.tree().is_empty()
+    }
+    fn is_leaf(&self, i: u32) -> bool {
+        self.tree().is_leaf(i)
+    }
+    fn children(&self, i: u32) -> [u32; 2] {
+        self.tree().children(i)
+    }
+    fn node_box(&self, i: u32) -> Aabb {
+        self.tree().node_box(i)
+    }
+    fn leaf_prims(&self, i: u32) -> &[u32] {
+        self.tree().leaf_prims(i)
+    }
+    fn subtree_prims(&self, i: u32) -> &[u32] {
+        self.tree().subtree_prims(i)
+    }
+    fn id_bound(&self) -> usize {
+        self.tree().id_bound()
+    }
+    fn stats(&self) -> crate::bvh::Stats {
+        self.tree().stats()
     }
 }
