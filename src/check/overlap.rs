@@ -486,6 +486,50 @@ mod tests {
         DVec3::new(x, y, z)
     }
 
+    /// The box with nothing skipped: every edge against every face, every vertex tested.
+    fn brute(a: &Mesh, b: &Mesh) -> Option<Overlap> {
+        let (ta, tb) = (Bvh::build(a, BuildOptions::default()), Bvh::build(b, BuildOptions::default()));
+        let mut acc = ExactBox::new(Frame::of_points(a.positions.iter().chain(b.positions.iter())));
+        for (m, o, to) in [(a, b, &tb), (b, a, &ta)] {
+            for t in 0..m.triangles.len() as u32 {
+                let v = m.indices(t);
+                for k in 0..3 {
+                    for u in 0..o.triangles.len() as u32 {
+                        edge_face(&mut acc, m.vertex(v[k]), m.vertex(v[(k + 1) % 3]), o.triangle(u));
+                    }
+                }
+            }
+            for &p in &m.positions {
+                if inside_or_on(p, o, to)? {
+                    acc.add_vertex(p);
+                }
+            }
+        }
+        acc.finish()
+    }
+
+    #[test]
+    fn skipping_edges_and_vertices_gives_the_brute_force_box() {
+        let a = grid_box(v(0.0, 0.0, 0.0), v(2.0, 1.0, 1.0), 3);
+        for (i, off) in [v(0.5, 0.25, -0.5), v(-1.0, 0.5, 0.5), v(1.5, -0.5, 0.25), v(0.25, 0.25, 0.25)]
+            .into_iter()
+            .enumerate()
+        {
+            // A tilted tetrahedron moved to each offset.
+            let t = Mesh {
+                positions: [v(0.0, 0.0, 0.0), v(1.5, 0.25, 0.0), v(0.25, 1.25, 0.1), v(0.3, 0.2, 1.1)]
+                    .map(|p| p + off)
+                    .to_vec(),
+                triangles: vec![[0, 2, 1], [0, 1, 3], [0, 3, 2], [1, 2, 3]],
+                tri_object: vec![0; 4],
+                objects: vec![Object::default()],
+            };
+            assert!(brute(&a, &t).is_some(), "offset {i}: they overlap");
+            assert_eq!(boxed(&a, &t), brute(&a, &t), "offset {i}");
+            assert_eq!(boxed(&t, &a), brute(&a, &t), "offset {i}");
+        }
+    }
+
     #[test]
     fn boxes_overlap_in_their_common_box_at_every_tessellation() {
         for n in [1, 2, 3, 5] {
