@@ -60,6 +60,7 @@ struct Point {
 
 /// The exact box of the candidate points seen so far, with f64 bounds that let most vertices
 /// be skipped without exact arithmetic.
+#[derive(Clone)]
 struct ExactBox {
     frame: Frame,
     lo: [Option<Ratio>; 3],
@@ -81,23 +82,38 @@ impl ExactBox {
 
     fn add(&mut self, p: Point) {
         for k in 0..3 {
-            let r = || Ratio::new(p.num[k].clone(), p.den.clone());
-            let mut changed = false;
-            if self.lo[k].as_ref().is_none_or(|lo| r().cmp_value(lo).is_lt()) {
-                self.lo[k] = Some(r());
-                changed = true;
-            }
-            if self.hi[k].as_ref().is_none_or(|hi| r().cmp_value(hi).is_gt()) {
-                self.hi[k] = Some(r());
-                changed = true;
-            }
-            if changed {
-                let base = self.frame.base();
-                let lo = self.lo[k].as_ref().map_or(f64::INFINITY, |r| r.round(base).next_up());
-                let hi = self.hi[k].as_ref().map_or(f64::NEG_INFINITY, |r| r.round(base).next_down());
-                self.inner[k] = (lo, hi);
+            let r = Ratio::new(p.num[k].clone(), p.den.clone());
+            self.extend(k, &r, &r);
+        }
+    }
+
+    /// Widen axis `k` to take in `[lo, hi]`.
+    fn extend(&mut self, k: usize, lo: &Ratio, hi: &Ratio) {
+        let mut changed = false;
+        if self.lo[k].as_ref().is_none_or(|cur| lo.cmp_value(cur).is_lt()) {
+            self.lo[k] = Some(lo.clone());
+            changed = true;
+        }
+        if self.hi[k].as_ref().is_none_or(|cur| hi.cmp_value(cur).is_gt()) {
+            self.hi[k] = Some(hi.clone());
+            changed = true;
+        }
+        if changed {
+            let base = self.frame.base();
+            let lo = self.lo[k].as_ref().map_or(f64::INFINITY, |r| r.round(base).next_up());
+            let hi = self.hi[k].as_ref().map_or(f64::NEG_INFINITY, |r| r.round(base).next_down());
+            self.inner[k] = (lo, hi);
+        }
+    }
+
+    /// The box of both boxes' points (same frame).
+    fn merge(mut self, other: ExactBox) -> ExactBox {
+        for k in 0..3 {
+            if let (Some(lo), Some(hi)) = (&other.lo[k], &other.hi[k]) {
+                self.extend(k, lo, hi);
             }
         }
+        self
     }
 
     fn add_vertex(&mut self, v: DVec3) {
@@ -131,28 +147,10 @@ impl ExactBox {
     }
 }
 
-/// Per triangle of `m`: is it proper (not degenerate)? Decided once per box.
-fn proper<M: TriMesh + ?Sized>(m: &M) -> Vec<bool> {
-    (0..m.triangle_count() as u32).map(|t| !Shape::of(&m.triangle(t)).is_degenerate()).collect()
-}
-
-/// The undirected edges (vertex index pairs) of the proper triangles of `m` (`proper` from
-/// [`proper`]).
-fn edges<M: TriMesh + ?Sized>(m: &M, proper: &[bool]) -> Vec<(u32, u32)> {
-    let mut out = Vec::with_capacity(m.triangle_count() * 3);
-    for t in 0..m.triangle_count() as u32 {
-        if !proper[t as usize] {
-            continue;
-        }
-        let v = m.indices(t);
-        for k in 0..3 {
-            let (a, b) = (v[k], v[(k + 1) % 3]);
-            out.push((a.min(b), a.max(b)));
-        }
-    }
-    out.sort_unstable();
-    out.dedup();
-    out
+/// Is triangle `t` of `m` proper (not degenerate)? Asked only of the triangles an edge or a
+/// vertex of the box needs.
+fn proper<M: TriMesh + ?Sized>(m: &M, t: u32) -> bool {
+    !Shape::of(&m.triangle(t)).is_degenerate()
 }
 
 /// The point `p + t (q - p)` for `t = n / d` (`d != 0`).
@@ -271,67 +269,158 @@ where
         return None;
     }
     let frame = Frame::of_points(a.positions().iter().chain(b.positions().iter()));
-    let mut acc = ExactBox::new(frame);
-    let (pa, pb) = (proper(a), proper(b));
-    edges_against(&mut acc, (a, &pa), (b, &pb), tb);
-    edges_against(&mut acc, (b, &pb), (a, &pa), ta);
-    vertices_inside(&mut acc, (a, &pa), b, tb)?;
-    vertices_inside(&mut acc, (b, &pb), a, ta)?;
+    // Every 8th run of triangles first, from nothing; then the rest from the box they found,
+    // so most edges of the rest lie strictly inside it and need no tree walk.
+    let empty = ExactBox::new(frame);
+    let seed = |r: u32| r.is_multiple_of(8);
+    let rest = |r: u32| !r.is_multiple_of(8);
+    let (sa, sb) =
+        rayon::join(|| edges_against(&empty, a, (b, tb), seed), || edges_against(&empty, b, (a, ta), seed));
+    let seeded = sa.merge(sb);
+    let (ra, rb) =
+        rayon::join(|| edges_against(&seeded, a, (b, tb), rest), || edges_against(&seeded, b, (a, ta), rest));
+    let mut acc = ra.merge(rb);
+    let mut cand = Vec::new();
+    candidates(&acc, 0, a, &tb.root_box(), &mut cand);
+    candidates(&acc, 1, b, &ta.root_box(), &mut cand);
+    vertices_inside(&mut acc, &cand, [&|p| inside_or_on(p, b, tb), &|p| inside_or_on(p, a, ta)])?;
     acc.finish()
 }
 
-/// The points where the edges of `m` meet the faces of `other` (tree `tree`).
+/// The points where the edges of `m` meet the faces of `other` (tree `tree`), added to a copy
+/// of `start`.
 ///
 /// Every such point lies on its edge and in its triangle, so inside the f64 boxes of both: an
 /// edge (or an edge–triangle pair) whose box lies strictly inside the box found so far cannot
 /// move it and is skipped without a tree walk (or without exact arithmetic). The skipped
-/// points would not have changed any bound, so the box is the same; only work is saved.
-fn edges_against<M, O, T>(acc: &mut ExactBox, (m, pm): (&M, &[bool]), (other, po): (&O, &[bool]), tree: &T)
+/// points would not have changed any bound, so the box is the same; only work is saved. Runs
+/// of triangles go in parallel, each into its own box, and the boxes are merged: the exact box
+/// of all the points whatever the split. An edge shared by two triangles is visited from both
+/// (the same points twice change nothing).
+fn edges_against<M, O, T>(
+    start: &ExactBox,
+    m: &M,
+    (other, tree): (&O, &T),
+    runs: impl Fn(u32) -> bool + Sync,
+) -> ExactBox
 where
     M: TriMesh + ?Sized,
     O: TriMesh + ?Sized,
     T: Tree + ?Sized,
 {
+    use rayon::prelude::*;
+    const RUN: u32 = 4096;
     let other_box = tree.root_box();
-    for (i, j) in edges(m, pm) {
-        let (p, q) = (m.vertex(i), m.vertex(j));
-        let seg = Aabb { min: p.min(q), max: p.max(q) };
-        if !seg.overlaps(&other_box) || acc.strictly_contains(&seg) {
-            continue;
-        }
-        traverse::any_in_box(tree, &seg, |t| {
-            let tri = other.triangle(t);
-            let tb = Aabb::of_triangle(&tri);
-            let common = Aabb { min: seg.min.max(tb.min), max: seg.max.min(tb.max) };
-            if po[t as usize] && !acc.strictly_contains(&common) {
-                edge_face(acc, p, q, tri);
+    let n = m.triangle_count() as u32;
+    let run = |first: u32| {
+        let mut acc = start.clone();
+        for t in first..(first + RUN).min(n) {
+            let v = m.indices(t);
+            let mut is_proper = None;
+            for k in 0..3 {
+                let (p, q) = (m.vertex(v[k]), m.vertex(v[(k + 1) % 3]));
+                let seg = Aabb { min: p.min(q), max: p.max(q) };
+                if !seg.overlaps(&other_box) || acc.strictly_contains(&seg) {
+                    continue;
+                }
+                if !*is_proper.get_or_insert_with(|| proper(m, t)) {
+                    break;
+                }
+                traverse::any_in_box(tree, &seg, |t| {
+                    let tri = other.triangle(t);
+                    let tb = Aabb::of_triangle(&tri);
+                    let common = Aabb { min: seg.min.max(tb.min), max: seg.max.min(tb.max) };
+                    if !acc.strictly_contains(&common) && proper(other, t) {
+                        edge_face(&mut acc, p, q, tri);
+                    }
+                    false
+                });
             }
-            false
-        });
-    }
+        }
+        acc
+    };
+    (0..n.div_ceil(RUN))
+        .into_par_iter()
+        .filter(|&r| runs(r))
+        .map(|r| run(r * RUN))
+        .reduce(|| start.clone(), ExactBox::merge)
 }
 
-/// The vertices of `m` (of its proper triangles) inside or on `other`; None when one cannot be
-/// decided.
-fn vertices_inside<M, O, T>(acc: &mut ExactBox, (m, pm): (&M, &[bool]), other: &O, tree: &T) -> Option<()>
-where
-    M: TriMesh + ?Sized,
-    O: TriMesh + ?Sized,
-    T: Tree + ?Sized,
-{
-    let mut used = vec![false; m.vertex_count()];
+/// Into `out`: the vertices of `m` (part `s`; of its proper triangles) outside the box so far
+/// and inside the other part's box `other_box`, as (part, vertex, point). Only the triangles
+/// at such vertices are asked whether they are proper.
+fn candidates<M: TriMesh + ?Sized>(
+    acc: &ExactBox,
+    s: usize,
+    m: &M,
+    other_box: &Aabb,
+    out: &mut Vec<(usize, u32, DVec3)>,
+) {
+    // 0: unused or cannot move the box, 1: a candidate if a proper triangle uses it, 2: one does.
+    let mut state = vec![0u8; m.vertex_count()];
     for t in 0..m.triangle_count() as u32 {
-        if pm[t as usize] {
-            m.indices(t).iter().for_each(|&v| used[v as usize] = true);
+        m.indices(t).iter().for_each(|&v| state[v as usize] = 1);
+    }
+    for (v, st) in state.iter_mut().enumerate() {
+        let p = m.vertex(v as u32);
+        if *st == 1 && (acc.strictly_inside(p) || !other_box.contains(&Aabb { min: p, max: p })) {
+            *st = 0;
         }
     }
-    for v in (0..used.len()).filter(|&v| used[v]) {
-        let p = m.vertex(v as u32);
-        if acc.strictly_inside(p) {
-            continue;
+    for t in 0..m.triangle_count() as u32 {
+        let v = m.indices(t);
+        if v.iter().any(|&v| state[v as usize] == 1) && proper(m, t) {
+            for &v in &v {
+                if state[v as usize] == 1 {
+                    state[v as usize] = 2;
+                }
+            }
         }
-        if inside_or_on(p, other, tree)? {
-            acc.add_vertex(p);
+    }
+    out.extend((0..state.len()).filter(|&v| state[v] == 2).map(|v| (s, v as u32, m.vertex(v as u32))));
+}
+
+/// Add the vertices of A inside or on B and of B inside or on A that can move a bound; None
+/// when one of those cannot be decided.
+///
+/// `cand` is from [`candidates`] (only those vertices can move the box) and
+/// `inside_other[s]` tests a point of part `s` against the other part. For each side of each axis, those beyond that side are
+/// tested from the most extreme inwards: the first one inside fixes the side (every later one
+/// lies at or inside it), so a side costs one point query when its extreme vertex is inside,
+/// and vertices that cannot move any side cost none. The box is the box of all inside
+/// vertices, as if every vertex were tested.
+fn vertices_inside(
+    acc: &mut ExactBox,
+    cand: &[(usize, u32, DVec3)],
+    inside_other: [&dyn Fn(DVec3) -> Option<bool>; 2],
+) -> Option<()> {
+    // Per candidate: 0 untested, 1 inside or on, 2 outside.
+    let mut state = vec![0u8; cand.len()];
+    for k in 0..3 {
+        for upper in [false, true] {
+            // Beyond the side now (the side only moves outwards, so this is a superset of the
+            // candidates beyond it later), most extreme first; ties by part and vertex.
+            let beyond =
+                |p: DVec3, acc: &ExactBox| if upper { p[k] > acc.inner[k].1 } else { p[k] < acc.inner[k].0 };
+            let mut order: Vec<usize> = (0..cand.len()).filter(|&i| beyond(cand[i].2, acc)).collect();
+            order.sort_unstable_by(|&i, &j| {
+                let (x, y) = (cand[i].2[k], cand[j].2[k]);
+                let by = if upper { y.total_cmp(&x) } else { x.total_cmp(&y) };
+                by.then((cand[i].0, cand[i].1).cmp(&(cand[j].0, cand[j].1)))
+            });
+            for i in order {
+                let (s, _, p) = cand[i];
+                if !beyond(p, acc) {
+                    break;
+                }
+                if state[i] == 0 {
+                    state[i] = if inside_other[s](p)? { 1 } else { 2 };
+                }
+                if state[i] == 1 {
+                    acc.add_vertex(p);
+                    break;
+                }
+            }
         }
     }
     Some(())
@@ -395,6 +484,50 @@ mod tests {
 
     fn v(x: f64, y: f64, z: f64) -> DVec3 {
         DVec3::new(x, y, z)
+    }
+
+    /// The box with nothing skipped: every edge against every face, every vertex tested.
+    fn brute(a: &Mesh, b: &Mesh) -> Option<Overlap> {
+        let (ta, tb) = (Bvh::build(a, BuildOptions::default()), Bvh::build(b, BuildOptions::default()));
+        let mut acc = ExactBox::new(Frame::of_points(a.positions.iter().chain(b.positions.iter())));
+        for (m, o, to) in [(a, b, &tb), (b, a, &ta)] {
+            for t in 0..m.triangles.len() as u32 {
+                let v = m.indices(t);
+                for k in 0..3 {
+                    for u in 0..o.triangles.len() as u32 {
+                        edge_face(&mut acc, m.vertex(v[k]), m.vertex(v[(k + 1) % 3]), o.triangle(u));
+                    }
+                }
+            }
+            for &p in &m.positions {
+                if inside_or_on(p, o, to)? {
+                    acc.add_vertex(p);
+                }
+            }
+        }
+        acc.finish()
+    }
+
+    #[test]
+    fn skipping_edges_and_vertices_gives_the_brute_force_box() {
+        let a = grid_box(v(0.0, 0.0, 0.0), v(2.0, 1.0, 1.0), 3);
+        for (i, off) in [v(0.5, 0.25, -0.5), v(-1.0, 0.5, 0.5), v(1.5, -0.5, 0.25), v(0.25, 0.25, 0.25)]
+            .into_iter()
+            .enumerate()
+        {
+            // A tilted tetrahedron moved to each offset.
+            let t = Mesh {
+                positions: [v(0.0, 0.0, 0.0), v(1.5, 0.25, 0.0), v(0.25, 1.25, 0.1), v(0.3, 0.2, 1.1)]
+                    .map(|p| p + off)
+                    .to_vec(),
+                triangles: vec![[0, 2, 1], [0, 1, 3], [0, 3, 2], [1, 2, 3]],
+                tri_object: vec![0; 4],
+                objects: vec![Object::default()],
+            };
+            assert!(brute(&a, &t).is_some(), "offset {i}: they overlap");
+            assert_eq!(boxed(&a, &t), brute(&a, &t), "offset {i}");
+            assert_eq!(boxed(&t, &a), brute(&a, &t), "offset {i}");
+        }
     }
 
     #[test]

@@ -2,9 +2,13 @@
 //! their common volume, and in two-file mode the box for two nested single-part files.
 
 use super::*;
+use crate::bvh::lazy::LazyBvh;
+use crate::bvh::traverse::Tree;
+use std::borrow::Cow;
 
 /// The exact overlap box of every clashing part pair of two closed parts (None for the other
-/// pairs, and for the pairs `need` declines, by their index in `o.part_pairs`). Each part involved is copied and gets a tree once, however many pairs it is in; parts
+/// pairs, and for the pairs `need` declines, by their index in `o.part_pairs`). Each part involved gets a lazy tree once, however many pairs it is in (a part that is a whole
+/// input is used in place, others are copied); parts
 /// and pairs run in parallel, and the answer does not depend on the thread count.
 pub fn overlaps(
     o: &assembly::Outcome,
@@ -27,21 +31,17 @@ pub fn overlaps(
         .collect();
     wanted.sort_unstable();
     wanted.dedup();
-    let solids: std::collections::HashMap<usize, Option<(Mesh, crate::bvh::Bvh)>> = wanted
+    let meshes: Vec<(usize, Cow<'_, Mesh>)> = wanted
         .par_iter()
         .map(|&i| {
             let part = &o.parts[i];
-            let m = if part.input == 0 || scene { a } else { b };
-            let mesh = m.sub_mesh(&part.triangles);
-            let closed = crate::check::containment::topology(&mesh).closed;
-            (
-                i,
-                closed.then(|| {
-                    let tree = crate::bvh::Bvh::build(&mesh, opts);
-                    (mesh, tree)
-                }),
-            )
+            (i, part_mesh(if part.input == 0 || scene { a } else { b }, part))
         })
+        .collect();
+    let solids: std::collections::HashMap<usize, (&Mesh, PartTree<'_>)> = meshes
+        .par_iter()
+        .filter(|(_, mesh)| crate::check::containment::topology(mesh.as_ref()).closed)
+        .map(|(i, mesh)| (*i, (mesh.as_ref(), PartTree::new(mesh.as_ref(), opts))))
         .collect();
     o.part_pairs
         .par_iter()
@@ -50,10 +50,10 @@ pub fn overlaps(
             if pp.verdict != query::Verdict::Clash || !need(k) {
                 return None;
             }
-            let (Some(Some((ma, ta))), Some(Some((mb, tb)))) = (solids.get(&pp.a), solids.get(&pp.b)) else {
+            let (Some((ma, ta)), Some((mb, tb))) = (solids.get(&pp.a), solids.get(&pp.b)) else {
                 return None;
             };
-            crate::check::overlap::overlap_box(ma, ta, mb, tb)
+            crate::check::overlap::overlap_box(*ma, ta, *mb, tb)
         })
         .collect()
 }
@@ -62,10 +62,10 @@ pub fn overlaps(
 /// clash by containment (one inside the other, or volumes overlapping through coincident faces)
 /// while no part pair is a clash to carry the box (a single part per file gets no part pair
 /// for a containment without meeting triangles); None otherwise.
-pub fn files_overlap(
+pub fn files_overlap<'m>(
     o: &assembly::Outcome,
-    a: &Mesh,
-    b: &Mesh,
+    a: &'m Mesh,
+    b: &'m Mesh,
     scene: bool,
     opts: BuildOptions,
 ) -> Option<crate::check::overlap::Overlap> {
@@ -77,14 +77,80 @@ pub fn files_overlap(
     if (pa.input, pb.input) != (0, 1) {
         return None;
     }
-    let solid = |m: &Mesh, part: &assembly::Part| {
-        let mesh = m.sub_mesh(&part.triangles);
-        crate::check::containment::topology(&mesh).closed.then(|| {
-            let tree = crate::bvh::Bvh::build(&mesh, opts);
-            (mesh, tree)
-        })
+    let solid = |m: &'m Mesh, part: &assembly::Part| -> Option<Cow<'m, Mesh>> {
+        let mesh = part_mesh(m, part);
+        crate::check::containment::topology(mesh.as_ref()).closed.then_some(mesh)
     };
     let (sa, sb) = rayon::join(|| solid(a, pa), || solid(b, pb));
-    let ((ma, ta), (mb, tb)) = (sa?, sb?);
-    crate::check::overlap::overlap_box(&ma, &ta, &mb, &tb)
+    let (ma, mb) = (sa?, sb?);
+    let (ta, tb) = rayon::join(|| PartTree::new(ma.as_ref(), opts), || PartTree::new(mb.as_ref(), opts));
+    crate::check::overlap::overlap_box(ma.as_ref(), &ta, mb.as_ref(), &tb)
+}
+
+/// The part's triangles as a mesh of their own: the input itself when the part is all of it
+/// (its triangles in file order are then `0..n`), a copy otherwise. The overlap box is a
+/// function of the solid alone, so it is the same either way.
+fn part_mesh<'m>(m: &'m Mesh, part: &assembly::Part) -> Cow<'m, Mesh> {
+    let whole = part.triangles.len() == m.triangles.len()
+        && part.triangles.iter().enumerate().all(|(k, &t)| t as usize == k);
+    if whole {
+        Cow::Borrowed(m)
+    } else {
+        Cow::Owned(m.sub_mesh(&part.triangles))
+    }
+}
+
+/// Parts with fewer triangles get an eager tree: for them the lazy tree's passes cost more than
+/// building the whole tree. A cost knob only (the box does not depend on the tree).
+const EAGER_BELOW: usize = 4096;
+
+/// A part's tree for its overlap boxes: eager when small, lazy otherwise (only the cells the
+/// edge and point queries open get built).
+enum PartTree<'m> {
+    Eager(crate::bvh::Bvh),
+    Lazy(LazyBvh<'m, Mesh>),
+}
+
+impl<'m> PartTree<'m> {
+    fn new(m: &'m Mesh, opts: BuildOptions) -> PartTree<'m> {
+        if m.triangles.len() < EAGER_BELOW {
+            PartTree::Eager(crate::bvh::Bvh::build(m, opts))
+        } else {
+            PartTree::Lazy(LazyBvh::new(m, opts))
+        }
+    }
+
+    fn tree(&self) -> &dyn Tree {
+        match self {
+            PartTree::Eager(t) => t,
+            PartTree::Lazy(t) => t,
+        }
+    }
+}
+
+impl Tree for PartTree<'_> {
+    fn is_empty(&self) -> bool {
+        self.tree().is_empty()
+    }
+    fn is_leaf(&self, i: u32) -> bool {
+        self.tree().is_leaf(i)
+    }
+    fn children(&self, i: u32) -> [u32; 2] {
+        self.tree().children(i)
+    }
+    fn node_box(&self, i: u32) -> Aabb {
+        self.tree().node_box(i)
+    }
+    fn leaf_prims(&self, i: u32) -> &[u32] {
+        self.tree().leaf_prims(i)
+    }
+    fn subtree_prims(&self, i: u32) -> &[u32] {
+        self.tree().subtree_prims(i)
+    }
+    fn id_bound(&self) -> usize {
+        self.tree().id_bound()
+    }
+    fn stats(&self) -> crate::bvh::Stats {
+        self.tree().stats()
+    }
 }
