@@ -639,6 +639,13 @@ pub fn signed_distance(a: &Placed, b: &Placed, bound: f64) -> Option<Signed> {
     })
 }
 
+/// The signed distance of two placed meshes known to collide through `contact`, a meeting
+/// triangle pair (found by [`meeting_pairs`] with `first`): what [`signed_distance`] answers
+/// when its own search finds that pair, without searching again.
+pub fn signed_meeting(a: &Placed, b: &Placed, contact: &PairFinding) -> Signed {
+    colliding(a, b, &Collision { contacts: vec![*contact], containment: Containment::None })
+}
+
 fn colliding(a: &Placed, b: &Placed, c: &Collision) -> Signed {
     let contact =
         c.contacts.first().map(|p| (p.a as i64, p.b as i64, query::pair_witness(&a.mesh(), &b.mesh(), p)));
@@ -776,6 +783,36 @@ mod tests {
                 }
             }
         }
+    }
+
+    /// The signed distance from a meeting pair found beforehand is the one the full query
+    /// finds (convex and non-convex pairs, crossing and touching).
+    #[test]
+    fn signed_from_a_meeting_pair_equals_the_full_query() {
+        let a = prepared(cube(DVec3::ZERO));
+        let mut two = cube(DVec3::ZERO);
+        let far = cube(DVec3::splat(3.0));
+        two.triangles.extend(far.triangles.iter().map(|t| t.map(|v| v + 8)));
+        two.positions.extend(far.positions);
+        two.tri_object = vec![0; two.triangles.len()];
+        let two = prepared(two);
+        let origin = a.place(DMat4::IDENTITY).unwrap();
+        let mut met = 0;
+        for k in 0..24 {
+            let t = k as f64 * 0.125;
+            let m = DMat4::from_translation(DVec3::new(t, 0.5 - t * 0.25, 0.25)) * DMat4::from_rotation_z(t);
+            for other in [a.place(m).unwrap(), two.place(m).unwrap()] {
+                let (ma, mb, ta, tb) = (origin.mesh(), other.mesh(), origin.tree(), other.tree());
+                let Some(first) = meeting_pairs(&ma, &ta, &mb, &tb, true).into_iter().next() else {
+                    continue;
+                };
+                met += 1;
+                let full = signed_distance(&origin, &other, f64::INFINITY).unwrap();
+                assert_eq!(signed_meeting(&origin, &other, &first), full, "step {k}");
+                assert!(full.distance <= 0.0);
+            }
+        }
+        assert!(met > 10, "{met}");
     }
 
     #[test]

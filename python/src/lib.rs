@@ -864,18 +864,20 @@ fn nearest(
         candidates.iter().copied().filter(|&(i, j)| !a[i].apart(&b[j])).collect();
     // Meeting triangles first (a pair known to collide without containment has them), then
     // containment: the first pair in (i, j) order of the first kind found.
+    // With the meeting pair found, when this search found it (its signed distance is then
+    // computed from it, not searched for again).
     let meeting = |&(i, j): &(usize, usize)| match memo.verdict(key(i, j)) {
-        Some(v) => (v.collides && v.containment.is_none()).then_some((i, j)),
+        Some(v) => (v.collides && v.containment.is_none()).then_some((i, j, None)),
         None if memo.no_meeting(key(i, j)) => None,
         None => {
             let (x, y) = (&a[i], &b[j]);
             let m = api::meeting_pairs(&x.mesh(), &x.tree(), &y.mesh(), &y.tree(), true);
-            if m.is_empty() {
+            let Some(first) = m.into_iter().next() else {
                 memo.keep_no_meeting(key(i, j));
                 return None;
-            }
+            };
             memo.keep_verdict(key(i, j), Verdict { collides: true, containment: None });
-            Some((i, j))
+            Some((i, j, Some(first)))
         }
     };
     let contained = |&(i, j): &(usize, usize)| {
@@ -888,10 +890,21 @@ fn nearest(
                 v
             }
         };
-        v.collides.then_some((i, j))
+        v.collides.then_some((i, j, None))
     };
-    if let Some((i, j)) = find_first(&overlapping, meeting).or_else(|| find_first(&overlapping, contained)) {
-        return Some(near(signed(i, j, 0.0).expect("colliding"), i, j));
+    if let Some((i, j, contact)) =
+        find_first(&overlapping, meeting).or_else(|| find_first(&overlapping, contained))
+    {
+        let s = match (memo.signed(key(i, j)), contact) {
+            (Some(s), _) => s,
+            (None, Some(c)) => {
+                let s = prepared::signed_meeting(&a[i], &b[j], &c);
+                memo.keep_signed(key(i, j), &s);
+                s
+            }
+            (None, None) => signed(i, j, 0.0).expect("colliding"),
+        };
+        return Some(near(s, i, j));
     }
     let key3 = |x: &(f64, usize, usize), y: &(f64, usize, usize)| {
         x.0.total_cmp(&y.0).then((x.1, x.2).cmp(&(y.1, y.2)))
