@@ -9,6 +9,7 @@ use meshclash::cache::CacheConfig;
 use meshclash::check::assembly::Selection;
 use meshclash::check::query::FailOn;
 use meshclash::check::query::{Detail, DistanceError, Mode};
+use meshclash::geom::predicates;
 use meshclash::geom::Aabb;
 use meshclash::pipeline::{Gate, Unit};
 use meshclash::prepared;
@@ -1014,11 +1015,10 @@ impl Sweep {
         out
     }
     /// The objects whose boxes meet `q`, ascending: those whose lower x lies in
-    /// `[q.min.x - 2 widest, q.max.x]` are looked at (a box that meets `q` has its upper x at
-    /// least `q.min.x`, and its lower x within its width of it; twice the widest width leaves
-    /// room for the rounding of the subtractions).
+    /// `[predicates::sweep_start(q.min.x, widest), q.max.x]` are looked at (a box that meets
+    /// `q` has its upper x at least `q.min.x`, and its lower x within its width of it).
     fn against(&self, objs: &[Arc<Placed>], q: &Aabb) -> Vec<usize> {
-        let from = q.min.x - 2.0 * self.widest;
+        let from = predicates::sweep_start(q.min.x, self.widest);
         let start = self.order.partition_point(|x| x.0 < from);
         let end = self.order.partition_point(|x| x.0 <= q.max.x);
         let mut out: Vec<usize> = self.order[start..end.max(start)]

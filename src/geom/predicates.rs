@@ -706,6 +706,17 @@ pub fn distance_lower_bound(p: DVec3, q: DVec3) -> f64 {
     (p - q).length() * (1.0 - 8.0 * UNIT_ROUNDOFF)
 }
 
+/// Where a sweep over boxes sorted by their lower x must start looking for the boxes that meet
+/// a box whose lower x is `min_x`, when every box's x extent, computed in f64, is at most
+/// `widest`: no box with a lower x below the result meets it. Proof: a box `[lo, hi]` that
+/// meets it has `hi >= min_x`; if `lo < min_x`, its exact width `hi - lo` is at least
+/// `D = min_x - lo > 0`, so `widest >= fl(hi - lo) >= fl(D) >= (1 - u) D` (rounding is
+/// monotone), and `min_x - 2 widest <= min_x - 2 (1 - u) D < lo`; the f64 subtraction rounds
+/// monotonically and `lo` is an f64, so the computed start is at most `lo`.
+pub fn sweep_start(min_x: f64, widest: f64) -> f64 {
+    min_x - 2.0 * widest
+}
+
 /// What rounding under one placement can do to a mesh's coincidences and degenerate
 /// triangles. A placement maps each vertex `p` to an f64 `w` within `delta` (a length: the box
 /// map's per-axis slack, as a vector norm) of the exact affine image `R p + t`; `low`, `high`
@@ -1052,5 +1063,29 @@ mod tests {
         let b = Aabb { min: DVec3::new(3.0, 0.0, 0.0), max: DVec3::new(4.0, 1.0, 1.0) };
         assert!(t.boxes_may_meet(&a, &b));
         assert!(!Tolerances::default().boxes_may_meet(&a, &b));
+    }
+
+    /// Boxes whose lower x lies before the sweep's start never meet the query box, at every
+    /// scale (widths of an ulp far from the origin included).
+    #[test]
+    fn sweep_start_misses_no_meeting_box() {
+        let mut x = 0x2545_f491_4f6c_dd1du64;
+        let mut next = move || {
+            x ^= x << 13;
+            x ^= x >> 7;
+            x ^= x << 17;
+            (x >> 11) as f64 / (1u64 << 53) as f64
+        };
+        for _ in 0..20_000 {
+            let at = (next() - 0.5) * 10f64.powf(next() * 16.0 - 4.0);
+            let ulps = |v: f64, k: f64| v + k * v.abs().max(f64::MIN_POSITIVE) * f64::EPSILON;
+            let lo = ulps(at, (next() * 8.0).floor() - 4.0);
+            let hi = ulps(lo, (next() * 8.0).floor());
+            let widest = hi - lo;
+            // Query boxes starting anywhere in the box (it meets them all).
+            for q in [lo, hi, ulps(lo, 1.0).min(hi), (lo + hi) * 0.5] {
+                assert!(sweep_start(q, widest) <= lo, "{lo} {hi} {q}");
+            }
+        }
     }
 }
