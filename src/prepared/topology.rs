@@ -44,7 +44,8 @@ pub struct Fragile {
     /// class_start[c + 1]]`.
     class_start: Vec<u32>,
     class_tris: Vec<u32>,
-    /// Per class, its component (`u32::MAX` when no triangle uses it).
+    /// Per class (as many as the prepared mesh has), its component (`u32::MAX` when no
+    /// triangle uses it).
     class_component: Vec<u32>,
     /// The edges (classes, lower first) of the proper triangles not used exactly twice.
     bad_edges: Vec<(u32, u32)>,
@@ -258,14 +259,25 @@ impl Fragile {
         }
         // Class ids numbered in order of first occurrence: a group keeps its lowest id, the
         // classes absorbed into a lower one are dropped from the numbering.
-        let absorbed: Vec<u32> = involved.iter().copied().filter(|&c| class(c) != c).collect();
-        let merged: Vec<u32> = old
-            .iter()
-            .map(|&c| {
-                let root = class(c);
-                root - absorbed.partition_point(|&x| x < root) as u32
-            })
-            .collect();
+        // One ascending pass over the classes (`involved` is sorted, a root comes before the
+        // classes absorbed into it), then one over the vertices.
+        let mut renumber = Vec::with_capacity(self.class_component.len());
+        let (mut next, mut k) = (0u32, 0usize);
+        for c in 0..self.class_component.len() as u32 {
+            let root = if involved.get(k) == Some(&c) {
+                k += 1;
+                roots[k - 1]
+            } else {
+                c
+            };
+            if root == c {
+                renumber.push(next);
+                next += 1;
+            } else {
+                renumber.push(renumber[root as usize]);
+            }
+        }
+        let merged: Vec<u32> = old.iter().map(|&c| renumber[c as usize]).collect();
         // Components joined by the merges: a group of components takes the place (and seed) of
         // its first one (the one whose first triangle comes first).
         let comps = prepared.component_seeds.len();
