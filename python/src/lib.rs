@@ -11,10 +11,12 @@ use meshclash::check::query::FailOn;
 use meshclash::check::query::{Detail, DistanceError, Mode};
 use meshclash::geom::predicates;
 use meshclash::geom::Aabb;
+use meshclash::narrow::tri_tri;
 use meshclash::pipeline::{Gate, Unit};
 use meshclash::prepared;
 use meshclash::prepared::broad::{self, ObjectTree};
 use meshclash::report::self_report::SelfFailOn;
+use meshclash::scene::mesh::TriMesh;
 use meshclash::Error;
 use numpy::{PyReadonlyArray2, PyUntypedArrayMethods};
 use pyo3::exceptions::{PyMemoryError, PyOSError, PyValueError};
@@ -658,6 +660,11 @@ struct Memo {
     signed: HashMap<(u64, u64), prepared::Signed>,
     /// Pairs known to have no meeting triangles (their containment not decided yet).
     no_meeting: std::collections::HashSet<(u64, u64)>,
+    /// A triangle pair (of A, of B) that met the last time two prepared meshes (keyed by their
+    /// addresses) collided, under any placements: kept when objects move, a yes/no query tries
+    /// it first (one exact triangle test; any meeting pair answers such a query). Only speed
+    /// depends on it: a stale hint is a triangle pair that no longer meets, or out of range.
+    hints: HashMap<(usize, usize), (u32, u32)>,
 }
 
 impl Memo {
@@ -698,6 +705,18 @@ impl Memory<'_> {
                 m.no_meeting.clear();
             }
             m.no_meeting.insert(k);
+        }
+    }
+    fn hint(&self, k: (usize, usize)) -> Option<(u32, u32)> {
+        self.0.and_then(|m| m.lock().unwrap().hints.get(&k).copied())
+    }
+    fn keep_hint(&self, k: (usize, usize), v: (u32, u32)) {
+        if let Some(m) = self.0 {
+            let mut m = m.lock().unwrap();
+            if m.hints.len() >= MEMO_MAX {
+                m.hints.clear();
+            }
+            m.hints.insert(k, v);
         }
     }
     fn signed(&self, k: (u64, u64)) -> Option<prepared::Signed> {
@@ -776,14 +795,30 @@ fn collide_pairs(
                 None => open.push(*p),
             }
         }
+        let prepared_key = |&(i, j): &(usize, usize)| {
+            (Arc::as_ptr(&a[i].prepared) as usize, Arc::as_ptr(&b[j].prepared) as usize)
+        };
+        let meets = |p: &(usize, usize)| {
+            let v = Verdict { collides: true, containment: None };
+            memo.keep_verdict(key(p), v);
+            hit(p, v)
+        };
+        // The triangle pair that met last time, when it still meets (exact test).
+        let hinted = |p: &(usize, usize)| {
+            let (s, t) = memo.hint(prepared_key(p))?;
+            let (x, y) = (a[p.0].mesh(), b[p.1].mesh());
+            let in_range = (s as usize) < x.triangle_count() && (t as usize) < y.triangle_count();
+            (in_range && tri_tri::classify(&x.triangle(s), &y.triangle(t)).is_some()).then(|| meets(p))
+        };
+        if let Some(h) = open.iter().find_map(hinted) {
+            return vec![h];
+        }
         let meet = |p: &(usize, usize)| {
             let (x, y) = (&a[p.0], &b[p.1]);
             let m = api::meeting_pairs(&x.mesh(), &x.tree(), &y.mesh(), &y.tree(), true);
-            (!m.is_empty()).then(|| {
-                let v = Verdict { collides: true, containment: None };
-                memo.keep_verdict(key(p), v);
-                hit(p, v)
-            })
+            let first = m.first()?;
+            memo.keep_hint(prepared_key(p), (first.a, first.b));
+            Some(meets(p))
         };
         if let Some(h) = find_any(&open, meet) {
             return vec![h];
