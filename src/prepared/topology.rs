@@ -235,16 +235,15 @@ impl Fragile {
         let mut recount: Vec<(u32, u32)> = affected.iter().flat_map(|&t| edges_of(t)).collect();
         recount.sort_unstable();
         recount.dedup();
-        let members = |c: u32| -> Vec<u32> {
-            match slot(c) {
-                Some(_) => involved.iter().copied().filter(|&x| class(x) == c).collect(),
-                None => vec![c],
-            }
-        };
+        let mut groups: HashMap<u32, Vec<u32>> = HashMap::new();
+        for (&c, &root) in involved.iter().zip(&roots) {
+            groups.entry(root).or_default().push(c);
+        }
         let uses = |e: (u32, u32)| {
-            members(e.0)
-                .into_iter()
-                .flat_map(|c| self.tris_of(c).iter().copied())
+            // The classes merged into the lower end (itself alone when it merged with none).
+            let of: &[u32] = groups.get(&e.0).map_or(std::slice::from_ref(&e.0), |g| g.as_slice());
+            of.iter()
+                .flat_map(|&c| self.tris_of(c).iter().copied())
                 .filter(|&t| proper(t) && edges_of(t).any(|x| x == e))
                 .count()
         };
