@@ -8,13 +8,14 @@
 //! differ (they describe the prepared tree).
 
 pub mod broad;
+pub mod topology;
 
 use crate::bvh::traverse::{MappedTree, Tree};
 use crate::bvh::{BuildOptions, Bvh, Node};
 use crate::check::containment::{self, Containment, Topology};
 use crate::check::query::{self, Closest, DistanceError, PairFinding, PairKind, Settings};
 use crate::error::{Error, InputProblem, Location, Result};
-use crate::geom::predicates::{self, BoxMap, Tolerances};
+use crate::geom::predicates::{self, BoxMap, PlacementRounding, Tolerances};
 use crate::geom::{Aabb, DVec3};
 use crate::narrow::convex::{self, Penetration, Polytope, Surface};
 use crate::scene::mesh::{Mesh, TriMesh};
@@ -22,6 +23,7 @@ use glam::DMat4;
 use std::path::{Path, PathBuf};
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::{Arc, OnceLock};
+use topology::Fragile;
 
 /// A mesh with its tree built once, to be placed under many transforms ([`Prepared::place`]).
 #[derive(Debug)]
@@ -38,95 +40,9 @@ pub struct Prepared {
     /// The ball of the mesh's own vertices, and whether their box lies in the tree's root box
     /// (where a box map's slack covers every vertex).
     ball: OnceLock<(Ball, bool)>,
-    /// How far rounding may move the vertices before the topology could change ([`Margins`]).
-    margins: OnceLock<Option<Margins>>,
-}
-
-/// How robust a mesh's topology ([`containment::topology`]) is to moving its vertices: lower
-/// bounds of the distance between any two vertices that are not exactly coincident, and of
-/// every height of every triangle whose three vertices are not exactly coincident. `None` when
-/// some such triangle is exactly or nearly collinear (no useful bound).
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct Margins {
-    /// At most the distance between any two distinct vertices (capped, see
-    /// [`Margins::of`]).
-    pub separation: f64,
-    /// At most every height of every triangle with three distinct vertices.
-    pub height: f64,
-}
-
-impl Margins {
-    /// The margins of `positions` and `triangles`, their exact coincidences `merged` (as
-    /// [`containment::topology`] finds them). Every bound is a lower bound whatever the f64
-    /// rounding:
-    /// * separation: distinct vertices are hashed into a grid of cells of side `c`
-    ///   ([`predicates::MARGIN_CELL`] of the coordinates' scale); pairs in the same or adjacent cells are
-    ///   measured (f64 distance, `4u` relative error at most, lowered by `8u`); two points whose
-    ///   cells are not adjacent differ by more than `c / 2` in some coordinate (the f64 quotient
-    ///   by `c` is off by a few ulps at most), so the result is capped at `c / 2`.
-    /// * height: twice the area over the longest edge, `|(b - a) × (c - a)| / L`; the f64 cross
-    ///   product is within `16u L²` of the exact one (two rounded differences per factor, two
-    ///   products and a difference per component: a few `u` of `L²` each), lowered by that and
-    ///   by `4u` relative for the norm and the quotient.
-    pub fn of(positions: &[DVec3], triangles: &[[u32; 3]], merged: &[u32]) -> Option<Margins> {
-        let mut height = f64::INFINITY;
-        for t in triangles {
-            let ids = t.map(|v| merged[v as usize]);
-            if ids[0] == ids[1] || ids[1] == ids[2] || ids[0] == ids[2] {
-                continue;
-            }
-            let h = predicates::height_lower_bound(t.map(|v| positions[v as usize]));
-            if h.is_nan() || h <= 0.0 {
-                return None;
-            }
-            height = height.min(h);
-        }
-        let scale = positions.iter().fold(0.0f64, |m, p| m.max(p.abs().max_element()));
-        let cell = scale * predicates::MARGIN_CELL;
-        let mut separation = cell * 0.5;
-        if cell <= 0.0 || !cell.is_finite() {
-            return None;
-        }
-        let mut seen = vec![false; merged.iter().map(|&m| m as usize + 1).max().unwrap_or(0)];
-        let mut grid: std::collections::HashMap<[i64; 3], Vec<DVec3>> = std::collections::HashMap::new();
-        for (v, p) in positions.iter().enumerate() {
-            let m = merged[v] as usize;
-            if std::mem::replace(&mut seen[m], true) {
-                continue;
-            }
-            let key = (*p / cell).floor().to_array().map(|x| x as i64);
-            for dx in -1..=1 {
-                for dy in -1..=1 {
-                    for dz in -1..=1 {
-                        if let Some(near) = grid.get(&[key[0] + dx, key[1] + dy, key[2] + dz]) {
-                            for q in near {
-                                separation = separation.min(predicates::distance_lower_bound(*p, *q));
-                            }
-                        }
-                    }
-                }
-            }
-            grid.entry(key).or_default().push(*p);
-        }
-        Some(Margins { separation, height })
-    }
-
-    /// Certainly the same topology after a placement by `map` (every vertex within `map.slack`
-    /// per axis, so within `δ = |slack|`, of the exact affine image `R p + t`): with `σ_min`,
-    /// `σ_max` bounds of `R`'s extreme singular values, the exact images of two distinct
-    /// vertices are at least `σ_min · separation` apart and stay distinct if that exceeds `2δ`;
-    /// a triangle's exact image has every height at least `σ_min² / σ_max · height` (area
-    /// scales by at least `σ_min²`, edges by at most `σ_max`), and a triangle with every height
-    /// above `5δ` cannot be made collinear by moving each vertex by `δ` (its area, half its
-    /// longest edge `L` times its smallest height, would have to drop by at most
-    /// `2δ (L + δ)`). So exactly coincident vertices, and degenerate triangles, are the same
-    /// before and after: the closedness and components are the same. The tests use `3δ` and
-    /// `6δ` (room for the rounding of the comparison itself).
-    pub fn hold_under(&self, map: &BoxMap) -> bool {
-        let (lo, hi) = predicates::singular_value_bounds(&map.rows);
-        let delta = map.slack.length();
-        lo * self.separation > 3.0 * delta && lo * lo / hi * self.height > 6.0 * delta
-    }
+    /// The vertex pairs and triangles whose coincidence or collinearity rounding under a
+    /// placement could change ([`Fragile`]).
+    fragile: OnceLock<Option<Fragile>>,
 }
 
 impl Prepared {
@@ -142,14 +58,15 @@ impl Prepared {
             convex: OnceLock::new(),
             topology: OnceLock::new(),
             ball: OnceLock::new(),
-            margins: OnceLock::new(),
+            fragile: OnceLock::new(),
         })
     }
 
-    /// The topology's robustness to moving the vertices ([`Margins`]), found once.
-    fn margins(&self) -> Option<&Margins> {
-        self.margins
-            .get_or_init(|| Margins::of(&self.mesh.positions, &self.mesh.triangles, &self.topology().merged))
+    /// The vertex pairs and triangles a placement's rounding could change ([`Fragile`]), found
+    /// once.
+    fn fragile(&self) -> Option<&Fragile> {
+        self.fragile
+            .get_or_init(|| Fragile::of(&self.mesh.positions, &self.mesh.triangles, self.topology()))
             .as_ref()
     }
 
@@ -468,23 +385,22 @@ impl Placed {
     }
 
     /// Closedness and components ([`containment::topology`]): the prepared mesh's for the
-    /// identity placement, for a box-mapped placement whose rounding cannot change them
-    /// ([`Margins::hold_under`]) and when [`Placed::translated`]; else found on the world
-    /// coordinates. Found once.
+    /// identity placement and when [`Placed::translated`]; for a box-mapped placement, the
+    /// prepared mesh's corrected where its rounding merged vertices or changed a triangle's
+    /// collinearity ([`Fragile::placed`]); else found on the world coordinates. Found once.
     fn topology(&self) -> &Topology {
         self.topology.get_or_init(|| {
-            let kept = match &self.tree {
-                Mapping::Own => true,
-                Mapping::Mapped(map) => {
-                    self.prepared.own_ball().1 && self.prepared.margins().is_some_and(|m| m.hold_under(map))
-                }
-                Mapping::Refit(_) => false,
+            let p = &self.prepared;
+            let from_prepared = match (&self.tree, &self.world) {
+                (Mapping::Own, _) | (_, None) => Some(p.topology().clone()),
+                (Mapping::Mapped(map), Some(world)) if p.own_ball().1 => p.fragile().and_then(|f| {
+                    f.placed(p.topology(), world, &p.mesh.triangles, &PlacementRounding::of(map))
+                }),
+                _ => None,
             };
-            if kept || self.translated() {
-                self.prepared.topology().clone()
-            } else {
-                Arc::new(containment::topology(&self.mesh()))
-            }
+            from_prepared
+                .or_else(|| self.translated().then(|| p.topology().clone()))
+                .unwrap_or_else(|| Arc::new(containment::topology(&self.mesh())))
         })
     }
 }
@@ -723,6 +639,13 @@ pub fn signed_distance(a: &Placed, b: &Placed, bound: f64) -> Option<Signed> {
     })
 }
 
+/// The signed distance of two placed meshes known to collide through `contact`, a meeting
+/// triangle pair (found by [`meeting_pairs`] with `first`): what [`signed_distance`] answers
+/// when its own search finds that pair, without searching again.
+pub fn signed_meeting(a: &Placed, b: &Placed, contact: &PairFinding) -> Signed {
+    colliding(a, b, &Collision { contacts: vec![*contact], containment: Containment::None })
+}
+
 fn colliding(a: &Placed, b: &Placed, c: &Collision) -> Signed {
     let contact =
         c.contacts.first().map(|p| (p.a as i64, p.b as i64, query::pair_witness(&a.mesh(), &b.mesh(), p)));
@@ -862,61 +785,34 @@ mod tests {
         }
     }
 
-    /// Under rotations and scalings (box-mapped placements), the prepared topology is taken
-    /// only where rounding cannot change it, and then it is the one found on the world
-    /// coordinates; two vertices a rounding apart, or a sliver, leave the world's to be found.
+    /// The signed distance from a meeting pair found beforehand is the one the full query
+    /// finds (convex and non-convex pairs, crossing and touching).
     #[test]
-    fn mapped_topology_is_kept_only_where_it_holds() {
-        let same = |p: &Placed| {
-            let (t, fresh) = (p.topology(), containment::topology(&p.mesh()));
-            assert_eq!(
-                (t.closed, &t.component_seeds, &t.component_of),
-                (fresh.closed, &fresh.component_seeds, &fresh.component_of)
-            );
-        };
-        // Two cubes (two components), one open (a face removed).
+    fn signed_from_a_meeting_pair_equals_the_full_query() {
+        let a = prepared(cube(DVec3::ZERO));
         let mut two = cube(DVec3::ZERO);
-        let far = cube(DVec3::new(3.0, 0.5, 0.25));
-        two.triangles.extend(far.triangles.iter().skip(2).map(|t| t.map(|v| v + 8)));
+        let far = cube(DVec3::splat(3.0));
+        two.triangles.extend(far.triangles.iter().map(|t| t.map(|v| v + 8)));
         two.positions.extend(far.positions);
         two.tri_object = vec![0; two.triangles.len()];
         let two = prepared(two);
-        assert!(two.margins().is_some());
-        let mut kept = 0;
-        for k in 0..40 {
-            let a = k as f64 * 0.37;
-            let m = DMat4::from_translation(DVec3::new(a, -2.0 * a, 0.5))
-                * DMat4::from_rotation_x(a)
-                * DMat4::from_rotation_y(1.3 * a)
-                * DMat4::from_scale(DVec3::new(1.0 + a, 1.0, 0.5 + a));
-            let p = two.place(m).unwrap();
-            if let Mapping::Mapped(map) = &p.tree {
-                kept += two.margins().unwrap().hold_under(map) as usize;
+        let origin = a.place(DMat4::IDENTITY).unwrap();
+        let mut met = 0;
+        for k in 0..24 {
+            let t = k as f64 * 0.125;
+            let m = DMat4::from_translation(DVec3::new(t, 0.5 - t * 0.25, 0.25)) * DMat4::from_rotation_z(t);
+            for other in [a.place(m).unwrap(), two.place(m).unwrap()] {
+                let (ma, mb, ta, tb) = (origin.mesh(), other.mesh(), origin.tree(), other.tree());
+                let Some(first) = meeting_pairs(&ma, &ta, &mb, &tb, true).into_iter().next() else {
+                    continue;
+                };
+                met += 1;
+                let full = signed_distance(&origin, &other, f64::INFINITY).unwrap();
+                assert_eq!(signed_meeting(&origin, &other, &first), full, "step {k}");
+                assert!(full.distance <= 0.0);
             }
-            same(&p);
-            assert!(!p.topology().closed);
-            assert_eq!(p.topology().component_seeds.len(), 2);
         }
-        assert!(kept > 30, "{kept}");
-        // A vertex 2^-50 away from another (distinct, but a rotation may merge them) and a
-        // sliver triangle: never kept.
-        let mut near = cube(DVec3::ZERO);
-        near.positions.push(DVec3::new(1.0, 1.0, 1.0 + 2f64.powi(-50)));
-        let near = prepared(near);
-        assert!(near.margins().unwrap().separation <= 2f64.powi(-50));
-        let mut sliver = cube(DVec3::ZERO);
-        sliver.positions.push(DVec3::new(0.5, 0.0, 2f64.powi(-60)));
-        sliver.triangles.push([0, 8, 1]);
-        sliver.tri_object.push(0);
-        assert!(prepared(sliver).margins().is_none());
-        for k in 0..10 {
-            let m = DMat4::from_rotation_z(0.3 + k as f64);
-            let p = near.place(m).unwrap();
-            if let Mapping::Mapped(map) = &p.tree {
-                assert!(!near.margins().unwrap().hold_under(map));
-            }
-            same(&p);
-        }
+        assert!(met > 10, "{met}");
     }
 
     #[test]

@@ -9,11 +9,14 @@ use meshclash::cache::CacheConfig;
 use meshclash::check::assembly::Selection;
 use meshclash::check::query::FailOn;
 use meshclash::check::query::{Detail, DistanceError, Mode};
+use meshclash::geom::predicates;
 use meshclash::geom::Aabb;
+use meshclash::narrow::tri_tri;
 use meshclash::pipeline::{Gate, Unit};
 use meshclash::prepared;
 use meshclash::prepared::broad::{self, ObjectTree};
 use meshclash::report::self_report::SelfFailOn;
+use meshclash::scene::mesh::TriMesh;
 use meshclash::Error;
 use numpy::{PyReadonlyArray2, PyUntypedArrayMethods};
 use pyo3::exceptions::{PyMemoryError, PyOSError, PyValueError};
@@ -657,6 +660,11 @@ struct Memo {
     signed: HashMap<(u64, u64), prepared::Signed>,
     /// Pairs known to have no meeting triangles (their containment not decided yet).
     no_meeting: std::collections::HashSet<(u64, u64)>,
+    /// A triangle pair (of A, of B) that met the last time two prepared meshes (keyed by their
+    /// addresses) collided, under any placements: kept when objects move, a yes/no query tries
+    /// it first (one exact triangle test; any meeting pair answers such a query). Only speed
+    /// depends on it: a stale hint is a triangle pair that no longer meets, or out of range.
+    hints: HashMap<(usize, usize), (u32, u32)>,
 }
 
 impl Memo {
@@ -697,6 +705,18 @@ impl Memory<'_> {
                 m.no_meeting.clear();
             }
             m.no_meeting.insert(k);
+        }
+    }
+    fn hint(&self, k: (usize, usize)) -> Option<(u32, u32)> {
+        self.0.and_then(|m| m.lock().unwrap().hints.get(&k).copied())
+    }
+    fn keep_hint(&self, k: (usize, usize), v: (u32, u32)) {
+        if let Some(m) = self.0 {
+            let mut m = m.lock().unwrap();
+            if m.hints.len() >= MEMO_MAX {
+                m.hints.clear();
+            }
+            m.hints.insert(k, v);
         }
     }
     fn signed(&self, k: (u64, u64)) -> Option<prepared::Signed> {
@@ -775,14 +795,30 @@ fn collide_pairs(
                 None => open.push(*p),
             }
         }
+        let prepared_key = |&(i, j): &(usize, usize)| {
+            (Arc::as_ptr(&a[i].prepared) as usize, Arc::as_ptr(&b[j].prepared) as usize)
+        };
+        let meets = |p: &(usize, usize)| {
+            let v = Verdict { collides: true, containment: None };
+            memo.keep_verdict(key(p), v);
+            hit(p, v)
+        };
+        // The triangle pair that met last time, when it still meets (exact test).
+        let hinted = |p: &(usize, usize)| {
+            let (s, t) = memo.hint(prepared_key(p))?;
+            let (x, y) = (a[p.0].mesh(), b[p.1].mesh());
+            let in_range = (s as usize) < x.triangle_count() && (t as usize) < y.triangle_count();
+            (in_range && tri_tri::classify(&x.triangle(s), &y.triangle(t)).is_some()).then(|| meets(p))
+        };
+        if let Some(h) = open.iter().find_map(hinted) {
+            return vec![h];
+        }
         let meet = |p: &(usize, usize)| {
             let (x, y) = (&a[p.0], &b[p.1]);
             let m = api::meeting_pairs(&x.mesh(), &x.tree(), &y.mesh(), &y.tree(), true);
-            (!m.is_empty()).then(|| {
-                let v = Verdict { collides: true, containment: None };
-                memo.keep_verdict(key(p), v);
-                hit(p, v)
-            })
+            let first = m.first()?;
+            memo.keep_hint(prepared_key(p), (first.a, first.b));
+            Some(meets(p))
         };
         if let Some(h) = find_any(&open, meet) {
             return vec![h];
@@ -864,18 +900,20 @@ fn nearest(
         candidates.iter().copied().filter(|&(i, j)| !a[i].apart(&b[j])).collect();
     // Meeting triangles first (a pair known to collide without containment has them), then
     // containment: the first pair in (i, j) order of the first kind found.
+    // With the meeting pair found, when this search found it (its signed distance is then
+    // computed from it, not searched for again).
     let meeting = |&(i, j): &(usize, usize)| match memo.verdict(key(i, j)) {
-        Some(v) => (v.collides && v.containment.is_none()).then_some((i, j)),
+        Some(v) => (v.collides && v.containment.is_none()).then_some((i, j, None)),
         None if memo.no_meeting(key(i, j)) => None,
         None => {
             let (x, y) = (&a[i], &b[j]);
             let m = api::meeting_pairs(&x.mesh(), &x.tree(), &y.mesh(), &y.tree(), true);
-            if m.is_empty() {
+            let Some(first) = m.into_iter().next() else {
                 memo.keep_no_meeting(key(i, j));
                 return None;
-            }
+            };
             memo.keep_verdict(key(i, j), Verdict { collides: true, containment: None });
-            Some((i, j))
+            Some((i, j, Some(first)))
         }
     };
     let contained = |&(i, j): &(usize, usize)| {
@@ -888,10 +926,21 @@ fn nearest(
                 v
             }
         };
-        v.collides.then_some((i, j))
+        v.collides.then_some((i, j, None))
     };
-    if let Some((i, j)) = find_first(&overlapping, meeting).or_else(|| find_first(&overlapping, contained)) {
-        return Some(near(signed(i, j, 0.0).expect("colliding"), i, j));
+    if let Some((i, j, contact)) =
+        find_first(&overlapping, meeting).or_else(|| find_first(&overlapping, contained))
+    {
+        let s = match (memo.signed(key(i, j)), contact) {
+            (Some(s), _) => s,
+            (None, Some(c)) => {
+                let s = prepared::signed_meeting(&a[i], &b[j], &c);
+                memo.keep_signed(key(i, j), &s);
+                s
+            }
+            (None, None) => signed(i, j, 0.0).expect("colliding"),
+        };
+        return Some(near(s, i, j));
     }
     let key3 = |x: &(f64, usize, usize), y: &(f64, usize, usize)| {
         x.0.total_cmp(&y.0).then((x.1, x.2).cmp(&(y.1, y.2)))
@@ -1001,11 +1050,10 @@ impl Sweep {
         out
     }
     /// The objects whose boxes meet `q`, ascending: those whose lower x lies in
-    /// `[q.min.x - 2 widest, q.max.x]` are looked at (a box that meets `q` has its upper x at
-    /// least `q.min.x`, and its lower x within its width of it; twice the widest width leaves
-    /// room for the rounding of the subtractions).
+    /// `[predicates::sweep_start(q.min.x, widest), q.max.x]` are looked at (a box that meets
+    /// `q` has its upper x at least `q.min.x`, and its lower x within its width of it).
     fn against(&self, objs: &[Arc<Placed>], q: &Aabb) -> Vec<usize> {
-        let from = q.min.x - 2.0 * self.widest;
+        let from = predicates::sweep_start(q.min.x, self.widest);
         let start = self.order.partition_point(|x| x.0 < from);
         let end = self.order.partition_point(|x| x.0 <= q.max.x);
         let mut out: Vec<usize> = self.order[start..end.max(start)]

@@ -706,6 +706,62 @@ pub fn distance_lower_bound(p: DVec3, q: DVec3) -> f64 {
     (p - q).length() * (1.0 - 8.0 * UNIT_ROUNDOFF)
 }
 
+/// Where a sweep over boxes sorted by their lower x must start looking for the boxes that meet
+/// a box whose lower x is `min_x`, when every box's x extent, computed in f64, is at most
+/// `widest`: no box with a lower x below the result meets it. Proof: a box `[lo, hi]` that
+/// meets it has `hi >= min_x`; if `lo < min_x`, its exact width `hi - lo` is at least
+/// `D = min_x - lo > 0`, so `widest >= fl(hi - lo) >= fl(D) >= (1 - u) D` (rounding is
+/// monotone), and `min_x - 2 widest <= min_x - 2 (1 - u) D < lo`; the f64 subtraction rounds
+/// monotonically and `lo` is an f64, so the computed start is at most `lo`.
+pub fn sweep_start(min_x: f64, widest: f64) -> f64 {
+    min_x - 2.0 * widest
+}
+
+/// What rounding under one placement can do to a mesh's coincidences and degenerate
+/// triangles. A placement maps each vertex `p` to an f64 `w` within `delta` (a length: the box
+/// map's per-axis slack, as a vector norm) of the exact affine image `R p + t`; `low`, `high`
+/// bound `R`'s smallest and largest singular values ([`singular_value_bounds`]).
+///
+/// * Two vertices at least `d` apart have exact images at least `low · d` apart, so their f64
+///   images differ when `low · d > 2 delta`.
+/// * A triangle whose heights are all at least `h` has an exact image whose heights are all at
+///   least `low² / high · h` (twice its area scales by at least `low²`, each edge by at most
+///   `high`), and moving each vertex of a triangle whose heights all exceed `5 delta` by at most
+///   `delta` cannot make it collinear (its area, half its longest edge `L` times its smallest
+///   height, drops by at most `2 delta (L + delta)`).
+///
+/// The tests below use `3 delta` and `6 delta`: room for the rounding of the comparisons
+/// themselves (a few ulps of each side).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct PlacementRounding {
+    /// At most the smallest singular value of the linear part.
+    pub low: f64,
+    /// At least the largest singular value of the linear part.
+    pub high: f64,
+    /// At least the distance of any placed vertex from its exact image.
+    pub delta: f64,
+}
+
+impl PlacementRounding {
+    /// The rounding of a placement by `map` (its vertices in the map's source root box).
+    pub fn of(map: &BoxMap) -> PlacementRounding {
+        let (low, high) = singular_value_bounds(&map.rows);
+        PlacementRounding { low, high, delta: map.slack.length() }
+    }
+
+    /// Certainly distinct after the placement: two vertices whose distance is at least
+    /// `separation` ([`distance_lower_bound`]). False for NaN.
+    pub fn keeps_apart(&self, separation: f64) -> bool {
+        self.low * separation > 3.0 * self.delta
+    }
+
+    /// Certainly a proper triangle after the placement: one whose heights are at least `height`
+    /// ([`height_lower_bound`]). False for NaN or a bound that is not positive.
+    pub fn keeps_proper(&self, height: f64) -> bool {
+        height > 0.0 && self.low * self.low / self.high * height > 6.0 * self.delta
+    }
+}
+
 /// Bounds of the smallest and largest singular values of the linear part of `rows` (the map's
 /// 3x3 matrix `R`): square roots of Gershgorin's bounds on the eigenvalues of `G = RᵀR`,
 /// `min_j (G_jj - Σ_{k≠j} |G_jk|)` and `max_j Σ_k |G_jk|`. Each f64 entry `Ĝ_jk` (three
@@ -1007,5 +1063,29 @@ mod tests {
         let b = Aabb { min: DVec3::new(3.0, 0.0, 0.0), max: DVec3::new(4.0, 1.0, 1.0) };
         assert!(t.boxes_may_meet(&a, &b));
         assert!(!Tolerances::default().boxes_may_meet(&a, &b));
+    }
+
+    /// Boxes whose lower x lies before the sweep's start never meet the query box, at every
+    /// scale (widths of an ulp far from the origin included).
+    #[test]
+    fn sweep_start_misses_no_meeting_box() {
+        let mut x = 0x2545_f491_4f6c_dd1du64;
+        let mut next = move || {
+            x ^= x << 13;
+            x ^= x >> 7;
+            x ^= x << 17;
+            (x >> 11) as f64 / (1u64 << 53) as f64
+        };
+        for _ in 0..20_000 {
+            let at = (next() - 0.5) * 10f64.powf(next() * 16.0 - 4.0);
+            let ulps = |v: f64, k: f64| v + k * v.abs().max(f64::MIN_POSITIVE) * f64::EPSILON;
+            let lo = ulps(at, (next() * 8.0).floor() - 4.0);
+            let hi = ulps(lo, (next() * 8.0).floor());
+            let widest = hi - lo;
+            // Query boxes starting anywhere in the box (it meets them all).
+            for q in [lo, hi, ulps(lo, 1.0).min(hi), (lo + hi) * 0.5] {
+                assert!(sweep_start(q, widest) <= lo, "{lo} {hi} {q}");
+            }
+        }
     }
 }
