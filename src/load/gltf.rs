@@ -59,6 +59,10 @@
 //!   instances share one BVH build in assemblies) and `world = Some(the matrix applied)`.
 //!   Instances that yield no triangles get no object. Winding is kept as stored, also under
 //!   mirroring transforms (containment decides orientation from the geometry).
+//! - **Without expansion** ([`load_instanced`]): the same walk, checks and errors, but each mesh
+//!   is kept once in its own coordinates and every part as (mesh, world matrix); a part's world
+//!   coordinates are computed when asked ([`InstancedScene::place`]) by the arithmetic above,
+//!   so they are the expanded load's, bit for bit.
 
 use std::borrow::Cow;
 use std::path::Path;
@@ -95,6 +99,152 @@ pub(crate) const MAX_SCENE_PARTS: usize = 1 << 24;
 
 /// Loads `.gltf` or `.glb` `bytes` (the GLB magic decides); see the module doc.
 pub(crate) fn load(path: &Path, bytes: &[u8]) -> Result<Loaded> {
+    let mut mesh = Mesh::default();
+    let (_, warnings) = walk(path, bytes, &mut mesh)?;
+    Ok(Loaded { mesh, warnings })
+}
+
+/// Loads `.gltf` or `.glb` `bytes` without expanding the instances: each mesh decoded once, in
+/// its own coordinates, and every part as (mesh, world matrix). Every check and error of
+/// [`load`] is made, in the same order (each part is placed once, in a scratch buffer, to find a
+/// non-finite world coordinate); [`InstancedScene::expand`] gives what [`load`] gives.
+pub(crate) fn load_instanced(path: &Path, bytes: &[u8]) -> Result<InstancedScene> {
+    let mut sink = PartSink { parts: Vec::new(), scratch: Mesh::default() };
+    let (meshes, warnings) = walk(path, bytes, &mut sink)?;
+    Ok(InstancedScene { path: path.to_path_buf(), meshes, parts: sink.parts, warnings })
+}
+
+/// What [`walk`] hands the scene's parts to, in object order.
+trait Sink {
+    /// Called once, before any part, with the expanded scene's vertex, triangle and part counts.
+    fn reserve(&mut self, vertices: usize, triangles: usize, parts: usize);
+    /// One part: `prims` placed by `world` (see [`add_instance`]).
+    fn part(&mut self, path: &Path, at: Placement, prims: &[Prim], name: String, world: DMat4) -> Result<()>;
+}
+
+impl Sink for Mesh {
+    fn reserve(&mut self, vertices: usize, triangles: usize, parts: usize) {
+        self.positions.reserve_exact(vertices);
+        self.triangles.reserve_exact(triangles);
+        self.tri_object.reserve_exact(triangles);
+        self.objects.reserve_exact(parts);
+    }
+    fn part(&mut self, path: &Path, at: Placement, prims: &[Prim], name: String, world: DMat4) -> Result<()> {
+        add_instance(self, path, at, prims, name, world)
+    }
+}
+
+/// Collects the parts of an [`InstancedScene`], placing each in `scratch` (cleared after) only
+/// to find a non-finite coordinate as [`load`] does.
+struct PartSink {
+    parts: Vec<ScenePart>,
+    scratch: Mesh,
+}
+
+impl Sink for PartSink {
+    fn reserve(&mut self, _: usize, _: usize, parts: usize) {
+        self.parts.reserve_exact(parts);
+    }
+    fn part(&mut self, path: &Path, at: Placement, prims: &[Prim], name: String, world: DMat4) -> Result<()> {
+        let m = &mut self.scratch;
+        m.positions.clear();
+        m.triangles.clear();
+        m.tri_object.clear();
+        m.objects.clear();
+        add_instance(m, path, at, prims, String::new(), world)?;
+        self.parts.push(ScenePart { name, mesh: at.mesh as u32, world, at });
+        Ok(())
+    }
+}
+
+/// Where a part comes from, for error messages: its glTF mesh, node and GPU instance.
+#[derive(Debug, Clone, Copy, PartialEq)]
+struct Placement {
+    mesh: usize,
+    node: usize,
+    instance: Option<usize>,
+}
+
+/// A glTF scene before its instances are expanded: each glTF mesh decoded once in its own
+/// coordinates, and every part (node × mesh, or GPU instance) as the mesh and the world matrix
+/// that places it. Its memory grows with the distinct meshes, not with the instances.
+#[derive(Clone)]
+pub struct InstancedScene {
+    path: std::path::PathBuf,
+    meshes: Decoded,
+    /// The parts, in object order (the expanded mesh's `objects`).
+    pub parts: Vec<ScenePart>,
+    /// The loader's warnings, as [`load`] gives them.
+    pub warnings: Vec<String>,
+}
+
+/// Decoded primitives by glTF mesh index (`None` for a mesh no node draws).
+type Decoded = Vec<Option<Vec<Prim>>>;
+
+/// One part of an [`InstancedScene`].
+#[derive(Debug, Clone, PartialEq)]
+pub struct ScenePart {
+    /// Object name, as in the expanded mesh.
+    pub name: String,
+    /// The glTF mesh it draws.
+    pub mesh: u32,
+    /// The world matrix that places it (node world, times the GPU instance's own for one).
+    pub world: DMat4,
+    at: Placement,
+}
+
+impl InstancedScene {
+    /// Part `k` placed: its world positions and its triangles (indexing them), exactly the
+    /// positions and triangles (less the offset of its first vertex) the expanded mesh holds for
+    /// object `k`, computed by the same arithmetic.
+    pub fn place(&self, k: usize) -> Result<(Vec<DVec3>, Vec<[u32; 3]>)> {
+        let p = &self.parts[k];
+        let mut one = Mesh::default();
+        add_instance(&mut one, &self.path, p.at, self.prims(p), String::new(), p.world)?;
+        Ok((one.positions, one.triangles))
+    }
+
+    /// The vertices and triangles part `k` expands to, without placing it.
+    pub fn part_counts(&self, k: usize) -> (usize, usize) {
+        counts(self.prims(&self.parts[k]))
+    }
+
+    /// The whole scene expanded into one mesh in world coordinates and validated: what
+    /// [`crate::load::load_bytes`] gives for the file.
+    pub fn expand(&self) -> Result<Loaded> {
+        let mut mesh = Mesh::default();
+        let (mut v, mut t) = (0usize, 0usize);
+        for k in 0..self.parts.len() {
+            let (pv, pt) = self.part_counts(k);
+            (v, t) = (v.saturating_add(pv), t.saturating_add(pt));
+        }
+        mesh.reserve(v, t, self.parts.len());
+        for p in &self.parts {
+            add_instance(&mut mesh, &self.path, p.at, self.prims(p), p.name.clone(), p.world)?;
+        }
+        let loaded = Loaded { mesh, warnings: self.warnings.clone() };
+        super::validate(&self.path, &loaded)?;
+        Ok(loaded)
+    }
+
+    fn prims(&self, p: &ScenePart) -> &[Prim] {
+        self.meshes.get(p.mesh as usize).and_then(Option::as_deref).unwrap_or(&[])
+    }
+}
+
+/// The vertices (a shared accessor once) and triangles one instance of `prims` places.
+fn counts(prims: &[Prim]) -> (usize, usize) {
+    let (mut v, mut t) = (0usize, 0usize);
+    for p in prims.iter().filter(|p| !p.triangles.is_empty()) {
+        v = v.saturating_add(p.positions.len());
+        t = t.saturating_add(p.triangles.len());
+    }
+    (v, t)
+}
+
+/// Parses, decodes and checks the scene, then hands `sink` every part in object order; returns
+/// the decoded meshes (by glTF mesh index) and the warnings.
+fn walk(path: &Path, bytes: &[u8], sink: &mut dyn Sink) -> Result<(Decoded, Vec<String>)> {
     let (json, bin) = if bytes.starts_with(b"glTF") { split_glb(path, bytes)? } else { (bytes, None) };
     let mut warnings = Vec::new();
     let doc = parse_document(path, json)?;
@@ -107,19 +257,14 @@ pub(crate) fn load(path: &Path, bytes: &[u8]) -> Result<Loaded> {
 
     // Decode each mesh once, whatever its number of instances; check the expanded scene
     // against the limits from declared counts, before any instance is read or allocated.
-    let mut decoded: Vec<Option<Vec<Prim>>> = vec![None; doc.meshes().len()];
+    let mut decoded: Decoded = vec![None; doc.meshes().len()];
     let (mut total_v, mut total_t, mut total_parts) = (0usize, 0usize, 0usize);
     for inst in &instances {
         if decoded[inst.mesh].is_none() {
             decoded[inst.mesh] = Some(decode_mesh(&reader, &doc, inst.mesh, &mut warnings)?);
         }
         let copies = inst.gpu.as_ref().map_or(1, |g| g.count);
-        let prims = decoded[inst.mesh].iter().flatten().filter(|p| !p.triangles.is_empty());
-        let (mut v, mut t) = (0usize, 0usize);
-        for p in prims {
-            v = v.saturating_add(p.positions.len());
-            t = t.saturating_add(p.triangles.len());
-        }
+        let (v, t) = counts(decoded[inst.mesh].as_deref().unwrap_or(&[]));
         if t > 0 {
             total_v = total_v.saturating_add(v.saturating_mul(copies));
             total_t = total_t.saturating_add(t.saturating_mul(copies));
@@ -150,12 +295,7 @@ pub(crate) fn load(path: &Path, bytes: &[u8]) -> Result<Loaded> {
         return Err(Error::in_file(path, problem));
     }
 
-    let mut mesh = Mesh {
-        positions: Vec::with_capacity(total_v),
-        triangles: Vec::with_capacity(total_t),
-        tri_object: Vec::with_capacity(total_t),
-        objects: Vec::with_capacity(total_parts),
-    };
+    sink.reserve(total_v, total_t, total_parts);
     let names = node_names(&doc);
     for inst in &instances {
         let prims = decoded[inst.mesh].as_deref().unwrap_or(&[]);
@@ -163,8 +303,9 @@ pub(crate) fn load(path: &Path, bytes: &[u8]) -> Result<Loaded> {
             continue;
         }
         let name = node_path(&inst.path, &names);
+        let at = |instance| Placement { mesh: inst.mesh, node: inst.node, instance };
         let Some(gpu) = &inst.gpu else {
-            add_instance(&mut mesh, path, inst, prims, name, inst.world, None)?;
+            sink.part(path, at(None), prims, name, inst.world)?;
             continue;
         };
         let trs = InstanceTransforms::read(&reader, &accessors, inst.node, gpu)?;
@@ -174,26 +315,24 @@ pub(crate) fn load(path: &Path, bytes: &[u8]) -> Result<Loaded> {
                 let at = Location::Instance { node: inst.node, instance: k };
                 return Err(Error::at(path, at, GltfProblem::WorldOverflow));
             }
-            let part = format!("{name}#{k}");
-            add_instance(&mut mesh, path, inst, prims, part, world, Some(k))?;
+            sink.part(path, at(Some(k)), prims, format!("{name}#{k}"), world)?;
         }
     }
-    Ok(Loaded { mesh, warnings })
+    Ok((decoded, warnings))
 }
 
-/// Appends one part: `prims` transformed by `world`, as object `name` (GPU instance `instance`
-/// of the node, when it has them).
+/// Appends one part: `prims` transformed by `world`, as object `name` (`at` says where it
+/// comes from, for an error).
 fn add_instance(
     mesh: &mut Mesh,
     path: &Path,
-    inst: &Instance,
+    at: Placement,
     prims: &[Prim],
     name: String,
     world: DMat4,
-    instance: Option<usize>,
 ) -> Result<()> {
     let object = mesh.objects.len() as u32;
-    mesh.objects.push(Object { name, gltf_mesh: Some(inst.mesh as u32), world: Some(world) });
+    mesh.objects.push(Object { name, gltf_mesh: Some(at.mesh as u32), world: Some(world) });
     // Where each primitive's vertices start (a primitive sharing an earlier one's accessor
     // uses that one's, placed once).
     let mut bases: Vec<Option<u32>> = vec![None; prims.len()];
@@ -214,7 +353,7 @@ fn add_instance(
         if let Some((i, value)) =
             placed.iter().enumerate().find_map(|(i, w)| Some((i, super::non_finite(w.to_array())?)))
         {
-            let at = Location::Placed { mesh: inst.mesh, position: i, node: inst.node, instance };
+            let at = Location::Placed { mesh: at.mesh, position: i, node: at.node, instance: at.instance };
             return Err(Error::at(path, at, InputProblem::NonFiniteAfterTransform { value: Some(value) }));
         }
     }

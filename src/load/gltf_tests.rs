@@ -49,14 +49,69 @@ fn path() -> PathBuf {
     PathBuf::from("t.gltf")
 }
 
+/// Loads `bytes`, and checks that the load without expansion gives the same mesh, warnings and
+/// placed parts ([`same_instanced`]).
 fn ok(bytes: &[u8]) -> Loaded {
-    load_bytes(&path(), bytes, Format::Gltf).unwrap()
+    let l = load_bytes(&path(), bytes, Format::Gltf).unwrap();
+    same_instanced(&path(), bytes, &l);
+    l
 }
 
+/// The error of loading `bytes`, which the load without expansion gives too.
 fn err(bytes: &[u8]) -> String {
     let e = load_bytes(&path(), bytes, Format::Gltf).unwrap_err().to_string();
     assert!(e.starts_with("t.gltf: ") && !e.contains('\n'), "{e}");
+    let instanced = crate::load::load_gltf_instanced(&path(), bytes).and_then(|s| s.expand());
+    assert_eq!(instanced.unwrap_err().to_string(), e);
     e
+}
+
+/// The scene loaded without expansion is `l`: expanded, the same mesh (every coordinate the same
+/// bits) and warnings; each part placed alone, the same positions and triangles (less its first
+/// vertex) as its object in `l`, the same name, mesh and matrix.
+fn same_instanced(path: &std::path::Path, bytes: &[u8], l: &Loaded) {
+    let scene = crate::load::load_gltf_instanced(path, bytes).unwrap();
+    let bits = |p: &[DVec3]| p.iter().map(|v| v.to_array().map(f64::to_bits)).collect::<Vec<_>>();
+    let e = scene.expand().unwrap();
+    assert_eq!(e.mesh, l.mesh);
+    assert_eq!(bits(&e.mesh.positions), bits(&l.mesh.positions));
+    assert_eq!(e.warnings, l.warnings);
+    assert_eq!(scene.warnings, l.warnings);
+    assert_eq!(scene.parts.len(), l.mesh.objects.len());
+    let mut first_tri = 0usize;
+    for (k, (part, object)) in scene.parts.iter().zip(&l.mesh.objects).enumerate() {
+        assert_eq!(
+            (Some(&part.name), Some(part.mesh), Some(part.world)),
+            (Some(&object.name), object.gltf_mesh, object.world)
+        );
+        let (pos, tris) = scene.place(k).unwrap();
+        assert_eq!(scene.part_counts(k), (pos.len(), tris.len()));
+        let mine = &l.mesh.triangles[first_tri..first_tri + tris.len()];
+        assert!(l.mesh.tri_object[first_tri..first_tri + tris.len()].iter().all(|&o| o as usize == k));
+        let base = mine.iter().flatten().copied().min().unwrap_or(0);
+        assert_eq!(tris, mine.iter().map(|t| t.map(|v| v - base)).collect::<Vec<_>>(), "part {k}");
+        assert_eq!(bits(&pos), bits(&l.mesh.positions[base as usize..base as usize + pos.len()]), "part {k}");
+        first_tri += tris.len();
+    }
+    assert_eq!(first_tri, l.mesh.triangles.len());
+}
+
+#[test]
+fn instanced_loads_of_shipped_and_shared_scenes_place_parts_as_the_expanded_load() {
+    let names = ["Box.glb", "SimpleMeshes.gltf", "pins.glb", "simple_pole.glb", "2CylinderEngine.glb"];
+    for name in names {
+        let Some(p) = shared(name) else {
+            eprintln!("skipped {name}: not found (set MESHCLASH_SHARED_MESHES)");
+            continue;
+        };
+        let bytes = std::fs::read(&p).unwrap();
+        let (l, _) = load_path(&p).unwrap();
+        same_instanced(&p, &bytes, &l);
+        // The scene keeps each mesh once: its own size is independent of the instances.
+        let scene = crate::load::load_gltf_instanced(&p, &bytes).unwrap();
+        let v: usize = (0..scene.parts.len()).map(|k| scene.part_counts(k).0).sum();
+        assert_eq!(v, l.mesh.positions.len(), "{name}");
+    }
 }
 
 /// Wraps JSON and a binary chunk into a GLB.

@@ -88,6 +88,7 @@ pub fn available_memory() -> Option<u64> {
 
 mod gltf;
 mod gltf_data;
+pub use gltf::{InstancedScene, ScenePart};
 mod obj;
 mod stl;
 
@@ -254,6 +255,21 @@ pub fn load_bytes(path: &Path, bytes: &[u8], format: Format) -> Result<Loaded> {
     };
     validate(path, &loaded)?;
     Ok(loaded)
+}
+
+/// Loads glTF or GLB `bytes` without expanding its instances: each mesh once in its own
+/// coordinates and every part as (mesh, world matrix), with every check and error of
+/// [`load_bytes`] made in the same order; [`InstancedScene::expand`] then gives what
+/// [`load_bytes`] gives, and [`InstancedScene::place`] one part of it.
+pub fn load_gltf_instanced(path: &Path, bytes: &[u8]) -> Result<InstancedScene> {
+    if bytes.is_empty() {
+        return Err(Error::in_file(path, InputProblem::Empty));
+    }
+    let scene = gltf::load_instanced(path, bytes)?;
+    if scene.parts.is_empty() {
+        return Err(Error::in_file(path, InputProblem::NoTriangles));
+    }
+    Ok(scene)
 }
 
 /// Detects the format from the extension of `path` (case-insensitive `.obj`, `.stl`, `.gltf`,

@@ -37,16 +37,34 @@ impl Mesh {
     /// The given triangles (in that order) re-indexed to the vertices they use, numbered in
     /// order of first use, and for each new index the vertex it stands for.
     pub fn reindex(&self, tris: &[u32]) -> (Vec<[u32; 3]>, Vec<u32>) {
-        // A table over every vertex when the triangles may use a good share of them (one array
-        // lookup each); a hash map for a few triangles of a large mesh (the table would cost
-        // more to fill than it saves). The numbering is the same either way.
-        self.reindex_by(tris, tris.len().saturating_mul(24) >= self.positions.len())
+        // A table over the span of vertices the triangles use when they may use a good share
+        // of it (one array lookup each): a part of a glTF scene uses one contiguous run of
+        // the scene's vertices, however large the scene. A hash map for a few triangles
+        // scattered over a large mesh (the table would cost more to fill than it saves). The
+        // numbering is the same either way.
+        let (lo, hi) = self.span(tris);
+        self.reindex_by(tris, tris.len().saturating_mul(24) >= (hi - lo) as usize, lo, hi)
     }
 
-    /// [`Mesh::reindex`] with a table (`table`) or a hash map.
-    fn reindex_by(&self, tris: &[u32], table: bool) -> (Vec<[u32; 3]>, Vec<u32>) {
+    /// The least and one past the greatest vertex index the given triangles use (`(0, 0)` for
+    /// none).
+    fn span(&self, tris: &[u32]) -> (u32, u32) {
+        let (lo, hi) = tris.iter().fold((u32::MAX, 0u32), |(lo, hi), &t| {
+            let [a, b, c] = self.triangles[t as usize];
+            (lo.min(a).min(b).min(c), hi.max(a).max(b).max(c))
+        });
+        if lo > hi {
+            (0, 0)
+        } else {
+            (lo, hi + 1)
+        }
+    }
+
+    /// [`Mesh::reindex`] with a table over vertices `lo..hi` (`table`; every vertex the
+    /// triangles use lies there) or a hash map.
+    fn reindex_by(&self, tris: &[u32], table: bool, lo: u32, hi: u32) -> (Vec<[u32; 3]>, Vec<u32>) {
         let mut remap = if table {
-            Remap::Table(vec![u32::MAX; self.positions.len()])
+            Remap::Table(lo, vec![u32::MAX; (hi - lo) as usize])
         } else {
             Remap::Map(std::collections::HashMap::new())
         };
@@ -128,16 +146,17 @@ impl TriMesh for Mesh {
 
 /// Old vertex index -> new, for [`Mesh::reindex`].
 enum Remap {
-    /// Indexed by the old vertex; `u32::MAX` where not yet numbered.
-    Table(Vec<u32>),
+    /// Indexed by the old vertex less the first one of the span; `u32::MAX` where not yet
+    /// numbered.
+    Table(u32, Vec<u32>),
     Map(std::collections::HashMap<u32, u32>),
 }
 
 impl Remap {
     fn get_or_insert(&mut self, v: u32, new: impl FnOnce() -> u32) -> u32 {
         match self {
-            Remap::Table(t) => {
-                let slot = &mut t[v as usize];
+            Remap::Table(lo, t) => {
+                let slot = &mut t[(v - *lo) as usize];
                 if *slot == u32::MAX {
                     *slot = new();
                 }
@@ -203,7 +222,13 @@ mod tests {
         };
         for k in [0usize, 1, 7, 150, 600] {
             let tris: Vec<u32> = (0..k).map(|_| next(600) as u32).collect();
-            let (table, map) = (m.reindex_by(&tris, true), m.reindex_by(&tris, false));
+            let (lo, hi) = m.span(&tris);
+            let used = tris.iter().flat_map(|&t| m.triangles[t as usize]);
+            assert!(used.clone().all(|v| (lo..hi).contains(&v)), "{k}");
+            assert_eq!(used.clone().min(), (k > 0).then_some(lo));
+            assert_eq!(used.max(), (k > 0).then(|| hi - 1));
+            let (table, map) = (m.reindex_by(&tris, true, lo, hi), m.reindex_by(&tris, false, lo, hi));
+            assert_eq!(table, m.reindex_by(&tris, true, 0, n as u32), "{k}");
             assert_eq!(table, map, "{k}");
             assert_eq!(m.reindex(&tris), map);
             for (t, r) in tris.iter().zip(&table.0) {
