@@ -678,23 +678,8 @@ mod tests {
     use super::*;
 
     fn cube(at: DVec3) -> Mesh {
-        let v: Vec<DVec3> = (0..8)
-            .map(|i| at + DVec3::new((i & 1) as f64, ((i >> 1) & 1) as f64, ((i >> 2) & 1) as f64))
-            .collect();
-        let t = vec![
-            [0, 2, 1],
-            [1, 2, 3],
-            [4, 5, 6],
-            [5, 7, 6],
-            [0, 1, 4],
-            [1, 5, 4],
-            [2, 6, 3],
-            [3, 6, 7],
-            [0, 4, 2],
-            [2, 4, 6],
-            [1, 3, 5],
-            [3, 7, 5],
-        ];
+        let v = crate::testing::gen::box_corners(at, at + DVec3::ONE).to_vec();
+        let t = crate::testing::gen::BOX_TRIANGLES.to_vec();
         Mesh {
             positions: v,
             tri_object: vec![0; t.len()],

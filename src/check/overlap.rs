@@ -272,20 +272,34 @@ where
     // Every 8th run of triangles first, from nothing; then the rest from the box they found,
     // so most edges of the rest lie strictly inside it and need no tree walk.
     let empty = ExactBox::new(frame);
-    let seed = |r: u32| r.is_multiple_of(8);
-    let rest = |r: u32| !r.is_multiple_of(8);
-    let (sa, sb) =
-        rayon::join(|| edges_against(&empty, a, (b, tb), seed), || edges_against(&empty, b, (a, ta), seed));
-    let seeded = sa.merge(sb);
-    let (ra, rb) =
-        rayon::join(|| edges_against(&seeded, a, (b, tb), rest), || edges_against(&seeded, b, (a, ta), rest));
-    let mut acc = ra.merge(rb);
+    let mut acc = if a.triangle_count() <= EDGE_RUN as usize && b.triangle_count() <= EDGE_RUN as usize {
+        // One run each: nothing to spread over threads, and B's edges start from the box A's
+        // found (more of them are skipped than from nothing).
+        let from_a = edges_against(&empty, a, (b, tb), |_| true);
+        edges_against(&from_a, b, (a, ta), |_| true)
+    } else {
+        let seed = |r: u32| r.is_multiple_of(8);
+        let rest = |r: u32| !r.is_multiple_of(8);
+        let (sa, sb) = rayon::join(
+            || edges_against(&empty, a, (b, tb), seed),
+            || edges_against(&empty, b, (a, ta), seed),
+        );
+        let seeded = sa.merge(sb);
+        let (ra, rb) = rayon::join(
+            || edges_against(&seeded, a, (b, tb), rest),
+            || edges_against(&seeded, b, (a, ta), rest),
+        );
+        ra.merge(rb)
+    };
     let mut cand = Vec::new();
     candidates(&acc, 0, a, &tb.root_box(), &mut cand);
     candidates(&acc, 1, b, &ta.root_box(), &mut cand);
     vertices_inside(&mut acc, &cand, [&|p| inside_or_on(p, b, tb), &|p| inside_or_on(p, a, ta)])?;
     acc.finish()
 }
+
+/// Triangles per run of [`edges_against`] (a cost setting only: the box is the same for any).
+const EDGE_RUN: u32 = 4096;
 
 /// The points where the edges of `m` meet the faces of `other` (tree `tree`), added to a copy
 /// of `start`.
@@ -309,7 +323,7 @@ where
     T: Tree + ?Sized,
 {
     use rayon::prelude::*;
-    const RUN: u32 = 4096;
+    const RUN: u32 = EDGE_RUN;
     let other_box = tree.root_box();
     let n = m.triangle_count() as u32;
     let run = |first: u32| {

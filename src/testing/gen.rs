@@ -6,6 +6,31 @@ use crate::geom::{Aabb, DVec3};
 use crate::scene::mesh::{Mesh, Object};
 use glam::DMat4;
 
+/// The 12 outward-facing triangles of a box whose corner `i` has bit 0, 1, 2 of `i` set for
+/// the maximum in x, y, z (the corner numbering of [`box_corners`]).
+pub const BOX_TRIANGLES: [[u32; 3]; 12] = [
+    [0, 2, 1],
+    [1, 2, 3],
+    [4, 5, 6],
+    [5, 7, 6],
+    [0, 1, 4],
+    [1, 5, 4],
+    [2, 6, 3],
+    [3, 6, 7],
+    [0, 4, 2],
+    [2, 4, 6],
+    [1, 3, 5],
+    [3, 7, 5],
+];
+
+/// The 8 corners of the box `[lo, hi]`, corner `i` taking `hi` on the axes of its set bits.
+pub fn box_corners(lo: DVec3, hi: DVec3) -> [DVec3; 8] {
+    std::array::from_fn(|i| {
+        let pick = |bit: usize, axis: usize| if i >> bit & 1 == 1 { hi[axis] } else { lo[axis] };
+        DVec3::new(pick(0, 0), pick(1, 1), pick(2, 2))
+    })
+}
+
 /// A torus around the z axis (major radius 1, minor 0.35) with `2·u·v ≈ n` triangles, u = 2v.
 pub fn torus(n: usize) -> Mesh {
     let v = ((n as f64 / 4.0).sqrt().round() as usize).max(3);
