@@ -3,6 +3,7 @@
 //! marker, contact lines, faint triangles, extras and a camera, the truncation said in the
 //! root's extras, `--up z`, and file names without directories.
 
+use crate::common::boxes_obj;
 use assert_cmd::Command;
 use meshclash::report::self_report::SelfReport;
 use meshclash::report::Report;
@@ -93,25 +94,6 @@ impl Glb {
         let b = p.bounding_box();
         (0..3).map(|k| (b.max[k] - b.min[k]) as f64).fold(0.0, f64::max)
     }
-}
-
-fn boxes_obj(dir: &Path, file: &str, boxes: &[(&str, [f64; 3], [f64; 3])]) -> String {
-    let mut s = String::new();
-    for (k, (name, lo, hi)) in boxes.iter().enumerate() {
-        s += &format!("o {name}\n");
-        for i in 0..8 {
-            let c = |bit: usize, axis: usize| if i & bit != 0 { hi[axis] } else { lo[axis] };
-            s += &format!("v {} {} {}\n", c(1, 0), c(2, 1), c(4, 2));
-        }
-        let quads = [[0, 2, 3, 1], [4, 5, 7, 6], [0, 1, 5, 4], [2, 6, 7, 3], [0, 4, 6, 2], [1, 3, 7, 5]];
-        let o = 8 * k + 1;
-        for [a, b, c, d] in quads {
-            s += &format!("f {} {} {}\nf {} {} {}\n", a + o, b + o, c + o, a + o, c + o, d + o);
-        }
-    }
-    let p = dir.join(file);
-    std::fs::write(&p, s).unwrap();
-    p.display().to_string()
 }
 
 /// Run with `--export-glb` and `-o`: the GLB, the report and the exit code.
