@@ -15,7 +15,7 @@ use crate::geom::{Aabb, DVec3};
 use crate::load::{self, Format};
 use crate::narrow::distance::triangle_distance;
 use crate::narrow::exact_distance::exact_distance_sq;
-use crate::narrow::tri_tri::{self, Contact, Shape};
+use crate::narrow::tri_tri::{self, Contact};
 use crate::scene::mesh::{Mesh, TriMesh};
 use glam::DMat4;
 use rayon::prelude::*;
@@ -350,7 +350,11 @@ impl MeshInfo {
     pub fn of(mesh: &Mesh) -> MeshInfo {
         let degenerate_triangles = (0..mesh.triangles.len() as u32)
             .into_par_iter()
-            .filter(|&t| Shape::of(&bvh::triangle(mesh, t)).is_degenerate())
+            .filter(|&t| {
+                // Zero area exactly when collinear (as `tri_tri::Shape::of` decides).
+                let [a, b, c] = bvh::triangle(mesh, t);
+                predicates::collinear(a, b, c)
+            })
             .count();
         let mut counts = vec![0usize; mesh.objects.len()];
         for &o in &mesh.tri_object {

@@ -62,7 +62,13 @@ fn pair_report(p: &PairFinding, ca: &[u32], cb: &[u32]) -> PairReport {
 pub fn build(o: &Outcome) -> Report {
     let [ia, ib] = [&o.inputs[0], &o.inputs[1]];
     let r = &o.assembly.result;
-    let (infa, infb) = (MeshInfo::of(&ia.input.mesh), MeshInfo::of(&ib.input.mesh));
+    // A scene's two sides are one input: summarise it once.
+    let (infa, infb) = if std::sync::Arc::ptr_eq(ia, ib) {
+        let info = MeshInfo::of(&ia.input.mesh);
+        (info.clone(), info)
+    } else {
+        rayon::join(|| MeshInfo::of(&ia.input.mesh), || MeshInfo::of(&ib.input.mesh))
+    };
     let (oa, ob) = (&ia.input.mesh.tri_object, &ib.input.mesh.tri_object);
     let (assembly, parts, mut part_pairs) = assembly_view(&o.assembly, o.settings.max_pairs);
     for (pp, ov) in part_pairs.iter_mut().zip(&o.overlaps) {
