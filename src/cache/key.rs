@@ -44,6 +44,22 @@ pub(crate) fn to_hex(d: &Digest) -> String {
     d.iter().map(|b| format!("{b:02x}")).collect()
 }
 
+/// The name of a model's index of earlier runs: `objects:` and the SHA-256 of its inputs'
+/// object names (per input its object count, then each name's length and bytes). Content, not
+/// file names: a model saved under another name or moved elsewhere finds its earlier runs, and
+/// a moved or reshaped part keeps its model's index.
+pub fn lineage(inputs: &[&Mesh]) -> String {
+    let mut sha = Sha256::default();
+    for mesh in inputs {
+        put_len(&mut sha, mesh.objects.len());
+        for o in &mesh.objects {
+            put_len(&mut sha, o.name.len());
+            sha.update(o.name.as_bytes());
+        }
+    }
+    format!("objects:{}", to_hex(&finish(sha)))
+}
+
 fn put_len(sha: &mut Sha256, n: usize) {
     sha.update(&(n as u64).to_le_bytes());
 }

@@ -614,21 +614,10 @@ pub fn run(req: &Request, progress: &(dyn Fn(Phase) + Sync)) -> Result<Outcome> 
     progress(Phase::Check);
     let cache = store.map(|s| {
         let active = !req.cross_check;
-        // What the inputs are, by content rather than file name: the names of their objects
-        // (each input's object count, then each name's length and text). The cache finds its
-        // index of earlier runs by it (never a result: results are found by their geometry),
-        // so a model saved under another name or moved elsewhere finds its earlier runs, and
-        // a moved or reshaped part keeps its model's index.
-        let mut sha = crate::shard::sha256::Sha256::default();
+        // The cache finds its index of earlier runs by what the inputs are (their objects'
+        // names), never by file name; results are found by their geometry.
         let sides = if req.selection.scene { 1 } else { 2 };
-        for mesh in [&a.mesh, &b.mesh].into_iter().take(sides) {
-            sha.update(&(mesh.objects.len() as u64).to_le_bytes());
-            for o in &mesh.objects {
-                sha.update(&(o.name.len() as u64).to_le_bytes());
-                sha.update(o.name.as_bytes());
-            }
-        }
-        let lineage: String = sha.digest().iter().map(|b| format!("{b:02x}")).collect();
+        let lineage = crate::cache::key::lineage(&[&a.mesh, &b.mesh][..sides]);
         crate::cache::CheckCache::new(
             std::sync::Arc::new(s),
             &settings,
@@ -636,7 +625,7 @@ pub fn run(req: &Request, progress: &(dyn Fn(Phase) + Sync)) -> Result<Outcome> 
             req.split_bodies,
             req.penetration,
             active,
-            &format!("objects:{lineage}"),
+            &lineage,
         )
     });
     let selection = cache.as_ref().map(|c| c.selection(&req.selection));
