@@ -372,15 +372,15 @@ mod tests {
         let apex = out.positions.len() as u32;
         out.positions.push(at + DVec3::new(0.5 * s, s, 2f64.powi(-50)));
         let top = |v: u32| 8 + (v - 4);
-        // The top face (triangles 2 and 3) on its own, nudged corners; the sides keep 4..8.
+        // The top face (triangles 4 and 5) on its own, nudged corners; the sides keep 4..8.
         let mut tris = crate::testing::gen::BOX_TRIANGLES;
-        for t in &mut tris[2..4] {
+        for t in &mut tris[4..6] {
             *t = t.map(top);
         }
         for t in tris {
             out.triangles.push(t.map(|v| base + v));
         }
-        out.triangles[base_t + 1][0] = copy;
+        out.triangles[base_t + 3][0] = copy;
         out.triangles.push([base, base + 1, mid]);
         out.triangles.push([base + 2, base + 3, apex]);
         out.tri_object.resize(out.triangles.len(), 0);

@@ -8,7 +8,10 @@ use glam::DMat4;
 
 /// The 12 outward-facing triangles of a box whose corner `i` has bit 0, 1, 2 of `i` set for
 /// the maximum in x, y, z (the corner numbering of [`box_corners`]).
+/// Faces in the order x = min, z = min, z = max, y = min, y = max, x = max.
 pub const BOX_TRIANGLES: [[u32; 3]; 12] = [
+    [0, 4, 2],
+    [2, 4, 6],
     [0, 2, 1],
     [1, 2, 3],
     [4, 5, 6],
@@ -17,8 +20,6 @@ pub const BOX_TRIANGLES: [[u32; 3]; 12] = [
     [1, 5, 4],
     [2, 6, 3],
     [3, 6, 7],
-    [0, 4, 2],
-    [2, 4, 6],
     [1, 3, 5],
     [3, 7, 5],
 ];

@@ -28,30 +28,8 @@ impl Shape {
 }
 
 fn cuboid(lo: DVec3, hi: DVec3) -> Shape {
-    let v = (0..8)
-        .map(|i| {
-            DVec3::new(
-                if i & 1 == 1 { hi.x } else { lo.x },
-                if i & 2 == 2 { hi.y } else { lo.y },
-                if i & 4 == 4 { hi.z } else { lo.z },
-            )
-        })
-        .collect();
-    let t = vec![
-        [0, 4, 2],
-        [2, 4, 6],
-        [0, 2, 1],
-        [1, 2, 3],
-        [4, 5, 6],
-        [5, 7, 6],
-        [0, 1, 4],
-        [1, 5, 4],
-        [2, 6, 3],
-        [3, 6, 7],
-        [1, 3, 5],
-        [3, 7, 5],
-    ];
-    Shape::new(v, t)
+    use crate::testing::gen::{box_corners, BOX_TRIANGLES};
+    Shape::new(box_corners(lo, hi).to_vec(), BOX_TRIANGLES.to_vec())
 }
 
 fn tetrahedron(p: [DVec3; 4]) -> Option<Shape> {
