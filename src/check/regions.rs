@@ -62,29 +62,98 @@ pub struct Penetration {
 
 /// Group `pairs` (triangle indices into `a` and `b`) into regions, sorted by id.
 pub fn regions(pairs: &[PairFinding], a: &Mesh, b: &Mesh) -> Vec<Region> {
-    let n = pairs.len();
-    let mut parent: Vec<u32> = (0..n as u32).collect();
-    let mut first: HashMap<(u8, u32, u32, [u64; 3]), u32> = HashMap::new();
-    for (i, p) in pairs.iter().enumerate() {
-        let objs = (a.tri_object[p.a as usize], b.tri_object[p.b as usize]);
-        let verts = [(0u8, a, p.a), (1u8, b, p.b)];
-        for (side, m, t) in verts {
+    regions_with_ids(pairs, a, b, &crate::check::finding_id::finding_hashes(pairs, a, b))
+}
+
+/// [`regions`] given every pair's finding id (`ids[i]`, the
+/// [`crate::check::finding_id::finding_hash`] of `pairs[i]`).
+///
+/// Regions never span part pairs, so each part pair's pairs are grouped on their own (in
+/// parallel): the (side, vertex) keys of its pairs' triangles are sorted, and pairs with equal
+/// keys joined.
+pub fn regions_with_ids(pairs: &[PairFinding], a: &Mesh, b: &Mesh, ids: &[u64]) -> Vec<Region> {
+    assert_eq!(pairs.len(), ids.len(), "one finding id per pair");
+    let objects = |p: &PairFinding| (a.tri_object[p.a as usize], b.tri_object[p.b as usize]);
+    // The pairs of each part pair, in pair order.
+    let mut order: Vec<((u32, u32), u32)> =
+        pairs.par_iter().enumerate().map(|(i, p)| (objects(p), i as u32)).collect();
+    order.par_sort_unstable();
+    let mut spans: Vec<&[((u32, u32), u32)]> = order.chunk_by(|x, y| x.0 == y.0).collect();
+    // Large part pairs first, so the parallel split stays even.
+    spans.sort_by_key(|s| std::cmp::Reverse(s.len()));
+    let mut out: Vec<(u64, Region)> = spans
+        .par_iter()
+        .flat_map_iter(|span| {
+            let members: Vec<usize> = span.iter().map(|&(_, i)| i as usize).collect();
+            part_pair_regions(pairs, a, b, ids, &members)
+        })
+        .collect();
+    // Distinct pairs have distinct ids but for a hash collision (or identical triangles and
+    // names): the first member settles those ties.
+    out.par_sort_unstable_by_key(|(id, r)| (*id, r.members[0]));
+    out.into_iter().map(|(_, r)| r).collect()
+}
+
+/// The regions of one part pair's pairs (`members`: their indices into `pairs`, ascending),
+/// each with its id's number.
+fn part_pair_regions(
+    pairs: &[PairFinding],
+    a: &Mesh,
+    b: &Mesh,
+    ids: &[u64],
+    members: &[usize],
+) -> Vec<(u64, Region)> {
+    // Nodes: the distinct A triangles of these pairs, then the distinct B triangles. Two
+    // nodes of one side are joined when their triangles share a vertex position, and a pair
+    // joins its two nodes; pairs are in one region exactly when their nodes are joined (pairs
+    // with the same triangle share its vertices).
+    let mut tris: [Vec<u32>; 2] =
+        [members.iter().map(|&i| pairs[i].a).collect(), members.iter().map(|&i| pairs[i].b).collect()];
+    for t in &mut tris {
+        t.sort_unstable();
+        t.dedup();
+    }
+    let na = tris[0].len();
+    let mut parent: Vec<u32> = (0..(na + tris[1].len()) as u32).collect();
+    for (side, m) in [(0usize, a), (1usize, b)] {
+        let base = if side == 0 { 0 } else { na as u32 };
+        let mut keys: Vec<([u64; 3], u32)> = Vec::with_capacity(3 * tris[side].len());
+        for (k, &t) in tris[side].iter().enumerate() {
             for v in m.triangles[t as usize] {
-                let k = (side, objs.0, objs.1, vertex_key(&m.positions[v as usize]));
-                let j = *first.entry(k).or_insert(i as u32);
-                union(&mut parent, i as u32, j);
+                keys.push((vertex_key(&m.positions[v as usize]), base + k as u32));
+            }
+        }
+        keys.sort_unstable();
+        for w in keys.windows(2) {
+            if w[0].0 == w[1].0 {
+                union(&mut parent, w[0].1, w[1].1);
             }
         }
     }
-    let hashes: Vec<u64> =
-        pairs.par_iter().map(|p| crate::check::finding_id::finding_hash(a, p.a, b, p.b)).collect();
-    let mut groups: HashMap<u32, Vec<usize>> = HashMap::new();
-    for i in 0..n {
-        let r = find(&mut parent, i as u32);
-        groups.entry(r).or_default().push(i);
+    let node = |side: usize, t: u32| -> u32 {
+        let k = tris[side].binary_search(&t).expect("the triangle is a node") as u32;
+        if side == 0 {
+            k
+        } else {
+            na as u32 + k
+        }
+    };
+    let nodes: Vec<u32> = members.iter().map(|&i| node(0, pairs[i].a)).collect();
+    for (&i, &na_node) in members.iter().zip(&nodes) {
+        union(&mut parent, na_node, node(1, pairs[i].b));
     }
-    let mut out: Vec<Region> = groups
-        .into_values()
+    // One set per root, numbered in order of first member; members stay ascending.
+    let mut set_of_root = vec![u32::MAX; parent.len()];
+    let mut sets: Vec<Vec<usize>> = Vec::new();
+    for (&i, &n) in members.iter().zip(&nodes) {
+        let r = find(&mut parent, n) as usize;
+        if set_of_root[r] == u32::MAX {
+            set_of_root[r] = sets.len() as u32;
+            sets.push(Vec::new());
+        }
+        sets[set_of_root[r] as usize].push(i);
+    }
+    sets.into_iter()
         .map(|members| {
             let mut bounds = Aabb::EMPTY;
             let mut sum = DVec3::ZERO;
@@ -102,10 +171,10 @@ pub fn regions(pairs: &[PairFinding], a: &Mesh, b: &Mesh) -> Vec<Region> {
                 bounds = bounds.grow(lo).grow(hi);
                 sum += lo * 0.5 + hi * 0.5;
                 crossing += (p.kind == PairKind::Crossing) as usize;
-                id = id.min(hashes[i]);
+                id = id.min(ids[i]);
             }
             let p0 = &pairs[members[0]];
-            Region {
+            let region = Region {
                 id: crate::check::finding_id::format_id(id),
                 objects: (a.tri_object[p0.a as usize], b.tri_object[p0.b as usize]),
                 pairs: members.len(),
@@ -115,11 +184,10 @@ pub fn regions(pairs: &[PairFinding], a: &Mesh, b: &Mesh) -> Vec<Region> {
                 extent: bounds.extent().length(),
                 penetration: None,
                 members,
-            }
+            };
+            (id, region)
         })
-        .collect();
-    out.sort_by(|x, y| x.id.cmp(&y.id));
-    out
+        .collect()
 }
 
 fn point_distance(p: DVec3, m: &Mesh, t: &Bvh) -> f64 {
@@ -516,5 +584,133 @@ mod tests {
         let regs = estimated(&a, &b);
         assert!(!regs.is_empty());
         assert!(regs.iter().all(|g| g.penetration.unwrap().depth == 0.0), "{regs:?}");
+    }
+
+    /// A mesh of `n` triangles on a coarse integer grid (so that many share vertex positions,
+    /// some with a negative zero), spread over `objects` objects.
+    fn grid_mesh(n: usize, objects: u32, seed: u64) -> Mesh {
+        let mut r = seed;
+        let mut next = move |m: u64| {
+            r = r.wrapping_mul(6_364_136_223_846_793_005).wrapping_add(1_442_695_040_888_963_407);
+            (r >> 33) % m
+        };
+        let mut m = Mesh::default();
+        for _ in 0..n {
+            let base = m.positions.len() as u32;
+            for _ in 0..3 {
+                let c = |v: u64| if v == 0 { -0.0 } else { v as f64 * 0.5 };
+                m.positions.push(DVec3::new(c(next(6)), c(next(6)), c(next(3))));
+            }
+            m.triangles.push([base, base + 1, base + 2]);
+            m.tri_object.push(next(objects as u64) as u32);
+        }
+        m.objects = (0..objects).map(|o| Object { name: format!("o{o}"), ..Default::default() }).collect();
+        m
+    }
+
+    /// Regions as one union-find over every pair, keyed by (side, part pair, vertex): the
+    /// definition, written the plain way.
+    fn regions_oracle(pairs: &[PairFinding], a: &Mesh, b: &Mesh) -> Vec<Region> {
+        let n = pairs.len();
+        let mut parent: Vec<u32> = (0..n as u32).collect();
+        let mut first: HashMap<(u8, u32, u32, [u64; 3]), u32> = HashMap::new();
+        for (i, p) in pairs.iter().enumerate() {
+            let objs = (a.tri_object[p.a as usize], b.tri_object[p.b as usize]);
+            for (side, m, t) in [(0u8, a, p.a), (1u8, b, p.b)] {
+                for v in m.triangles[t as usize] {
+                    let k = (side, objs.0, objs.1, vertex_key(&m.positions[v as usize]));
+                    let j = *first.entry(k).or_insert(i as u32);
+                    union(&mut parent, i as u32, j);
+                }
+            }
+        }
+        let mut groups: std::collections::BTreeMap<u32, Vec<usize>> = Default::default();
+        for i in 0..n {
+            let r = find(&mut parent, i as u32);
+            groups.entry(r).or_default().push(i);
+        }
+        let mut out: Vec<Region> = groups
+            .into_values()
+            .map(|members| {
+                let (mut bounds, mut sum, mut crossing) = (Aabb::EMPTY, DVec3::ZERO, 0);
+                let mut id = String::from("g");
+                for &i in &members {
+                    let p = &pairs[i];
+                    let [lo, hi] = p.segment.unwrap();
+                    bounds = bounds.grow(lo).grow(hi);
+                    sum += lo * 0.5 + hi * 0.5;
+                    crossing += (p.kind == PairKind::Crossing) as usize;
+                    id = id.min(crate::check::finding_id::finding_id(a, p.a, b, p.b));
+                }
+                let p0 = &pairs[members[0]];
+                Region {
+                    id,
+                    objects: (a.tri_object[p0.a as usize], b.tri_object[p0.b as usize]),
+                    pairs: members.len(),
+                    crossing,
+                    center: sum / members.len() as f64,
+                    bounds,
+                    extent: bounds.extent().length(),
+                    penetration: None,
+                    members,
+                }
+            })
+            .collect();
+        out.sort_by(|x, y| (&x.id, x.members[0]).cmp(&(&y.id, y.members[0])));
+        out
+    }
+
+    fn in_pool<T: Send>(threads: usize, f: impl FnOnce() -> T + Send) -> T {
+        rayon::ThreadPoolBuilder::new().num_threads(threads).build().unwrap().install(f)
+    }
+
+    #[test]
+    fn regions_and_ids_match_the_plain_definition_at_any_thread_count() {
+        let (a, b) = (grid_mesh(300, 3, 1), grid_mesh(200, 4, 2));
+        let mut r = 7u64;
+        let mut next = move |m: u64| {
+            r = r.wrapping_mul(6_364_136_223_846_793_005).wrapping_add(1_442_695_040_888_963_407);
+            (r >> 33) % m
+        };
+        let mut tri_pairs: Vec<(u32, u32)> =
+            (0..5000).map(|_| (next(300) as u32, next(200) as u32)).collect();
+        tri_pairs.sort_unstable();
+        tri_pairs.dedup();
+        let kinds = [PairKind::Crossing, PairKind::Touching, PairKind::Clearance];
+        let mut pairs: Vec<PairFinding> = tri_pairs
+            .iter()
+            .map(|&(ta, tb)| {
+                let s = DVec3::new(next(100) as f64, next(100) as f64, -(next(100) as f64)) / 7.0;
+                PairFinding {
+                    a: ta,
+                    b: tb,
+                    kind: kinds[next(3) as usize],
+                    contact: None,
+                    distance: 0.0,
+                    segment: Some([s, s + DVec3::new(0.1, next(9) as f64, 0.3)]),
+                }
+            })
+            .collect();
+        for sorted in [true, false] {
+            if !sorted {
+                // Not sorted by (a, b): the shared first halves of the hashes must not leak.
+                pairs.reverse();
+                pairs.swap(1, 40);
+            }
+            let want_ids: Vec<u64> =
+                pairs.iter().map(|p| crate::check::finding_id::finding_hash(&a, p.a, &b, p.b)).collect();
+            let want = regions_oracle(&pairs, &a, &b);
+            assert!(want.len() > 5 && want.iter().any(|r| r.pairs > 1), "{}", want.len());
+            for threads in [1, 2, 3] {
+                let ids = in_pool(threads, || crate::check::finding_id::finding_hashes(&pairs, &a, &b));
+                assert_eq!(ids, want_ids, "{threads} threads");
+                let got = in_pool(threads, || regions_with_ids(&pairs, &a, &b, &ids));
+                assert_eq!(got.len(), want.len());
+                for (g, w) in got.iter().zip(&want) {
+                    assert_eq!(g, w, "{threads} threads");
+                    assert_eq!(g.center.to_array().map(f64::to_bits), w.center.to_array().map(f64::to_bits));
+                }
+            }
+        }
     }
 }

@@ -56,6 +56,10 @@ pub struct Staged {
     pending: Vec<(PathBuf, tempfile::NamedTempFile)>,
 }
 
+/// The buffer an output is written through: large reports (hundreds of MB of pretty JSON)
+/// are written in few system calls.
+const OUT_BUFFER: usize = 1 << 20;
+
 impl Staged {
     /// Nothing staged yet.
     pub fn new() -> Self {
@@ -79,11 +83,11 @@ impl Staged {
             Target::Directory => return Err(Error::output(path, OutputProblem::IsADirectory)),
             Target::Direct => {
                 let f = std::fs::OpenOptions::new().write(true).truncate(true).open(path).map_err(&err)?;
-                let mut w = BufWriter::new(f);
+                let mut w = BufWriter::with_capacity(OUT_BUFFER, f);
                 return fill(&mut w).and_then(|_| w.flush()).map_err(&err);
             }
             Target::Descriptor(f) => {
-                let mut w = BufWriter::new(f);
+                let mut w = BufWriter::with_capacity(OUT_BUFFER, f);
                 return fill(&mut w).and_then(|_| w.flush()).map_err(&err);
             }
             Target::Replace(t) => t,
@@ -93,7 +97,7 @@ impl Staged {
         let mut tmp =
             tempfile::Builder::new().permissions(mode).tempfile_in(dir_of(&target)).map_err(&err)?;
         {
-            let mut w = BufWriter::new(tmp.as_file_mut());
+            let mut w = BufWriter::with_capacity(OUT_BUFFER, tmp.as_file_mut());
             fill(&mut w).and_then(|_| w.flush()).map_err(&err)?;
         }
         tmp.as_file().sync_all().map_err(&err)?;

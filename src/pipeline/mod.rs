@@ -643,7 +643,10 @@ pub fn run(req: &Request, progress: &(dyn Fn(Phase) + Sync)) -> Result<Outcome> 
     };
     progress(Phase::Write);
     let result = &outcome.result;
-    let mut regions = crate::check::regions::regions(&result.pairs, &a.mesh, &b.mesh);
+    // Every finding's id, computed once: regions take theirs from them, an uncut list shows
+    // them all, a cut one records the rest under `unlisted`, and a baseline compares them all.
+    let ids = crate::check::finding_id::finding_hashes(&result.pairs, &a.mesh, &b.mesh);
+    let mut regions = crate::check::regions::regions_with_ids(&result.pairs, &a.mesh, &b.mesh, &ids);
     if req.penetration && !settings.first_hit {
         let opts = BuildOptions::default();
         crate::check::regions::estimate_penetration(&mut regions, &result.pairs, &a.mesh, &b.mesh, opts);
@@ -671,12 +674,9 @@ pub fn run(req: &Request, progress: &(dyn Fn(Phase) + Sync)) -> Result<Outcome> 
         overlaps::files_overlap(&outcome, &a.mesh, &b.mesh, req.selection.scene, req.settings.bvh);
     let listed = listed_pairs(&result.pairs, req.max_pairs);
     let cut = listed.len() < result.pairs.len();
-    // Every finding's id when the list is cut (the report records the unlisted ones) or a
-    // baseline compares; else only the listed pairs'.
-    // Every finding's id: an uncut list shows them all, a cut one records the rest under
-    // `unlisted`, and a baseline compares them all.
-    let all: Vec<Finding> = baseline::findings(&result.pairs, &a.mesh, &b.mesh);
-    let listed_ids: Vec<String> = listed.iter().map(|&i| all[i].id.clone()).collect();
+    let all: Vec<Finding> = baseline::findings_of(&result.pairs, &ids);
+    let listed_ids: Vec<String> =
+        listed.iter().map(|&i| crate::check::finding_id::format_id(ids[i])).collect();
     let unlisted = cut.then(|| baseline::unlisted(&all, &listed));
     let contained = crate::report::ReportContainment::of(&result.containment);
     let comparison = base.as_ref().map(|base| compare(base, &all, &listed, contained));

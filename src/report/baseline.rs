@@ -51,10 +51,11 @@ pub struct BaselineReport {
 }
 
 /// A finding of this run: its id and kind.
-#[derive(Debug, Clone, PartialEq, Eq)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub struct Finding {
-    /// Stable id (16 hex digits).
-    pub id: String,
+    /// Stable id: the number its 16 hex digits spell ([`crate::check::finding_id::format_id`]
+    /// writes it).
+    pub id: u64,
     /// How the pair meets.
     pub kind: PairKind,
 }
@@ -73,13 +74,37 @@ pub struct Baseline {
 }
 
 impl Baseline {
-    /// Does the baseline have a finding with this id?
-    pub fn contains(&self, id: &str) -> bool {
-        parse_hex(id).is_some_and(|k| self.ids.contains_key(&k))
+    /// Does the baseline have a finding with this id (its 16 hex digits, or its number)?
+    pub fn contains<I: AsFindingId + ?Sized>(&self, id: &I) -> bool {
+        id.finding_id().is_some_and(|k| self.ids.contains_key(&k))
     }
 
-    fn crossing(&self, id: &str) -> bool {
-        parse_hex(id).and_then(|k| self.ids.get(&k)).copied().unwrap_or(false)
+    fn crossing<I: AsFindingId + ?Sized>(&self, id: &I) -> bool {
+        id.finding_id().and_then(|k| self.ids.get(&k)).copied().unwrap_or(false)
+    }
+}
+
+/// A finding id as written (16 hex digits) or as its number.
+pub trait AsFindingId {
+    /// The id's number, or None when it is malformed.
+    fn finding_id(&self) -> Option<u64>;
+}
+
+impl AsFindingId for u64 {
+    fn finding_id(&self) -> Option<u64> {
+        Some(*self)
+    }
+}
+
+impl AsFindingId for str {
+    fn finding_id(&self) -> Option<u64> {
+        parse_hex(self)
+    }
+}
+
+impl AsFindingId for String {
+    fn finding_id(&self) -> Option<u64> {
+        parse_hex(self)
     }
 }
 
@@ -92,24 +117,36 @@ pub use crate::check::finding_id::finding_id;
 
 /// Ids and kinds of every pair found (in the order of `pairs`).
 pub fn findings(pairs: &[PairFinding], a: &Mesh, b: &Mesh) -> Vec<Finding> {
-    use rayon::prelude::*;
-    pairs.par_iter().map(|p| Finding { id: finding_id(a, p.a, b, p.b), kind: p.kind }).collect()
+    findings_of(pairs, &crate::check::finding_id::finding_hashes(pairs, a, b))
+}
+
+/// The findings of `pairs` whose ids (`ids[i]` the id of `pairs[i]`) are already known.
+pub fn findings_of(pairs: &[PairFinding], ids: &[u64]) -> Vec<Finding> {
+    debug_assert_eq!(pairs.len(), ids.len());
+    pairs.iter().zip(ids).map(|(p, &id)| Finding { id, kind: p.kind }).collect()
 }
 
 /// The ids of the findings a cut list does not show (`listed`: the indices it shows, sorted),
 /// split by whether the finding is a crossing, each list sorted and without repeats.
 pub fn unlisted(all: &[Finding], listed: &[usize]) -> UnlistedFindings {
+    use rayon::prelude::*;
     let mut shown = listed.iter().copied().peekable();
-    let (mut crossing, mut other) = (BTreeSet::new(), BTreeSet::new());
+    let (mut crossing, mut other) = (Vec::new(), Vec::new());
     for (i, f) in all.iter().enumerate() {
         if shown.peek() == Some(&i) {
             shown.next();
             continue;
         }
-        if f.kind == PairKind::Crossing { &mut crossing } else { &mut other }.insert(f.id.as_str());
+        if f.kind == PairKind::Crossing { &mut crossing } else { &mut other }.push(f.id);
     }
-    let list = |s: BTreeSet<&str>| s.into_iter().map(str::to_string).collect();
-    UnlistedFindings { crossing_ids: list(crossing), other_ids: list(other) }
+    // 16 hex digits order as the numbers they spell.
+    let list = |mut ids: Vec<u64>| -> Vec<String> {
+        ids.par_sort_unstable();
+        ids.dedup();
+        ids.par_iter().map(|&k| crate::check::finding_id::format_id(k)).collect()
+    };
+    let (crossing_ids, other_ids) = rayon::join(|| list(crossing), || list(other));
+    UnlistedFindings { crossing_ids, other_ids }
 }
 
 /// A finding id as read from a baseline (16 hex digits; None when malformed).
@@ -287,7 +324,7 @@ fn is_containment_clash(c: Option<ReportContainment>) -> bool {
 /// Compare every finding of this run (`all`) with a baseline that records all of its own;
 /// `contained` is this run's containment.
 pub fn compare(all: &[Finding], base: &Baseline, contained: Option<ReportContainment>) -> BaselineReport {
-    let now: HashSet<u64> = all.iter().filter_map(|f| parse_hex(&f.id)).collect();
+    let now: HashSet<u64> = all.iter().map(|f| f.id).collect();
     let persistent = all.iter().filter(|f| base.contains(&f.id)).count() as u64;
     let new_crossing =
         all.iter().filter(|f| f.kind == PairKind::Crossing && !base.crossing(&f.id)).count() as u64;
@@ -411,5 +448,34 @@ mod tests {
         let bad = ok.replace(id2, "xyz");
         assert!(parse("b.json", bad.as_bytes()).unwrap_err().contains("malformed id"));
         assert_eq!(b.contained, Some(ReportContainment::AInB));
+    }
+
+    #[test]
+    fn unlisted_ids_are_the_sorted_distinct_hex_ids_of_the_pairs_not_shown() {
+        let mut r = 3u64;
+        let mut next = move || {
+            r = r.wrapping_mul(6_364_136_223_846_793_005).wrapping_add(1_442_695_040_888_963_407);
+            r
+        };
+        // Ids of every width and with repeats (a repeat may be listed once and unlisted once).
+        let all: Vec<Finding> = (0..3000)
+            .map(|i| {
+                let id = if i % 7 == 0 { 0xa5 } else { next() >> (next() % 64) };
+                let kind = if next() % 3 == 0 { PairKind::Crossing } else { PairKind::Touching };
+                Finding { id, kind }
+            })
+            .collect();
+        let listed: Vec<usize> = (0..all.len()).filter(|i| i % 5 == 1).collect();
+        let (mut crossing, mut other) = (BTreeSet::new(), BTreeSet::new());
+        for (i, f) in all.iter().enumerate() {
+            if !listed.contains(&i) {
+                let id = format!("{:016x}", f.id);
+                if f.kind == PairKind::Crossing { &mut crossing } else { &mut other }.insert(id);
+            }
+        }
+        let got = unlisted(&all, &listed);
+        assert_eq!(got.crossing_ids, crossing.into_iter().collect::<Vec<_>>());
+        assert_eq!(got.other_ids, other.into_iter().collect::<Vec<_>>());
+        assert!(got.crossing_ids.len() > 100 && got.crossing_ids.iter().all(|s| s.len() == 16));
     }
 }
