@@ -153,6 +153,8 @@ fn gen_and_cases_small() {
     for n in ["spheres", "tori-crossing", "tori-apart", "tori-linked"] {
         let c = by_name(n);
         assert_eq!(c["triangles"][0], c["triangles"][1], "{n}");
+        // What the CLI runs, timed through the library's pipeline (its verdict checked there).
+        assert!(c["meshclash"]["pipeline_ms"].as_f64().is_some(), "{n}: {c}");
         for tool in ["meshclash", "parry_f64", "parry_f32"] {
             assert!(c[tool]["build_ms"].as_f64().is_some(), "{n} {tool}: {c}");
             assert!(c[tool]["pairs_ms"].as_f64().is_some(), "{n} {tool}: {c}");

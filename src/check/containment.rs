@@ -45,30 +45,40 @@ pub struct Topology {
 /// table, [`crate::scene::bodies::merge_vertices_in_order`]; ids then follow the file's vertex
 /// order, so the union–find and the edge buckets below touch memory mostly in order), edges of
 /// the proper triangles bucketed by their lower end (a counting sort), components by a
-/// union–find whose roots are flattened in one ascending pass.
+/// union–find whose roots are flattened in one ascending pass. The merge runs beside the
+/// parallel pass that tells proper triangles (one byte each) from zero-area ones; the passes
+/// after it read each triangle's merged ids from the mesh again rather than from a copy.
 pub fn topology<M: TriMesh + ?Sized>(mesh: &M) -> Topology {
-    use rayon::prelude::*;
-    let (merged, distinct) = crate::scene::bodies::merge_vertices_in_order(&mesh.positions());
     use crate::scene::bodies::union;
+    use rayon::prelude::*;
     let n = mesh.triangle_count();
-    // Per triangle: its merged vertex ids, and whether it is proper (non-zero area).
-    let tris: Vec<([u32; 3], bool)> = (0..n as u32)
-        .into_par_iter()
-        .map(|t| {
-            let ids = mesh.indices(t).map(|i| merged[i as usize]);
-            (ids, !Shape::of(&mesh.triangle(t)).is_degenerate())
-        })
-        .collect();
+    let vertices = mesh.vertex_count();
+    let ((merged, distinct), proper) = rayon::join(
+        || crate::scene::bodies::merge_vertices_in_order(&mesh.positions()),
+        || {
+            (0..n as u32)
+                .into_par_iter()
+                .map(|t| !Shape::of(&mesh.triangle(t)).is_degenerate())
+                .collect::<Vec<bool>>()
+        },
+    );
+    let ids = |t: u32| mesh.indices(t).map(|i| merged[i as usize]);
     let mut parent: Vec<u32> = (0..distinct as u32).collect();
     // Undirected edges (lo, hi) of the proper triangles, bucketed by lo (a counting sort: two
     // passes over the triangles, 4 bytes per edge).
     let lo_hi = |v: [u32; 3], k: usize| (v[k].min(v[(k + 1) % 3]), v[k].max(v[(k + 1) % 3]));
     let mut start = vec![0u32; distinct + 1];
-    for &(v, is_proper) in &tris {
+    let mut used = vec![false; vertices];
+    for t in 0..n as u32 {
+        let idx = mesh.indices(t);
+        for i in idx {
+            used[i as usize] = true;
+        }
+        let v = idx.map(|i| merged[i as usize]);
         // Two unions join all three vertices.
         union(&mut parent, v[0], v[1]);
         union(&mut parent, v[1], v[2]);
-        if is_proper {
+        if proper[t as usize] {
             for k in 0..3 {
                 start[lo_hi(v, k).0 as usize + 1] += 1;
             }
@@ -79,7 +89,8 @@ pub fn topology<M: TriMesh + ?Sized>(mesh: &M) -> Topology {
     }
     let mut fill = start.clone();
     let mut hi = vec![0u32; start[distinct] as usize];
-    for &(v, _) in tris.iter().filter(|x| x.1) {
+    for t in (0..n as u32).filter(|&t| proper[t as usize]) {
+        let v = ids(t);
         for k in 0..3 {
             let (a, b) = lo_hi(v, k);
             hi[fill[a as usize] as usize] = b;
@@ -87,6 +98,7 @@ pub fn topology<M: TriMesh + ?Sized>(mesh: &M) -> Topology {
         }
     }
     drop(fill);
+    drop(proper);
     // Closed: every undirected edge of the proper triangles used exactly twice.
     let closed = !hi.is_empty()
         && (0..distinct).all(|a| {
@@ -94,6 +106,8 @@ pub fn topology<M: TriMesh + ?Sized>(mesh: &M) -> Topology {
             bucket.sort_unstable();
             bucket.chunk_by(|x, y| x == y).all(|run| run.len() == 2)
         });
+    drop(hi);
+    drop(start);
     // Every parent is below its child (a union hangs the larger root under the smaller, path
     // halving only shortens), so one ascending pass turns `parent` into each id's root.
     for x in 0..distinct {
@@ -104,20 +118,15 @@ pub fn topology<M: TriMesh + ?Sized>(mesh: &M) -> Topology {
     // The first vertex (in triangle order) of each component.
     let mut comp_of_root = vec![u32::MAX; distinct];
     let mut component_seeds = Vec::new();
-    for (t, &(v, _)) in tris.iter().enumerate() {
-        let r = root[v[0] as usize] as usize;
+    for t in 0..n as u32 {
+        let first = mesh.indices(t)[0];
+        let r = root[merged[first as usize] as usize] as usize;
         if comp_of_root[r] == u32::MAX {
             comp_of_root[r] = component_seeds.len() as u32;
-            component_seeds.push(mesh.indices(t as u32)[0]);
+            component_seeds.push(first);
         }
     }
-    let mut used = vec![false; mesh.vertex_count()];
-    for t in 0..n as u32 {
-        for v in mesh.indices(t) {
-            used[v as usize] = true;
-        }
-    }
-    let component_of = (0..mesh.vertex_count())
+    let component_of = (0..vertices)
         .map(|v| if used[v] { comp_of_root[root[merged[v] as usize] as usize] } else { u32::MAX })
         .collect();
     Topology { closed, component_seeds, component_of, merged }
@@ -816,6 +825,95 @@ mod tests {
 
     fn inside(p: DVec3, m: &Mesh) -> Inside {
         point_in_closed_mesh(p, m, &Bvh::build(m, BuildOptions::default()))
+    }
+
+    /// [`topology`] against a brute-force reading of its definition on random small meshes
+    /// with coincident vertices (±0 included), zero-area triangles (repeated and collinear
+    /// vertices) and unused vertices.
+    #[test]
+    fn topology_equals_a_brute_force_oracle() {
+        use std::collections::BTreeMap;
+        let mut seed = 0x2545_f491_4f6c_dd1du64;
+        let mut next = move |n: u64| {
+            seed ^= seed << 13;
+            seed ^= seed >> 7;
+            seed ^= seed << 17;
+            seed % n
+        };
+        let grid = [-0.0, 0.0, 1.0, 2.0, 0.5];
+        for round in 0..2000 {
+            let nv = 3 + next(12) as usize;
+            let positions: Vec<DVec3> = (0..nv)
+                .map(|_| DVec3::new(grid[next(5) as usize], grid[next(5) as usize], grid[next(3) as usize]))
+                .collect();
+            let nt = 1 + next(14) as usize;
+            let triangles: Vec<[u32; 3]> =
+                (0..nt).map(|_| [0; 3].map(|_| next(nv as u64 - (round % 2)) as u32)).collect();
+            let mesh = Mesh {
+                positions: positions.clone(),
+                tri_object: vec![0; nt],
+                triangles: triangles.clone(),
+                objects: vec![Object { name: "m".into(), ..Default::default() }],
+            };
+            let got = topology(&mesh);
+            // Merged ids in order of first occurrence, by comparing every earlier position.
+            let key = |p: DVec3| [p.x + 0.0, p.y + 0.0, p.z + 0.0];
+            let mut merged = vec![0u32; nv];
+            let mut distinct = 0;
+            for i in 0..nv {
+                merged[i] = match (0..i).find(|&j| key(positions[j]) == key(positions[i])) {
+                    Some(j) => merged[j],
+                    None => {
+                        distinct += 1;
+                        distinct - 1
+                    }
+                };
+            }
+            assert_eq!(got.merged, merged);
+            let mut uses: BTreeMap<(u32, u32), usize> = BTreeMap::new();
+            for t in &triangles {
+                let [a, b, c] = t.map(|i| positions[i as usize]);
+                if pr::collinear(a, b, c) {
+                    continue;
+                }
+                let v = t.map(|i| merged[i as usize]);
+                for k in 0..3 {
+                    let (x, y) = (v[k], v[(k + 1) % 3]);
+                    *uses.entry((x.min(y), x.max(y))).or_default() += 1;
+                }
+            }
+            assert_eq!(got.closed, !uses.is_empty() && uses.values().all(|&u| u == 2), "round {round}");
+            // Components: flood over shared merged ids, numbered by first triangle.
+            let mut comp_of_id = vec![u32::MAX; distinct as usize];
+            let mut seeds = Vec::new();
+            for t in &triangles {
+                let v = t.map(|i| merged[i as usize]);
+                if comp_of_id[v[0] as usize] != u32::MAX {
+                    continue;
+                }
+                let c = seeds.len() as u32;
+                seeds.push(t[0]);
+                comp_of_id[v[0] as usize] = c;
+                let mut grew = true;
+                while grew {
+                    grew = false;
+                    for u in &triangles {
+                        let w = u.map(|i| merged[i as usize]);
+                        if w.iter().any(|&x| comp_of_id[x as usize] == c)
+                            && w.iter().any(|&x| comp_of_id[x as usize] != c)
+                        {
+                            w.iter().for_each(|&x| comp_of_id[x as usize] = c);
+                            grew = true;
+                        }
+                    }
+                }
+            }
+            assert_eq!(got.component_seeds, seeds, "round {round}");
+            let used = |v: usize| triangles.iter().any(|t| t.contains(&(v as u32)));
+            let want: Vec<u32> =
+                (0..nv).map(|v| if used(v) { comp_of_id[merged[v] as usize] } else { u32::MAX }).collect();
+            assert_eq!(got.component_of, want, "round {round}");
+        }
     }
 
     #[test]

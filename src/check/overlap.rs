@@ -397,19 +397,26 @@ fn candidates<M: TriMesh + ?Sized>(
 /// Add the vertices of A inside or on B and of B inside or on A that can move a bound; None
 /// when one of those cannot be decided.
 ///
-/// `cand` is from [`candidates`] (only those vertices can move the box) and
-/// `inside_other[s]` tests a point of part `s` against the other part. For each side of each axis, those beyond that side are
-/// tested from the most extreme inwards: the first one inside fixes the side (every later one
-/// lies at or inside it), so a side costs one point query when its extreme vertex is inside,
-/// and vertices that cannot move any side cost none. The box is the box of all inside
-/// vertices, as if every vertex were tested.
+/// `cand` is from [`candidates`] (only those vertices can move the box) and `inside_other[s]`
+/// tests a point of part `s` against the other part. For each side of each axis, those beyond
+/// that side are taken from the most extreme inwards: the first one inside fixes the side
+/// (every later one lies at or inside it), and an undecided one met before it leaves no box.
+/// They are tested in batches, each batch's queries in parallel: one vertex first (a side
+/// whose extreme vertex is inside costs one point query), then twice as many each time up to
+/// [`INSIDE_BATCH`]; vertices that cannot move any side cost none. Each answer is kept, so no
+/// vertex is tested twice, and the answers are read in the order above: the first inside
+/// vertex and the first undecided one are those a one-by-one pass would meet, whatever the
+/// batches. The box is the box of all inside vertices, as if every vertex were tested.
 fn vertices_inside(
     acc: &mut ExactBox,
     cand: &[(usize, u32, DVec3)],
-    inside_other: [&dyn Fn(DVec3) -> Option<bool>; 2],
+    inside_other: [&(dyn Fn(DVec3) -> Option<bool> + Sync); 2],
 ) -> Option<()> {
-    // Per candidate: 0 untested, 1 inside or on, 2 outside.
-    let mut state = vec![0u8; cand.len()];
+    use rayon::prelude::*;
+    const UNTESTED: u8 = 0;
+    const INSIDE: u8 = 1;
+    const UNDECIDED: u8 = 3;
+    let mut state = vec![UNTESTED; cand.len()];
     for k in 0..3 {
         for upper in [false, true] {
             // Beyond the side now (the side only moves outwards, so this is a superset of the
@@ -422,23 +429,42 @@ fn vertices_inside(
                 let by = if upper { y.total_cmp(&x) } else { x.total_cmp(&y) };
                 by.then((cand[i].0, cand[i].1).cmp(&(cand[j].0, cand[j].1)))
             });
-            for i in order {
-                let (s, _, p) = cand[i];
-                if !beyond(p, acc) {
-                    break;
+            let (mut at, mut size) = (0, 1);
+            'side: while at < order.len() {
+                let batch = &order[at..(at + size).min(order.len())];
+                let todo: Vec<usize> = batch.iter().copied().filter(|&i| state[i] == UNTESTED).collect();
+                let answers: Vec<u8> = todo
+                    .par_iter()
+                    .map(|&i| match inside_other[cand[i].0](cand[i].2) {
+                        Some(true) => INSIDE,
+                        Some(false) => 2,
+                        None => UNDECIDED,
+                    })
+                    .collect();
+                for (&i, answer) in todo.iter().zip(answers) {
+                    state[i] = answer;
                 }
-                if state[i] == 0 {
-                    state[i] = if inside_other[s](p)? { 1 } else { 2 };
+                for &i in batch {
+                    match state[i] {
+                        INSIDE => {
+                            acc.add_vertex(cand[i].2);
+                            break 'side;
+                        }
+                        UNDECIDED => return None,
+                        _ => {}
+                    }
                 }
-                if state[i] == 1 {
-                    acc.add_vertex(p);
-                    break;
-                }
+                at += batch.len();
+                size = (size * 2).min(INSIDE_BATCH);
             }
         }
     }
     Some(())
 }
+
+/// The most candidate vertices [`vertices_inside`] tests at once (a cost setting only: the box
+/// is the same for any).
+const INSIDE_BATCH: usize = 64;
 
 #[cfg(test)]
 mod tests {

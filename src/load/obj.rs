@@ -391,7 +391,7 @@ impl<'a> Tokens<'a> {
 /// on anything else it returns `None` and the sequential parser runs (and reports the problem
 /// with its line number).
 mod chunked {
-    use super::{plain_index, trim_end, Tokens, IGNORED, MAX_FACE_VERTICES};
+    use super::{decimal, plain_index, trim_end, Tokens, IGNORED, MAX_FACE_VERTICES};
     use crate::scene::mesh::{Loaded, Mesh, Object};
     use glam::DVec3;
     use rayon::prelude::*;
@@ -463,6 +463,26 @@ mod chunked {
             if trim_end(text).last() == Some(&b'\\') {
                 return None; // continued lines: the sequential parser joins them
             }
+            // The two statements that make up nearly every file, in their plain spellings, in
+            // one pass over their bytes; any other spelling takes the general path below.
+            match text {
+                [b'v', rest @ ..] => {
+                    if let Some(p) = plain_vertex(rest) {
+                        c.positions.push(p);
+                        continue;
+                    }
+                }
+                [b'f', rest @ ..] => {
+                    if let Some(v) = plain_triangle(rest) {
+                        let most = v.iter().max().map_or(0, |&i| i as u64 + 1);
+                        c.max_index = c.max_index.max(most);
+                        c.triangles.push(v);
+                        c.names_before.push(c.names.len() as u32);
+                        continue;
+                    }
+                }
+                _ => {}
+            }
             let mut tokens = Tokens { text, pos: 0 };
             let Some((_, keyword)) = tokens.next() else {
                 continue;
@@ -527,6 +547,80 @@ mod chunked {
             }
         }
         Some(c)
+    }
+
+    /// A blank between the fields of a plain statement (the general path splits at any ASCII
+    /// whitespace; a line with other whitespace takes it).
+    #[inline(always)]
+    fn blank(b: Option<&u8>) -> bool {
+        matches!(b, Some(b' ' | b'\t'))
+    }
+
+    /// After a line's leading `v`: blanks, three coordinates the decimal fast path reads, each
+    /// after blanks, and nothing but blanks after the third. On such a line the general path
+    /// reads the same three tokens with the same reader ([`decimal::parse`] of a token is
+    /// [`decimal::prefix`] when the prefix ends at the token's end), so it gives the same
+    /// position. `None`: the line takes the general path.
+    #[inline]
+    fn plain_vertex(rest: &[u8]) -> Option<DVec3> {
+        let mut p = [0.0f64; 3];
+        let mut i = 0;
+        for slot in &mut p {
+            if !blank(rest.get(i)) {
+                return None;
+            }
+            while blank(rest.get(i)) {
+                i += 1;
+            }
+            let (x, used) = decimal::prefix(&rest[i..])?;
+            if !x.is_finite() {
+                return None;
+            }
+            *slot = x;
+            i += used;
+        }
+        rest[i..].iter().all(|b| blank(Some(b))).then(|| DVec3::from_array(p))
+    }
+
+    /// After a line's leading `f`: three vertex references `i`, `i/…` (the rest of the token
+    /// is not read, as on the general path), each after blanks, with positive indices of at
+    /// most ten digits in `1..=2^32`, and nothing but blanks after; their 0-based indices.
+    /// `None`: the line takes the general path (relative indices, polygons, anything else).
+    #[inline]
+    fn plain_triangle(rest: &[u8]) -> Option<[u32; 3]> {
+        let mut v = [0u32; 3];
+        let mut i = 0;
+        for slot in &mut v {
+            if !blank(rest.get(i)) {
+                return None;
+            }
+            while blank(rest.get(i)) {
+                i += 1;
+            }
+            let start = i;
+            let mut x: u64 = 0;
+            while let Some(&b) = rest.get(i) {
+                let d = b.wrapping_sub(b'0');
+                if d > 9 {
+                    break;
+                }
+                x = x * 10 + d as u64;
+                i += 1;
+                if i - start > 10 {
+                    return None;
+                }
+            }
+            if i == start || x == 0 || x > 1 << 32 {
+                return None;
+            }
+            if rest.get(i) == Some(&b'/') {
+                while rest.get(i).is_some_and(|b| !b.is_ascii_whitespace()) {
+                    i += 1;
+                }
+            }
+            *slot = (x - 1) as u32;
+        }
+        rest[i..].iter().all(|b| blank(Some(b))).then_some(v)
     }
 
     fn join(chunks: Vec<Chunk>, max_triangles: usize) -> Option<Loaded> {
@@ -613,6 +707,89 @@ mod chunked {
             for src in declined {
                 assert!(!agree(src), "{}", String::from_utf8_lossy(src));
             }
+        }
+
+        /// Lines in and near the plain spellings the one-pass readers take (blanks, signs,
+        /// exponents, `/` references, large and zero indices, trailing values, comments, other
+        /// whitespace): the chunked parse equals the sequential parser or declines, line by line
+        /// and in files mixing them.
+        #[test]
+        fn plain_statement_readers_equal_the_general_path() {
+            let mut seed = 0x9e37_79b9_7f4a_7c15u64;
+            let mut next = move |n: u64| {
+                seed ^= seed << 13;
+                seed ^= seed >> 7;
+                seed ^= seed << 17;
+                seed % n
+            };
+            let seps: [&[u8]; 6] = [b" ", b"  ", b"\t", b" \t", b"\x0c", b""];
+            let numbers: [&[u8]; 16] = [
+                b"0",
+                b"-0",
+                b"1",
+                b"-2.5",
+                b"+4",
+                b".5",
+                b"5.",
+                b"1e3",
+                b"-2.5E-3",
+                b"0.8506507873535156",
+                b"12345678901234567890",
+                b"1e400",
+                b"nan",
+                b"inf",
+                b"1.5x",
+                b"1e",
+            ];
+            let indices: [&[u8]; 14] = [
+                b"1",
+                b"2",
+                b"3",
+                b"4",
+                b"01",
+                b"3/1",
+                b"2//7",
+                b"1/2/3",
+                b"-1",
+                b"0",
+                b"+1",
+                b"4294967296",
+                b"4294967297",
+                b"12345678901",
+            ];
+            let tails: [&[u8]; 6] = [b"", b" ", b" 1", b" # c", b"#c", b"\t"];
+            let mut lines = 0;
+            for round in 0..3000 {
+                let mut src = b"v 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 0 1\n".to_vec();
+                for _ in 0..1 + next(6) {
+                    let sep = |k: u64| if k < 5 { seps[0] } else { seps[(k % 6) as usize] };
+                    if next(2) == 0 {
+                        src.push(b'v');
+                        for _ in 0..3 {
+                            src.extend_from_slice(sep(next(8)));
+                            src.extend_from_slice(numbers[(next(20) % 16) as usize]);
+                        }
+                    } else {
+                        src.push(b'f');
+                        for _ in 0..3 + (next(8) == 0) as u64 {
+                            src.extend_from_slice(sep(next(8)));
+                            src.extend_from_slice(indices[(next(18) % 14) as usize]);
+                        }
+                    }
+                    src.extend_from_slice(tails[(next(12) % 6) as usize]);
+                    src.extend_from_slice(if next(4) == 0 { b"\r\n" } else { b"\n" });
+                    lines += 1;
+                }
+                if round % 2 == 0 {
+                    src.extend_from_slice(b"f 1 2 3\n");
+                }
+                agree(&src);
+            }
+            assert!(lines > 5000);
+            // Plain files are taken, and read as the general path reads them.
+            assert!(agree(
+                b"v 0.5 -1e-3 +2\nv\t1 0 0\t\nv  0 1 0 \nf 1 2 3\nf 3/3 2//2 1/1/1\nf\t1  2\t3 \n"
+            ));
         }
 
         #[test]

@@ -56,10 +56,21 @@ const EXACT_INT: u64 = 1 << 53;
 /// module doc), exactly `str::parse::<f64>`'s; `None` otherwise (then ask `str::parse`).
 #[inline]
 pub(super) fn parse(t: &[u8]) -> Option<f64> {
-    let (negative, rest) = match t {
-        [b'-', rest @ ..] => (true, rest),
-        [b'+', rest @ ..] => (false, rest),
-        _ => (false, t),
+    match prefix(t)? {
+        (x, used) if used == t.len() => Some(x),
+        _ => None,
+    }
+}
+
+/// The literal at the start of `t`, read as far as its spelling goes: its value and length,
+/// when that much is a spelling [`parse`] reads. The caller checks what follows: when it ends
+/// the token, the value is [`parse`]'s (and so `str::parse`'s) for the token.
+#[inline]
+pub(super) fn prefix(t: &[u8]) -> Option<(f64, usize)> {
+    let (negative, rest, sign) = match t {
+        [b'-', rest @ ..] => (true, rest, 1),
+        [b'+', rest @ ..] => (false, rest, 1),
+        _ => (false, t, 0),
     };
     let mut i = 0;
     let mut w: u64 = 0;
@@ -107,11 +118,8 @@ pub(super) fn parse(t: &[u8]) -> Option<f64> {
         }
         exponent += if negative_exp { -x } else { x };
     }
-    if i != rest.len() {
-        return None;
-    }
     let magnitude = if w == 0 { 0.0 } else { scale(w, exponent)? };
-    Some(if negative { -magnitude } else { magnitude })
+    Some((if negative { -magnitude } else { magnitude }, sign + i))
 }
 
 /// Reads the run of ASCII digits of `t` from `*i` into `w` (`w · 10 + d` per digit; wrapping,
@@ -195,6 +203,18 @@ mod tests {
     /// `parse` either declines or gives `str::parse`'s bits; returns whether it answered.
     fn agrees(s: &str) -> bool {
         let want = s.parse::<f64>().ok();
+        // The prefix reader on the token followed by a blank and more: it reads exactly the
+        // token when `parse` reads it, with the same bits, and stops short of the blank otherwise.
+        let line = format!("{s} 7 x");
+        let read = super::prefix(line.as_bytes());
+        match (parse(s.as_bytes()), read) {
+            (Some(x), Some((y, used))) => {
+                assert_eq!((x.to_bits(), used), (y.to_bits(), s.len()), "'{s}' as a prefix");
+            }
+            (Some(_), None) => panic!("'{s}': read as a token, not as a prefix"),
+            (None, Some((_, used))) => assert!(used < s.len() || s.is_empty(), "'{s}' read as a prefix only"),
+            (None, None) => {}
+        }
         match parse(s.as_bytes()) {
             Some(got) => {
                 let want = want.unwrap_or_else(|| panic!("'{s}': read {got:e}, str::parse refuses it"));
