@@ -772,7 +772,7 @@ fn collide_pairs(
     memo: Memory<'_>,
 ) -> Vec<Hit> {
     let key = |&(i, j): &(usize, usize)| (a[i].id(), b[j].id());
-    let near: Vec<(usize, usize)> = pairs.iter().copied().filter(|&(i, j)| !a[i].apart(&b[j])).collect();
+    let apart = |&(i, j): &(usize, usize)| a[i].apart(&b[j]);
     let decide = |p: &(usize, usize)| -> Verdict {
         if let Some(v) = memo.verdict(key(p)) {
             return v;
@@ -787,8 +787,10 @@ fn collide_pairs(
         (i, j, cs, v.containment)
     };
     if stop_at_first {
-        let mut open = Vec::with_capacity(near.len());
-        for p in &near {
+        // Kept verdicts and the hints first: neither needs the pairs' bounding balls (a pair
+        // known to collide, or with a meeting triangle pair, is not apart).
+        let mut open = Vec::with_capacity(pairs.len());
+        for p in pairs {
             match memo.verdict(key(p)) {
                 Some(v) if v.collides => return vec![hit(p, v)],
                 Some(_) => {}
@@ -813,6 +815,7 @@ fn collide_pairs(
         if let Some(h) = open.iter().find_map(hinted) {
             return vec![h];
         }
+        open.retain(|p| !apart(p));
         let meet = |p: &(usize, usize)| {
             let (x, y) = (&a[p.0], &b[p.1]);
             let m = api::meeting_pairs(&x.mesh(), &x.tree(), &y.mesh(), &y.tree(), true);
@@ -829,6 +832,7 @@ fn collide_pairs(
         };
         return find_any(&open, contained).into_iter().collect();
     }
+    let near: Vec<(usize, usize)> = pairs.iter().copied().filter(|p| !apart(p)).collect();
     filter_map_all(&near, |p| {
         let v = decide(p);
         v.collides.then(|| hit(p, v))
@@ -863,11 +867,12 @@ enum Among {
 
 /// `candidates`: the pairs whose boxes meet, sorted (only they can collide); `among`: every pair
 /// the query is about, searched best-first (by [`Placed::gap`]) only when no candidate
-/// collides; `tree`: the tree of `b`'s objects (all of them), when the caller keeps one.
+/// collides; `tree`: the tree of `b`'s objects (all of them), when the caller keeps one (asked
+/// for only when no candidate collides: a colliding pair answers without it).
 fn nearest(
     candidates: &[(usize, usize)],
     among: Among,
-    tree: Option<&ObjectTree>,
+    tree: &(dyn Fn() -> Option<Arc<ObjectTree>> + Sync),
     a: &[Arc<Placed>],
     b: &[Arc<Placed>],
     memo: Memory<'_>,
@@ -896,15 +901,15 @@ fn nearest(
             None => break,
         }
     }
-    let overlapping: Vec<(usize, usize)> =
-        candidates.iter().copied().filter(|&(i, j)| !a[i].apart(&b[j])).collect();
     // Meeting triangles first (a pair known to collide without containment has them), then
     // containment: the first pair in (i, j) order of the first kind found.
     // With the meeting pair found, when this search found it (its signed distance is then
     // computed from it, not searched for again).
+    // A pair whose boxes or balls are apart is neither (its balls are found only when its
+    // turn comes).
     let meeting = |&(i, j): &(usize, usize)| match memo.verdict(key(i, j)) {
         Some(v) => (v.collides && v.containment.is_none()).then_some((i, j, None)),
-        None if memo.no_meeting(key(i, j)) => None,
+        None if memo.no_meeting(key(i, j)) || a[i].apart(&b[j]) => None,
         None => {
             let (x, y) = (&a[i], &b[j]);
             let m = api::meeting_pairs(&x.mesh(), &x.tree(), &y.mesh(), &y.tree(), true);
@@ -919,6 +924,7 @@ fn nearest(
     let contained = |&(i, j): &(usize, usize)| {
         let v = match memo.verdict(key(i, j)) {
             Some(v) => v,
+            None if a[i].apart(&b[j]) => return None,
             None => {
                 let c = api::collide(&a[i], &b[j], false);
                 let v = Verdict { collides: c.collides(), containment: c.containment.name() };
@@ -929,7 +935,7 @@ fn nearest(
         v.collides.then_some((i, j, None))
     };
     if let Some((i, j, contact)) =
-        find_first(&overlapping, meeting).or_else(|| find_first(&overlapping, contained))
+        find_first(candidates, meeting).or_else(|| find_first(candidates, contained))
     {
         let s = match (memo.signed(key(i, j)), contact) {
             (Some(s), _) => s,
@@ -952,12 +958,12 @@ fn nearest(
     // nodes hold their objects' boxes, and each step of the box distance is monotone.
     let margin = a.iter().chain(b).map(|p| p.ball().slack).fold(0.0f64, f64::max);
     let boxes = |l: &[Arc<Placed>]| l.iter().map(|p| p.bounds()).collect::<Vec<Aabb>>();
-    let (bb, own_b);
-    let tb = match tree {
+    let kept = tree();
+    let own_b;
+    let tb = match &kept {
         Some(t) => t,
         None => {
-            bb = boxes(b);
-            own_b = ObjectTree::build(&bb, (0..b.len()).collect());
+            own_b = ObjectTree::build(&boxes(b), (0..b.len()).collect());
             &own_b
         }
     };
@@ -1101,16 +1107,6 @@ impl Manager {
         self.placed(i);
     }
 
-    /// The tree over every object's box (kept until an object is placed or removed).
-    fn object_tree(&self) -> Arc<ObjectTree> {
-        let mut kept = self.tree.lock().unwrap();
-        kept.get_or_insert_with(|| {
-            let boxes: Vec<Aabb> = self.objs.iter().map(|p| p.bounds()).collect();
-            Arc::new(ObjectTree::build(&boxes, (0..boxes.len()).collect()))
-        })
-        .clone()
-    }
-
     /// Object `i` was placed anew (added or moved): its candidate pairs are found again.
     fn placed(&mut self, i: usize) {
         *self.tree.get_mut().unwrap() = None;
@@ -1137,6 +1133,17 @@ impl Manager {
         out.sort_unstable();
         out
     }
+}
+
+/// The tree over the boxes of `objs`, built once and kept in `kept` (emptied when an object is
+/// placed or removed).
+fn object_tree(objs: &[Arc<Placed>], kept: &Mutex<Option<Arc<ObjectTree>>>) -> Arc<ObjectTree> {
+    let mut kept = kept.lock().unwrap();
+    kept.get_or_insert_with(|| {
+        let boxes: Vec<Aabb> = objs.iter().map(|p| p.bounds()).collect();
+        Arc::new(ObjectTree::build(&boxes, (0..boxes.len()).collect()))
+    })
+    .clone()
 }
 
 fn place(py: Python<'_>, p: &Arc<Prepared>, t: DMat4) -> PyResult<Arc<Placed>> {
@@ -1257,8 +1264,9 @@ impl Manager {
             candidates.sort_unstable();
         }
         let among = k.map_or(Among::Internal, Among::Named);
-        let (tree, memo) = (self.object_tree(), &self.memo);
-        let near = py.detach(|| nearest(&candidates, among, Some(&tree), objs, objs, Memory(Some(memo))));
+        let (kept, memo) = (&self.tree, &self.memo);
+        let tree = || Some(object_tree(objs, kept));
+        let near = py.detach(|| nearest(&candidates, among, &tree, objs, objs, Memory(Some(memo))));
         Ok(near.map(|(d, i, j, fi, fj, pi, pj)| {
             (d, self.names[i].clone(), self.names[j].clone(), fi, fj, pi, pj)
         }))
@@ -1268,8 +1276,9 @@ impl Manager {
         let (a, b) = (&self.objs, &other.objs);
         let candidates = self.pairs_with(b);
         let memo = &self.memo;
-        let tree = other.object_tree();
-        let near = py.detach(|| nearest(&candidates, Among::Across, Some(&tree), a, b, Memory(Some(memo))));
+        let kept = &other.tree;
+        let tree = || Some(object_tree(b, kept));
+        let near = py.detach(|| nearest(&candidates, Among::Across, &tree, a, b, Memory(Some(memo))));
         near.map(|(d, i, j, fi, fj, pi, pj)| {
             (d, self.names[i].clone(), other.names[j].clone(), fi, fj, pi, pj)
         })
@@ -1285,7 +1294,7 @@ impl Manager {
         let single = vec![place(py, &mesh.inner, transform_of(transform)?)?];
         let a = &self.objs;
         let candidates = self.pairs_with(&single);
-        let near = py.detach(|| nearest(&candidates, Among::Across, None, a, &single, Memory(None)));
+        let near = py.detach(|| nearest(&candidates, Among::Across, &|| None, a, &single, Memory(None)));
         Ok(near.map(|(d, i, _, fi, fj, pi, pj)| (d, self.names[i].clone(), fi, fj, pi, pj)))
     }
 }
