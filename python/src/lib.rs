@@ -660,11 +660,12 @@ struct Memo {
     signed: HashMap<(u64, u64), prepared::Signed>,
     /// Pairs known to have no meeting triangles (their containment not decided yet).
     no_meeting: std::collections::HashSet<(u64, u64)>,
-    /// A triangle pair (of A, of B) that met the last time two prepared meshes (keyed by their
-    /// addresses) collided, under any placements: kept when objects move, a yes/no query tries
-    /// it first (one exact triangle test; any meeting pair answers such a query). Only speed
-    /// depends on it: a stale hint is a triangle pair that no longer meets, or out of range.
-    hints: HashMap<(usize, usize), (u32, u32)>,
+    /// A triangle pair (of A, of B) that met the last time two objects collided, under any
+    /// placements (keyed by [`HintKey`]): kept when objects move, yes/no questions about the
+    /// pair try it first (one exact triangle test; any meeting pair settles that the pair
+    /// collides, with no containment to decide). Only speed depends on it: a stale hint is a
+    /// triangle pair that no longer meets, or out of range.
+    hints: HashMap<HintKey, (u32, u32)>,
 }
 
 impl Memo {
@@ -675,6 +676,10 @@ impl Memo {
         self.no_meeting.retain(|k| k.0 != id && k.1 != id);
     }
 }
+
+/// Two objects (index in their list, and their prepared mesh's address: a hint stays with the
+/// meshes it was found on even when indices shift after a removal).
+type HintKey = ((usize, usize), (usize, usize));
 
 /// Above this many entries a memo is emptied (a bound on memory; only speed depends on it).
 const MEMO_MAX: usize = 1 << 20;
@@ -707,10 +712,10 @@ impl Memory<'_> {
             m.no_meeting.insert(k);
         }
     }
-    fn hint(&self, k: (usize, usize)) -> Option<(u32, u32)> {
+    fn hint(&self, k: HintKey) -> Option<(u32, u32)> {
         self.0.and_then(|m| m.lock().unwrap().hints.get(&k).copied())
     }
-    fn keep_hint(&self, k: (usize, usize), v: (u32, u32)) {
+    fn keep_hint(&self, k: HintKey, v: (u32, u32)) {
         if let Some(m) = self.0 {
             let mut m = m.lock().unwrap();
             if m.hints.len() >= MEMO_MAX {
@@ -773,12 +778,25 @@ fn collide_pairs(
 ) -> Vec<Hit> {
     let key = |&(i, j): &(usize, usize)| (a[i].id(), b[j].id());
     let apart = |&(i, j): &(usize, usize)| a[i].apart(&b[j]);
+    let meets = Verdict { collides: true, containment: None };
+    // The triangle pair that met last time, when it still meets (exact test): then the pair
+    // collides with no containment, the verdict the full test gives.
+    let hinted = |p: &(usize, usize)| hint_meets(&a[p.0], &b[p.1], memo.hint(hint_key(a, b, *p)));
     let decide = |p: &(usize, usize)| -> Verdict {
         if let Some(v) = memo.verdict(key(p)) {
             return v;
         }
-        let c = api::collide(&a[p.0], &b[p.1], false);
-        let v = Verdict { collides: c.collides(), containment: c.containment.name() };
+        let v = if hinted(p) {
+            meets
+        } else if apart(p) {
+            Verdict { collides: false, containment: None }
+        } else {
+            let c = api::collide(&a[p.0], &b[p.1], false);
+            if let Some(f) = c.contacts.first() {
+                memo.keep_hint(hint_key(a, b, *p), (f.a, f.b));
+            }
+            Verdict { collides: c.collides(), containment: c.containment.name() }
+        };
         memo.keep_verdict(key(p), v);
         v
     };
@@ -797,22 +815,11 @@ fn collide_pairs(
                 None => open.push(*p),
             }
         }
-        let prepared_key = |&(i, j): &(usize, usize)| {
-            (Arc::as_ptr(&a[i].prepared) as usize, Arc::as_ptr(&b[j].prepared) as usize)
+        let met = |p: &(usize, usize)| {
+            memo.keep_verdict(key(p), meets);
+            hit(p, meets)
         };
-        let meets = |p: &(usize, usize)| {
-            let v = Verdict { collides: true, containment: None };
-            memo.keep_verdict(key(p), v);
-            hit(p, v)
-        };
-        // The triangle pair that met last time, when it still meets (exact test).
-        let hinted = |p: &(usize, usize)| {
-            let (s, t) = memo.hint(prepared_key(p))?;
-            let (x, y) = (a[p.0].mesh(), b[p.1].mesh());
-            let in_range = (s as usize) < x.triangle_count() && (t as usize) < y.triangle_count();
-            (in_range && tri_tri::classify(&x.triangle(s), &y.triangle(t)).is_some()).then(|| meets(p))
-        };
-        if let Some(h) = open.iter().find_map(hinted) {
+        if let Some(h) = open.iter().find(|p| hinted(p)).map(met) {
             return vec![h];
         }
         open.retain(|p| !apart(p));
@@ -820,8 +827,8 @@ fn collide_pairs(
             let (x, y) = (&a[p.0], &b[p.1]);
             let m = api::meeting_pairs(&x.mesh(), &x.tree(), &y.mesh(), &y.tree(), true);
             let first = m.first()?;
-            memo.keep_hint(prepared_key(p), (first.a, first.b));
-            Some(meets(p))
+            memo.keep_hint(hint_key(a, b, *p), (first.a, first.b));
+            Some(met(p))
         };
         if let Some(h) = find_any(&open, meet) {
             return vec![h];
@@ -832,11 +839,24 @@ fn collide_pairs(
         };
         return find_any(&open, contained).into_iter().collect();
     }
-    let near: Vec<(usize, usize)> = pairs.iter().copied().filter(|p| !apart(p)).collect();
-    filter_map_all(&near, |p| {
+    filter_map_all(pairs, |p| {
         let v = decide(p);
         v.collides.then(|| hit(p, v))
     })
+}
+
+/// The key of object pair `(i, j)` (of `a`, of `b`) in the memo's hints.
+fn hint_key(a: &[Arc<Placed>], b: &[Arc<Placed>], (i, j): (usize, usize)) -> HintKey {
+    ((i, Arc::as_ptr(&a[i].prepared) as usize), (j, Arc::as_ptr(&b[j].prepared) as usize))
+}
+
+/// Exact: does triangle pair `hint` (of `x`, of `y`; ignored when out of range) meet?
+fn hint_meets(x: &Placed, y: &Placed, hint: Option<(u32, u32)>) -> bool {
+    let Some((s, t)) = hint else { return false };
+    let (mx, my) = (x.mesh(), y.mesh());
+    (s as usize) < mx.triangle_count()
+        && (t as usize) < my.triangle_count()
+        && tri_tri::classify(&mx.triangle(s), &my.triangle(t)).is_some()
 }
 
 /// Up to this many candidate object pairs, a query runs them on the calling thread (waking the
@@ -905,11 +925,11 @@ fn nearest(
     // containment: the first pair in (i, j) order of the first kind found.
     // With the meeting pair found, when this search found it (its signed distance is then
     // computed from it, not searched for again).
-    // A pair whose boxes or balls are apart is neither (its balls are found only when its
-    // turn comes).
+    // (The walk itself settles a pair whose boxes meet but whose balls are apart; finding the
+    // balls cost more than that.)
     let meeting = |&(i, j): &(usize, usize)| match memo.verdict(key(i, j)) {
         Some(v) => (v.collides && v.containment.is_none()).then_some((i, j, None)),
-        None if memo.no_meeting(key(i, j)) || a[i].apart(&b[j]) => None,
+        None if memo.no_meeting(key(i, j)) => None,
         None => {
             let (x, y) = (&a[i], &b[j]);
             let m = api::meeting_pairs(&x.mesh(), &x.tree(), &y.mesh(), &y.tree(), true);
@@ -917,6 +937,7 @@ fn nearest(
                 memo.keep_no_meeting(key(i, j));
                 return None;
             };
+            memo.keep_hint(hint_key(a, b, (i, j)), (first.a, first.b));
             memo.keep_verdict(key(i, j), Verdict { collides: true, containment: None });
             Some((i, j, Some(first)))
         }
