@@ -505,9 +505,12 @@ where
     if !tol.boxes_may_meet(&root_a, &root_b) {
         return None;
     }
-    let mut stack = vec![(0u32, 0u32, root_a, root_b)];
+    // Room for the usual depth at once (the stack holds at most one entry per level of the two
+    // trees, plus one).
+    let mut stack = Vec::with_capacity(64);
+    stack.push((0u32, 0u32, root_a, root_b));
     // The triangles of the current leaf of B whose boxes meet the leaf of A's box.
-    let mut near_b: Vec<(u32, [DVec3; 3], Aabb)> = Vec::new();
+    let mut near_b: Vec<(u32, [DVec3; 3], Aabb)> = Vec::with_capacity(16);
     while let Some((i, j, bi, bj)) = stack.pop() {
         let open_a = match (ta.is_leaf(i), tb.is_leaf(j)) {
             (true, true) => {

@@ -917,7 +917,7 @@ fn nearest(
                 break;
             }
             Some(_) => {}
-            None if memo.no_meeting(key(i, j)) || a[i].apart(&b[j]) => {}
+            None if memo.no_meeting(key(i, j)) => {}
             None => break,
         }
     }
@@ -1093,6 +1093,9 @@ impl Sweep {
     }
 }
 
+/// A list of object pairs, shared between the manager and the queries that read it.
+type Pairs = Arc<Vec<(usize, usize)>>;
+
 /// The native collision manager (`meshclash.CollisionManager` wraps it with trimesh's
 /// interface). Objects keep their insertion order; names are unique.
 #[pyclass(module = "meshclash._meshclash")]
@@ -1104,7 +1107,7 @@ struct Manager {
     sweep: Sweep,
     /// The candidate pairs (boxes meet) of the objects, sorted, kept across queries: updated
     /// for the one object an add or set_transform places, rebuilt after a removal.
-    pairs: Mutex<Option<Vec<(usize, usize)>>>,
+    pairs: Mutex<Option<Pairs>>,
     /// Pair answers kept across queries ([`Memo`]).
     memo: Mutex<Memo>,
     /// The tree over every object's box, built by the first distance query that needs it after
@@ -1132,16 +1135,17 @@ impl Manager {
     fn placed(&mut self, i: usize) {
         *self.tree.get_mut().unwrap() = None;
         let Some(pairs) = self.pairs.get_mut().unwrap().as_mut() else { return };
+        let pairs = Arc::make_mut(pairs);
         pairs.retain(|&(x, y)| x != i && y != i);
         let with = self.sweep.against(&self.objs, &self.objs[i].bounds());
         pairs.extend(with.into_iter().filter(|&j| j != i).map(|j| (i.min(j), i.max(j))));
         pairs.sort_unstable();
     }
 
-    /// The candidate pairs (i < j, boxes meet), sorted.
-    fn candidate_pairs(&self) -> Vec<(usize, usize)> {
+    /// The candidate pairs (i < j, boxes meet), sorted (shared with the kept list, not copied).
+    fn candidate_pairs(&self) -> Pairs {
         let mut kept = self.pairs.lock().unwrap();
-        kept.get_or_insert_with(|| self.sweep.pairs(&self.objs)).clone()
+        kept.get_or_insert_with(|| Arc::new(self.sweep.pairs(&self.objs))).clone()
     }
 
     /// Pairs (ours, theirs) whose boxes meet, sorted.
@@ -1275,9 +1279,10 @@ impl Manager {
         let k = name.as_deref().map(|n| self.find(n)).transpose()?;
         let mut candidates = self.candidate_pairs();
         if let Some(k) = k {
+            let candidates = Arc::make_mut(&mut candidates);
             candidates.retain(|&(i, j)| i == k || j == k);
             // The named object first in every pair.
-            for p in &mut candidates {
+            for p in candidates.iter_mut() {
                 if p.0 != k {
                     *p = (k, p.0);
                 }
