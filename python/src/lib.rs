@@ -660,11 +660,12 @@ struct Memo {
     signed: HashMap<(u64, u64), prepared::Signed>,
     /// Pairs known to have no meeting triangles (their containment not decided yet).
     no_meeting: std::collections::HashSet<(u64, u64)>,
-    /// A triangle pair (of A, of B) that met the last time two prepared meshes (keyed by their
-    /// addresses) collided, under any placements: kept when objects move, a yes/no query tries
-    /// it first (one exact triangle test; any meeting pair answers such a query). Only speed
-    /// depends on it: a stale hint is a triangle pair that no longer meets, or out of range.
-    hints: HashMap<(usize, usize), (u32, u32)>,
+    /// A triangle pair (of A, of B) that met the last time two objects collided, under any
+    /// placements (keyed by [`HintKey`]): kept when objects move, yes/no questions about the
+    /// pair try it first (one exact triangle test; any meeting pair settles that the pair
+    /// collides, with no containment to decide). Only speed depends on it: a stale hint is a
+    /// triangle pair that no longer meets, or out of range.
+    hints: HashMap<HintKey, (u32, u32)>,
 }
 
 impl Memo {
@@ -675,6 +676,10 @@ impl Memo {
         self.no_meeting.retain(|k| k.0 != id && k.1 != id);
     }
 }
+
+/// Two objects (index in their list, and their prepared mesh's address: a hint stays with the
+/// meshes it was found on even when indices shift after a removal).
+type HintKey = ((usize, usize), (usize, usize));
 
 /// Above this many entries a memo is emptied (a bound on memory; only speed depends on it).
 const MEMO_MAX: usize = 1 << 20;
@@ -707,10 +712,10 @@ impl Memory<'_> {
             m.no_meeting.insert(k);
         }
     }
-    fn hint(&self, k: (usize, usize)) -> Option<(u32, u32)> {
+    fn hint(&self, k: HintKey) -> Option<(u32, u32)> {
         self.0.and_then(|m| m.lock().unwrap().hints.get(&k).copied())
     }
-    fn keep_hint(&self, k: (usize, usize), v: (u32, u32)) {
+    fn keep_hint(&self, k: HintKey, v: (u32, u32)) {
         if let Some(m) = self.0 {
             let mut m = m.lock().unwrap();
             if m.hints.len() >= MEMO_MAX {
@@ -772,13 +777,26 @@ fn collide_pairs(
     memo: Memory<'_>,
 ) -> Vec<Hit> {
     let key = |&(i, j): &(usize, usize)| (a[i].id(), b[j].id());
-    let near: Vec<(usize, usize)> = pairs.iter().copied().filter(|&(i, j)| !a[i].apart(&b[j])).collect();
+    let apart = |&(i, j): &(usize, usize)| a[i].apart(&b[j]);
+    let meets = Verdict { collides: true, containment: None };
+    // The triangle pair that met last time, when it still meets (exact test): then the pair
+    // collides with no containment, the verdict the full test gives.
+    let hinted = |p: &(usize, usize)| hint_meets(&a[p.0], &b[p.1], memo.hint(hint_key(a, b, *p)));
     let decide = |p: &(usize, usize)| -> Verdict {
         if let Some(v) = memo.verdict(key(p)) {
             return v;
         }
-        let c = api::collide(&a[p.0], &b[p.1], false);
-        let v = Verdict { collides: c.collides(), containment: c.containment.name() };
+        let v = if hinted(p) {
+            meets
+        } else if apart(p) {
+            Verdict { collides: false, containment: None }
+        } else {
+            let c = api::collide(&a[p.0], &b[p.1], false);
+            if let Some(f) = c.contacts.first() {
+                memo.keep_hint(hint_key(a, b, *p), (f.a, f.b));
+            }
+            Verdict { collides: c.collides(), containment: c.containment.name() }
+        };
         memo.keep_verdict(key(p), v);
         v
     };
@@ -787,38 +805,30 @@ fn collide_pairs(
         (i, j, cs, v.containment)
     };
     if stop_at_first {
-        let mut open = Vec::with_capacity(near.len());
-        for p in &near {
+        // Kept verdicts and the hints first: neither needs the pairs' bounding balls (a pair
+        // known to collide, or with a meeting triangle pair, is not apart).
+        let mut open = Vec::with_capacity(pairs.len());
+        for p in pairs {
             match memo.verdict(key(p)) {
                 Some(v) if v.collides => return vec![hit(p, v)],
                 Some(_) => {}
                 None => open.push(*p),
             }
         }
-        let prepared_key = |&(i, j): &(usize, usize)| {
-            (Arc::as_ptr(&a[i].prepared) as usize, Arc::as_ptr(&b[j].prepared) as usize)
+        let met = |p: &(usize, usize)| {
+            memo.keep_verdict(key(p), meets);
+            hit(p, meets)
         };
-        let meets = |p: &(usize, usize)| {
-            let v = Verdict { collides: true, containment: None };
-            memo.keep_verdict(key(p), v);
-            hit(p, v)
-        };
-        // The triangle pair that met last time, when it still meets (exact test).
-        let hinted = |p: &(usize, usize)| {
-            let (s, t) = memo.hint(prepared_key(p))?;
-            let (x, y) = (a[p.0].mesh(), b[p.1].mesh());
-            let in_range = (s as usize) < x.triangle_count() && (t as usize) < y.triangle_count();
-            (in_range && tri_tri::classify(&x.triangle(s), &y.triangle(t)).is_some()).then(|| meets(p))
-        };
-        if let Some(h) = open.iter().find_map(hinted) {
+        if let Some(h) = open.iter().find(|p| hinted(p)).map(met) {
             return vec![h];
         }
+        open.retain(|p| !apart(p));
         let meet = |p: &(usize, usize)| {
             let (x, y) = (&a[p.0], &b[p.1]);
             let m = api::meeting_pairs(&x.mesh(), &x.tree(), &y.mesh(), &y.tree(), true);
             let first = m.first()?;
-            memo.keep_hint(prepared_key(p), (first.a, first.b));
-            Some(meets(p))
+            memo.keep_hint(hint_key(a, b, *p), (first.a, first.b));
+            Some(met(p))
         };
         if let Some(h) = find_any(&open, meet) {
             return vec![h];
@@ -829,10 +839,24 @@ fn collide_pairs(
         };
         return find_any(&open, contained).into_iter().collect();
     }
-    filter_map_all(&near, |p| {
+    filter_map_all(pairs, |p| {
         let v = decide(p);
         v.collides.then(|| hit(p, v))
     })
+}
+
+/// The key of object pair `(i, j)` (of `a`, of `b`) in the memo's hints.
+fn hint_key(a: &[Arc<Placed>], b: &[Arc<Placed>], (i, j): (usize, usize)) -> HintKey {
+    ((i, Arc::as_ptr(&a[i].prepared) as usize), (j, Arc::as_ptr(&b[j].prepared) as usize))
+}
+
+/// Exact: does triangle pair `hint` (of `x`, of `y`; ignored when out of range) meet?
+fn hint_meets(x: &Placed, y: &Placed, hint: Option<(u32, u32)>) -> bool {
+    let Some((s, t)) = hint else { return false };
+    let (mx, my) = (x.mesh(), y.mesh());
+    (s as usize) < mx.triangle_count()
+        && (t as usize) < my.triangle_count()
+        && tri_tri::classify(&mx.triangle(s), &my.triangle(t)).is_some()
 }
 
 /// Up to this many candidate object pairs, a query runs them on the calling thread (waking the
@@ -863,11 +887,12 @@ enum Among {
 
 /// `candidates`: the pairs whose boxes meet, sorted (only they can collide); `among`: every pair
 /// the query is about, searched best-first (by [`Placed::gap`]) only when no candidate
-/// collides; `tree`: the tree of `b`'s objects (all of them), when the caller keeps one.
+/// collides; `tree`: the tree of `b`'s objects (all of them), when the caller keeps one (asked
+/// for only when no candidate collides: a colliding pair answers without it).
 fn nearest(
     candidates: &[(usize, usize)],
     among: Among,
-    tree: Option<&ObjectTree>,
+    tree: &(dyn Fn() -> Option<Arc<ObjectTree>> + Sync),
     a: &[Arc<Placed>],
     b: &[Arc<Placed>],
     memo: Memory<'_>,
@@ -892,16 +917,16 @@ fn nearest(
                 break;
             }
             Some(_) => {}
-            None if memo.no_meeting(key(i, j)) || a[i].apart(&b[j]) => {}
+            None if memo.no_meeting(key(i, j)) => {}
             None => break,
         }
     }
-    let overlapping: Vec<(usize, usize)> =
-        candidates.iter().copied().filter(|&(i, j)| !a[i].apart(&b[j])).collect();
     // Meeting triangles first (a pair known to collide without containment has them), then
     // containment: the first pair in (i, j) order of the first kind found.
     // With the meeting pair found, when this search found it (its signed distance is then
     // computed from it, not searched for again).
+    // (The walk itself settles a pair whose boxes meet but whose balls are apart; finding the
+    // balls cost more than that.)
     let meeting = |&(i, j): &(usize, usize)| match memo.verdict(key(i, j)) {
         Some(v) => (v.collides && v.containment.is_none()).then_some((i, j, None)),
         None if memo.no_meeting(key(i, j)) => None,
@@ -912,6 +937,7 @@ fn nearest(
                 memo.keep_no_meeting(key(i, j));
                 return None;
             };
+            memo.keep_hint(hint_key(a, b, (i, j)), (first.a, first.b));
             memo.keep_verdict(key(i, j), Verdict { collides: true, containment: None });
             Some((i, j, Some(first)))
         }
@@ -919,6 +945,7 @@ fn nearest(
     let contained = |&(i, j): &(usize, usize)| {
         let v = match memo.verdict(key(i, j)) {
             Some(v) => v,
+            None if a[i].apart(&b[j]) => return None,
             None => {
                 let c = api::collide(&a[i], &b[j], false);
                 let v = Verdict { collides: c.collides(), containment: c.containment.name() };
@@ -929,7 +956,7 @@ fn nearest(
         v.collides.then_some((i, j, None))
     };
     if let Some((i, j, contact)) =
-        find_first(&overlapping, meeting).or_else(|| find_first(&overlapping, contained))
+        find_first(candidates, meeting).or_else(|| find_first(candidates, contained))
     {
         let s = match (memo.signed(key(i, j)), contact) {
             (Some(s), _) => s,
@@ -952,12 +979,12 @@ fn nearest(
     // nodes hold their objects' boxes, and each step of the box distance is monotone.
     let margin = a.iter().chain(b).map(|p| p.ball().slack).fold(0.0f64, f64::max);
     let boxes = |l: &[Arc<Placed>]| l.iter().map(|p| p.bounds()).collect::<Vec<Aabb>>();
-    let (bb, own_b);
-    let tb = match tree {
+    let kept = tree();
+    let own_b;
+    let tb = match &kept {
         Some(t) => t,
         None => {
-            bb = boxes(b);
-            own_b = ObjectTree::build(&bb, (0..b.len()).collect());
+            own_b = ObjectTree::build(&boxes(b), (0..b.len()).collect());
             &own_b
         }
     };
@@ -1066,6 +1093,9 @@ impl Sweep {
     }
 }
 
+/// A list of object pairs, shared between the manager and the queries that read it.
+type Pairs = Arc<Vec<(usize, usize)>>;
+
 /// The native collision manager (`meshclash.CollisionManager` wraps it with trimesh's
 /// interface). Objects keep their insertion order; names are unique.
 #[pyclass(module = "meshclash._meshclash")]
@@ -1077,7 +1107,7 @@ struct Manager {
     sweep: Sweep,
     /// The candidate pairs (boxes meet) of the objects, sorted, kept across queries: updated
     /// for the one object an add or set_transform places, rebuilt after a removal.
-    pairs: Mutex<Option<Vec<(usize, usize)>>>,
+    pairs: Mutex<Option<Pairs>>,
     /// Pair answers kept across queries ([`Memo`]).
     memo: Mutex<Memo>,
     /// The tree over every object's box, built by the first distance query that needs it after
@@ -1101,30 +1131,21 @@ impl Manager {
         self.placed(i);
     }
 
-    /// The tree over every object's box (kept until an object is placed or removed).
-    fn object_tree(&self) -> Arc<ObjectTree> {
-        let mut kept = self.tree.lock().unwrap();
-        kept.get_or_insert_with(|| {
-            let boxes: Vec<Aabb> = self.objs.iter().map(|p| p.bounds()).collect();
-            Arc::new(ObjectTree::build(&boxes, (0..boxes.len()).collect()))
-        })
-        .clone()
-    }
-
     /// Object `i` was placed anew (added or moved): its candidate pairs are found again.
     fn placed(&mut self, i: usize) {
         *self.tree.get_mut().unwrap() = None;
         let Some(pairs) = self.pairs.get_mut().unwrap().as_mut() else { return };
+        let pairs = Arc::make_mut(pairs);
         pairs.retain(|&(x, y)| x != i && y != i);
         let with = self.sweep.against(&self.objs, &self.objs[i].bounds());
         pairs.extend(with.into_iter().filter(|&j| j != i).map(|j| (i.min(j), i.max(j))));
         pairs.sort_unstable();
     }
 
-    /// The candidate pairs (i < j, boxes meet), sorted.
-    fn candidate_pairs(&self) -> Vec<(usize, usize)> {
+    /// The candidate pairs (i < j, boxes meet), sorted (shared with the kept list, not copied).
+    fn candidate_pairs(&self) -> Pairs {
         let mut kept = self.pairs.lock().unwrap();
-        kept.get_or_insert_with(|| self.sweep.pairs(&self.objs)).clone()
+        kept.get_or_insert_with(|| Arc::new(self.sweep.pairs(&self.objs))).clone()
     }
 
     /// Pairs (ours, theirs) whose boxes meet, sorted.
@@ -1137,6 +1158,17 @@ impl Manager {
         out.sort_unstable();
         out
     }
+}
+
+/// The tree over the boxes of `objs`, built once and kept in `kept` (emptied when an object is
+/// placed or removed).
+fn object_tree(objs: &[Arc<Placed>], kept: &Mutex<Option<Arc<ObjectTree>>>) -> Arc<ObjectTree> {
+    let mut kept = kept.lock().unwrap();
+    kept.get_or_insert_with(|| {
+        let boxes: Vec<Aabb> = objs.iter().map(|p| p.bounds()).collect();
+        Arc::new(ObjectTree::build(&boxes, (0..boxes.len()).collect()))
+    })
+    .clone()
 }
 
 fn place(py: Python<'_>, p: &Arc<Prepared>, t: DMat4) -> PyResult<Arc<Placed>> {
@@ -1247,9 +1279,10 @@ impl Manager {
         let k = name.as_deref().map(|n| self.find(n)).transpose()?;
         let mut candidates = self.candidate_pairs();
         if let Some(k) = k {
+            let candidates = Arc::make_mut(&mut candidates);
             candidates.retain(|&(i, j)| i == k || j == k);
             // The named object first in every pair.
-            for p in &mut candidates {
+            for p in candidates.iter_mut() {
                 if p.0 != k {
                     *p = (k, p.0);
                 }
@@ -1257,8 +1290,9 @@ impl Manager {
             candidates.sort_unstable();
         }
         let among = k.map_or(Among::Internal, Among::Named);
-        let (tree, memo) = (self.object_tree(), &self.memo);
-        let near = py.detach(|| nearest(&candidates, among, Some(&tree), objs, objs, Memory(Some(memo))));
+        let (kept, memo) = (&self.tree, &self.memo);
+        let tree = || Some(object_tree(objs, kept));
+        let near = py.detach(|| nearest(&candidates, among, &tree, objs, objs, Memory(Some(memo))));
         Ok(near.map(|(d, i, j, fi, fj, pi, pj)| {
             (d, self.names[i].clone(), self.names[j].clone(), fi, fj, pi, pj)
         }))
@@ -1268,8 +1302,9 @@ impl Manager {
         let (a, b) = (&self.objs, &other.objs);
         let candidates = self.pairs_with(b);
         let memo = &self.memo;
-        let tree = other.object_tree();
-        let near = py.detach(|| nearest(&candidates, Among::Across, Some(&tree), a, b, Memory(Some(memo))));
+        let kept = &other.tree;
+        let tree = || Some(object_tree(b, kept));
+        let near = py.detach(|| nearest(&candidates, Among::Across, &tree, a, b, Memory(Some(memo))));
         near.map(|(d, i, j, fi, fj, pi, pj)| {
             (d, self.names[i].clone(), other.names[j].clone(), fi, fj, pi, pj)
         })
@@ -1285,7 +1320,7 @@ impl Manager {
         let single = vec![place(py, &mesh.inner, transform_of(transform)?)?];
         let a = &self.objs;
         let candidates = self.pairs_with(&single);
-        let near = py.detach(|| nearest(&candidates, Among::Across, None, a, &single, Memory(None)));
+        let near = py.detach(|| nearest(&candidates, Among::Across, &|| None, a, &single, Memory(None)));
         Ok(near.map(|(d, i, _, fi, fj, pi, pj)| (d, self.names[i].clone(), fi, fj, pi, pj)))
     }
 }
