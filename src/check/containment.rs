@@ -841,14 +841,14 @@ mod tests {
             seed % n
         };
         let grid = [-0.0, 0.0, 1.0, 2.0, 0.5];
-        for round in 0..2000 {
+        for case in 0..2000 {
             let nv = 3 + next(12) as usize;
             let positions: Vec<DVec3> = (0..nv)
                 .map(|_| DVec3::new(grid[next(5) as usize], grid[next(5) as usize], grid[next(3) as usize]))
                 .collect();
             let nt = 1 + next(14) as usize;
             let triangles: Vec<[u32; 3]> =
-                (0..nt).map(|_| [0; 3].map(|_| next(nv as u64 - (round % 2)) as u32)).collect();
+                (0..nt).map(|_| [0; 3].map(|_| next(nv as u64 - (case % 2)) as u32)).collect();
             let mesh = Mesh {
                 positions: positions.clone(),
                 tri_object: vec![0; nt],
@@ -882,7 +882,7 @@ mod tests {
                     *uses.entry((x.min(y), x.max(y))).or_default() += 1;
                 }
             }
-            assert_eq!(got.closed, !uses.is_empty() && uses.values().all(|&u| u == 2), "round {round}");
+            assert_eq!(got.closed, !uses.is_empty() && uses.values().all(|&u| u == 2), "case {case}");
             // Components: flood over shared merged ids, numbered by first triangle.
             let mut comp_of_id = vec![u32::MAX; distinct as usize];
             let mut seeds = Vec::new();
@@ -908,11 +908,11 @@ mod tests {
                     }
                 }
             }
-            assert_eq!(got.component_seeds, seeds, "round {round}");
+            assert_eq!(got.component_seeds, seeds, "case {case}");
             let used = |v: usize| triangles.iter().any(|t| t.contains(&(v as u32)));
             let want: Vec<u32> =
                 (0..nv).map(|v| if used(v) { comp_of_id[merged[v] as usize] } else { u32::MAX }).collect();
-            assert_eq!(got.component_of, want, "round {round}");
+            assert_eq!(got.component_of, want, "case {case}");
         }
     }
 

@@ -759,7 +759,7 @@ mod chunked {
             ];
             let tails: [&[u8]; 6] = [b"", b" ", b" 1", b" # c", b"#c", b"\t"];
             let mut lines = 0;
-            for round in 0..3000 {
+            for case in 0..3000 {
                 let mut src = b"v 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 0 1\n".to_vec();
                 for _ in 0..1 + next(6) {
                     let sep = |k: u64| if k < 5 { seps[0] } else { seps[(k % 6) as usize] };
@@ -780,7 +780,7 @@ mod chunked {
                     src.extend_from_slice(if next(4) == 0 { b"\r\n" } else { b"\n" });
                     lines += 1;
                 }
-                if round % 2 == 0 {
+                if case % 2 == 0 {
                     src.extend_from_slice(b"f 1 2 3\n");
                 }
                 agree(&src);
