@@ -199,7 +199,7 @@ impl<'a> Source<'a> {
     fn world(self, part: &Part) -> Cow<'a, [DVec3]> {
         match self {
             Source::Loaded(m) => Cow::Borrowed(&m.positions),
-            Source::Placed(s) => Cow::Owned(placed_part(s, part.object as usize).positions),
+            Source::Placed(s) => Cow::Owned(s.place_positions(part.object as usize)),
         }
     }
 
