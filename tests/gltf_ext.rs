@@ -237,6 +237,34 @@ fn scene_of_gpu_instances_of_a_quantized_mesh() {
     assert_eq!(p02["min_distance"].as_f64(), Some(0.25), "{p02}");
 }
 
+/// `scene --detail parts` checks the GPU instances (mirrored, turned, non-uniformly scaled)
+/// placed one part at a time; the report is the expanded scene's, byte for byte, with and
+/// without a clearance, and with a part left out.
+#[test]
+fn gpu_instances_checked_placed_give_the_expanded_report() {
+    use meshclash::pipeline::{self, Request, Tolerance};
+    let dir = TempDir::new().unwrap();
+    let (mut inst, _) = scene_instances();
+    let f = write(&dir, "bolts.glb", instanced_cube_glb(&inst));
+    inst[2].0 = [-0.25, 0.0, 0.0];
+    let moved = write(&dir, "moved.glb", instanced_cube_glb(&inst));
+    let json = |o: &pipeline::Outcome| serde_json::to_string(&pipeline::report::build(o)).unwrap();
+    for (file, clearance, exclude) in
+        [(&f, 0.0, None), (&f, 0.5, Some("*#1")), (&moved, 0.5, Some("*#1")), (&moved, 0.0, None)]
+    {
+        let mut req = Request::scene(file);
+        req.settings.detail = meshclash::check::query::Detail::Parts;
+        req.deterministic = true;
+        req.clearance = Tolerance::Abs(clearance);
+        req.selection.exclude.extend(exclude.map(String::from));
+        assert!(pipeline::instanced_path(&req));
+        let placed = pipeline::run(&req, &|_| {}).unwrap();
+        assert!(placed.inputs[0].instanced.is_some());
+        let expanded = pipeline::run_expanded(&req, &|_| {}).unwrap();
+        assert_eq!(json(&placed), json(&expanded), "{} {clearance} {exclude:?}", file.display());
+    }
+}
+
 #[test]
 fn two_files_with_instances_against_each_other() {
     // files mode: A = the instanced scene, B = a single instance placed inside instance 3's

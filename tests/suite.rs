@@ -50,6 +50,8 @@ mod gltf_ext;
 mod hostile;
 #[path = "html.rs"]
 mod html;
+#[path = "instanced_scene.rs"]
+mod instanced_scene;
 #[path = "layers.rs"]
 mod layers;
 #[path = "memory_bounds.rs"]

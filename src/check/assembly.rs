@@ -34,8 +34,10 @@ use crate::check::query::{
 };
 use crate::geom::predicates::BoxMap;
 use crate::geom::{Aabb, DVec3};
-use crate::scene::mesh::{Mesh, Object, TriMesh};
+use crate::load::InstancedScene;
+use crate::scene::mesh::{Mesh, TriMesh};
 use rayon::prelude::*;
+use std::borrow::Cow;
 use std::collections::HashMap;
 use std::time::Instant;
 
@@ -129,8 +131,8 @@ struct Layout {
 }
 
 impl Layout {
-    fn of(mesh: &Mesh, part: &Part) -> Layout {
-        let (tris, mut vmap) = mesh.reindex(&part.triangles);
+    fn of(mesh: &Mesh, tris: &[u32]) -> Layout {
+        let (tris, mut vmap) = mesh.reindex(tris);
         let run = vmap.first().copied().filter(|&s| vmap.iter().zip(s..).all(|(&v, w)| v == w));
         let vertices = vmap.len();
         if run.is_some() {
@@ -157,6 +159,93 @@ fn shift_of(mesh: &Mesh, leader: &Part, inst: &Part) -> Option<i64> {
         (0..3).all(|k| i[k] as i64 == l[k] as i64 + shift)
     });
     same.then_some(shift)
+}
+
+/// Where the check reads the parts of one input: the loaded mesh in world coordinates, or an
+/// instanced glTF scene whose parts are placed when they are read (by the loader's own
+/// arithmetic, so the coordinates are the loaded mesh's, bit for bit) and dropped after.
+#[derive(Clone, Copy)]
+enum Source<'a> {
+    Loaded(&'a Mesh),
+    Placed(&'a InstancedScene),
+}
+
+impl<'a> Source<'a> {
+    /// The layout of `part` (see [`Layout`]).
+    fn layout(self, part: &Part) -> Layout {
+        match self {
+            Source::Loaded(m) => Layout::of(m, &part.triangles),
+            Source::Placed(s) => {
+                let one = placed_part(s, part.object as usize);
+                Layout::of(&one, &(0..one.triangles.len() as u32).collect::<Vec<_>>())
+            }
+        }
+    }
+
+    /// The vertex offset that makes `inst` read like `leader` (see [`shift_of`]). Placed, the
+    /// instances of one glTF mesh index their own vertices alike.
+    fn shift(self, leader: &Part, inst: &Part) -> Option<i64> {
+        match self {
+            Source::Loaded(m) => shift_of(m, leader, inst),
+            Source::Placed(_) => (leader.gltf_mesh == inst.gltf_mesh
+                && leader.triangles.len() == inst.triangles.len()
+                && !leader.triangles.is_empty())
+            .then_some(0),
+        }
+    }
+
+    /// The world coordinates `part`'s layout indexes: the loaded mesh's (borrowed), or the part
+    /// placed.
+    fn world(self, part: &Part) -> Cow<'a, [DVec3]> {
+        match self {
+            Source::Loaded(m) => Cow::Borrowed(&m.positions),
+            Source::Placed(s) => Cow::Owned(s.place_positions(part.object as usize)),
+        }
+    }
+
+    /// The glTF world matrix of `part`, if known.
+    fn matrix(self, part: &Part) -> Option<glam::DMat4> {
+        match self {
+            Source::Loaded(m) => m.objects[part.object as usize].world,
+            Source::Placed(s) => Some(s.parts[part.object as usize].world),
+        }
+    }
+}
+
+/// Part `k` of `scene` placed, as a mesh of its positions and triangles. The loader placed
+/// every part by the same arithmetic and found all coordinates finite, so placing cannot fail
+/// here (an empty mesh stands in if it ever did).
+fn placed_part(scene: &InstancedScene, k: usize) -> Mesh {
+    let (positions, triangles) = scene.place(k).unwrap_or_default();
+    Mesh { positions, triangles, ..Mesh::default() }
+}
+
+/// The parts of an instanced scene (see [`parts_of`]): the same list the expanded mesh gives,
+/// each part placed once, in parallel, for its box.
+pub fn parts_of_scene(scene: &InstancedScene) -> Vec<Part> {
+    let mut first = Vec::with_capacity(scene.parts.len());
+    let mut t0 = 0u32;
+    for k in 0..scene.parts.len() {
+        first.push(t0);
+        t0 = t0.saturating_add(scene.part_counts(k).1 as u32);
+    }
+    (0..scene.parts.len())
+        .into_par_iter()
+        .map(|k| {
+            let one = placed_part(scene, k);
+            let bounds = (0..one.triangles.len() as u32)
+                .fold(Aabb::EMPTY, |b, t| b.union(Aabb::of_triangle(&crate::bvh::triangle(&one, t))));
+            let p = &scene.parts[k];
+            Part {
+                input: 0,
+                object: k as u32,
+                name: p.name.clone(),
+                triangles: (first[k]..first[k] + one.triangles.len() as u32).collect(),
+                bounds,
+                gltf_mesh: Some(p.mesh),
+            }
+        })
+        .collect()
 }
 
 /// One part seen through its layout: vertex `v` is `world[vmap[v] + shift]`. Nothing is copied.
@@ -199,11 +288,27 @@ impl TriMesh for PartMesh<'_> {
     }
 }
 
+/// The parts' views: a part's layout over coordinates given when it is read.
+struct Views<'l> {
+    plan: &'l [Option<Plan>],
+    layouts: &'l [Layout],
+}
+
+impl<'l> Views<'l> {
+    fn of<'w>(&self, i: usize, world: &'w [DVec3]) -> PartMesh<'w>
+    where
+        'l: 'w,
+    {
+        let p = self.plan[i].expect("needed part has a plan");
+        PartMesh { world, layout: &self.layouts[p.layout], shift: p.shift }
+    }
+}
+
 /// The affine map from `leader`'s world coordinates to `inst`'s: `world(inst) · world(leader)⁻¹`
 /// from the glTF node matrices, as [`BoxMap`] rows. `None` without matrices or for a singular
 /// leader matrix.
-fn relative_rows(leader: &Object, inst: &Object) -> Option<[[f64; 4]; 3]> {
-    let (l, i) = (leader.world?, inst.world?);
+fn relative_rows(leader: Option<glam::DMat4>, inst: Option<glam::DMat4>) -> Option<[[f64; 4]; 3]> {
+    let (l, i) = (leader?, inst?);
     let det = l.determinant();
     if det == 0.0 || !det.is_finite() {
         return None;
@@ -326,6 +431,27 @@ pub fn check_parts_kept(
     settings: &Settings,
     keep: &(dyn Fn(usize, usize) -> bool + Sync),
 ) -> AssemblyResult {
+    check_parts_from(
+        [Source::Loaded(meshes[0]), Source::Loaded(meshes[1])],
+        parts,
+        sel_a,
+        sel_b,
+        pairing,
+        settings,
+        keep,
+    )
+}
+
+/// [`check_parts_kept`] on parts read from `sources` (by input).
+fn check_parts_from(
+    sources: [Source<'_>; 2],
+    parts: Vec<Part>,
+    sel_a: &[usize],
+    sel_b: &[usize],
+    pairing: Pairing,
+    settings: &Settings,
+    keep: &(dyn Fn(usize, usize) -> bool + Sync),
+) -> AssemblyResult {
     let t0 = Instant::now();
     // Broad phase: a tree over the selected parts' boxes on each side, walked together.
     let mut candidates: Vec<(usize, usize)> =
@@ -340,7 +466,7 @@ pub fn check_parts_kept(
         built[b] = true;
     }
     let needed: Vec<usize> = (0..parts.len()).filter(|&i| built[i]).collect();
-    let mesh_of = |i: usize| meshes[parts[i].input as usize];
+    let source = |i: usize| sources[parts[i].input as usize];
     // Group instances: the first needed part of each (input, glTF mesh) leads; another instance
     // shares its layout and tree when its triangles index the mesh in the same pattern.
     let mut leader_of_mesh: HashMap<(u8, u32), usize> = HashMap::new();
@@ -349,7 +475,7 @@ pub fn check_parts_kept(
     for &i in &needed {
         let shared = parts[i].gltf_mesh.and_then(|m| {
             let l = *leader_of_mesh.entry((parts[i].input, m)).or_insert(i);
-            let shift = if l == i { None } else { shift_of(mesh_of(i), &parts[l], &parts[i]) }?;
+            let shift = if l == i { None } else { source(i).shift(&parts[l], &parts[i]) }?;
             Some(Plan { leader: l, shift, ..plan[l]? })
         });
         plan[i] = Some(shared.unwrap_or_else(|| {
@@ -357,15 +483,16 @@ pub fn check_parts_kept(
             Plan { layout: leaders.len() - 1, shift: 0, leader: i }
         }));
     }
-    let layouts: Vec<Layout> = leaders.par_iter().map(|&i| Layout::of(mesh_of(i), &parts[i])).collect();
-    let view = |i: usize| {
-        let p = plan[i].expect("needed part has a plan");
-        PartMesh { world: &mesh_of(i).positions, layout: &layouts[p.layout], shift: p.shift }
-    };
+    let layouts: Vec<Layout> = leaders.par_iter().map(|&i| source(i).layout(&parts[i])).collect();
+    // A part's coordinates (borrowed from the loaded mesh, or placed for the moment) and its
+    // view through its layout.
+    let world = |i: usize| source(i).world(&parts[i]);
+    let views = Views { plan: &plan, layouts: &layouts };
     let own: Vec<Bvh> = leaders
         .par_iter()
         .map(|&i| {
-            let v = view(i);
+            let w = world(i);
+            let v = views.of(i, &w);
             let boxes: Vec<Aabb> =
                 (0..v.triangle_count() as u32).map(|t| Aabb::of_triangle(&v.triangle(t))).collect();
             Bvh::build_from_boxes(&boxes, settings.bvh)
@@ -383,11 +510,10 @@ pub fn check_parts_kept(
         .filter(|&&i| plan[i].is_some_and(|p| p.leader != i))
         .map(|&i| {
             let p = plan[i].expect("planned");
-            let (vl, vi) = (view(p.leader), view(i));
+            let (wl, wi) = (world(p.leader), world(i));
+            let (vl, vi) = (views.of(p.leader, &wl), views.of(i, &wi));
             let template = &own[p.layout];
-            let objects = &mesh_of(i).objects;
-            let rows =
-                relative_rows(&objects[parts[p.leader].object as usize], &objects[parts[i].object as usize]);
+            let rows = relative_rows(source(i).matrix(&parts[p.leader]), source(i).matrix(&parts[i]));
             let map = rows.and_then(|r| {
                 let pairs = (0..vl.vertex_count() as u32).map(|v| (vl.vertex(v), vi.vertex(v)));
                 BoxMap::fit(r, &template.bounds(), pairs)
@@ -441,7 +567,8 @@ pub fn check_parts_kept(
     let phases: Vec<(PairPhase, bool)> = candidates
         .par_iter()
         .map(|&(a, b)| {
-            let (va, vb, ta, tb) = (view(a), view(b), tree(a), tree(b));
+            let (wa, wb) = (world(a), world(b));
+            let (va, vb, ta, tb) = (views.of(a, &wa), views.of(b, &wb), tree(a), tree(b));
             // Without the lists (`--detail parts`) the walk keeps only a tally: memory does not
             // grow with the pairs of a part pair.
             let phase = match settings.detail {
@@ -461,7 +588,7 @@ pub fn check_parts_kept(
     }
     let topology: Vec<Option<Topology>> = (0..parts.len())
         .into_par_iter()
-        .map(|i| wanted[i].then(|| containment::topology(&view(i))))
+        .map(|i| wanted[i].then(|| containment::topology(&views.of(i, &world(i)))))
         .collect();
     let mut finished: Vec<(ClashResult, bool)> = candidates
         .par_iter()
@@ -471,11 +598,13 @@ pub fn check_parts_kept(
                 needs.then(|| (topology[a].as_ref().expect("wanted"), topology[b].as_ref().expect("wanted")));
             let pending = phase.closest_pending();
             let mut phase = phase;
+            let (wa, wb) = (world(a), world(b));
+            let (va, vb) = (views.of(a, &wa), views.of(b, &wb));
             if topo.is_some_and(|(x, y)| phase.needs_pairs(x, y)) {
                 // Touching closed parts: containment reads their contacts.
-                phase.set_pairs(find_pairs(&view(a), &tree(a), &view(b), &tree(b), settings).0);
+                phase.set_pairs(find_pairs(&va, &tree(a), &vb, &tree(b), settings).0);
             }
-            let mut r = phase.finish(&view(a), &tree(a), &view(b), &tree(b), topo);
+            let mut r = phase.finish(&va, &tree(a), &vb, &tree(b), topo);
             if settings.detail == Detail::Parts {
                 r.pairs = Vec::new();
             }
@@ -490,13 +619,14 @@ pub fn check_parts_kept(
     // distance already known (0 as soon as any pair touches or crosses: then no clear pair,
     // whose exact distance is positive, can be the minimum and none is searched).
     let listed = |r: &ClashResult| r.verdict != Verdict::Clear || r.containment != Containment::None;
-    let closest_of = |&(a, b): &(usize, usize)| {
-        let (va, vb, ta, tb) = (view(a), view(b), tree(a), tree(b));
-        move |best: &AtomicU64| closest_pair_within(&va, &ta, &vb, &tb, settings.distance_error, best)
+    let closest_of = |&(a, b): &(usize, usize), best: &AtomicU64| {
+        let (wa, wb) = (world(a), world(b));
+        let (va, vb, ta, tb) = (views.of(a, &wa), views.of(b, &wb), tree(a), tree(b));
+        closest_pair_within(&va, &ta, &vb, &tb, settings.distance_error, best)
     };
     finished.par_iter_mut().zip(candidates.par_iter()).filter(|((r, p), _)| *p && listed(r)).for_each(
         |((r, pending), pair)| {
-            r.closest = closest_of(pair)(&AtomicU64::new(f64::INFINITY.to_bits()));
+            r.closest = closest_of(pair, &AtomicU64::new(f64::INFINITY.to_bits()));
             *pending = false;
         },
     );
@@ -506,7 +636,7 @@ pub fn check_parts_kept(
         let shared = AtomicU64::new(known.to_bits());
         finished.par_iter_mut().zip(candidates.par_iter()).filter(|((_, p), _)| *p).for_each(
             |((r, _), pair)| {
-                r.closest = closest_of(pair)(&shared);
+                r.closest = closest_of(pair, &shared);
             },
         );
     }
@@ -567,6 +697,7 @@ pub fn centroid(points: &[DVec3]) -> DVec3 {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::scene::mesh::Object;
 
     /// Each part lists exactly its object's triangles, in file order, in a list allocated at
     /// its size; objects without triangles give no part.
@@ -672,11 +803,7 @@ mod tests {
                 let boxes: Vec<Aabb> =
                     tris.iter().map(|t| Aabb::of_triangle(&t.map(|v| wl[v as usize]))).collect();
                 let tree = Bvh::build_from_boxes(&boxes, BuildOptions::default());
-                let (ol, oi) = (
-                    Object { world: Some(l), ..Default::default() },
-                    Object { world: Some(i), ..Default::default() },
-                );
-                let rows = relative_rows(&ol, &oi).unwrap();
+                let rows = relative_rows(Some(l), Some(i)).unwrap();
                 let map = BoxMap::fit(rows, &tree.bounds(), wl.iter().copied().zip(wi.iter().copied()))
                     .expect("an instance maps");
                 // Every node's mapped box holds the instance's triangles below it.
@@ -830,18 +957,7 @@ fn run_checked(a: &Mesh, b: &Mesh, sel: &Selection, settings: &Settings) -> Resu
     if !sel.scene {
         parts.extend(parts_of(b, 1));
     }
-    let b_input = if sel.scene { 0 } else { 1 };
-    let sa = select(&parts, 0, &sel.select_a, &sel.exclude);
-    let sb = select(&parts, b_input, &sel.select_b, &sel.exclude);
-    for (s, globs, side) in [(&sa, &sel.select_a, "a"), (&sb, &sel.select_b, "b")] {
-        if s.is_empty() {
-            return Err(if globs.is_empty() {
-                format!("no part left to check on side {side} after --exclude")
-            } else {
-                format!("--select-{side} {} matches no part", globs.join(","))
-            });
-        }
-    }
+    let (sa, sb) = selected(&parts, sel)?;
     let meshes = [a, if sel.scene { a } else { b }];
     if let Some(o) = sel.hook.as_ref().and_then(|h| h.0.stand_in(meshes, &parts, [sa.len(), sb.len()])) {
         return o;
@@ -872,8 +988,53 @@ fn run_checked(a: &Mesh, b: &Mesh, sel: &Selection, settings: &Settings) -> Resu
         };
         return Ok(Outcome { result, parts, part_pairs, info });
     }
+    by_parts([Source::Loaded(a), Source::Loaded(meshes[1])], parts, &sa, &sb, sel, settings)
+}
+
+/// [`run`] in scene mode on an instanced glTF scene: the same outcome as [`run`] on the
+/// scene's expanded mesh, each part placed when the check reads it (never all at once). The
+/// selection must be a scene's without a sharding hook.
+pub fn run_instanced(
+    scene: &InstancedScene,
+    sel: &Selection,
+    settings: &Settings,
+) -> Result<Outcome, String> {
+    if !sel.scene || sel.hook.is_some() {
+        return Err("an instanced scene is checked in scene mode without a sharding hook".to_string());
+    }
+    let parts = parts_of_scene(scene);
+    let (sa, sb) = selected(&parts, sel)?;
+    by_parts([Source::Placed(scene); 2], parts, &sa, &sb, sel, settings)
+}
+
+/// The selected parts of each side (indices into `parts`); an error when a side has none.
+fn selected(parts: &[Part], sel: &Selection) -> Result<(Vec<usize>, Vec<usize>), String> {
+    let b_input = if sel.scene { 0 } else { 1 };
+    let sa = select(parts, 0, &sel.select_a, &sel.exclude);
+    let sb = select(parts, b_input, &sel.select_b, &sel.exclude);
+    for (s, globs, side) in [(&sa, &sel.select_a, "a"), (&sb, &sel.select_b, "b")] {
+        if s.is_empty() {
+            return Err(if globs.is_empty() {
+                format!("no part left to check on side {side} after --exclude")
+            } else {
+                format!("--select-{side} {} matches no part", globs.join(","))
+            });
+        }
+    }
+    Ok((sa, sb))
+}
+
+/// The part-by-part check of the selected parts `sa` against `sb` (scene mode or a selection).
+fn by_parts(
+    sources: [Source<'_>; 2],
+    parts: Vec<Part>,
+    sa: &[usize],
+    sb: &[usize],
+    sel: &Selection,
+    settings: &Settings,
+) -> Result<Outcome, String> {
     let pairing = if sel.scene && sel.select_b.is_empty() { Pairing::AllVsAll } else { Pairing::Cross };
-    if candidates_exceed(&parts, &sa, &sb, pairing, settings, MAX_CANDIDATE_PART_PAIRS) {
+    if candidates_exceed(&parts, sa, sb, pairing, settings, MAX_CANDIDATE_PART_PAIRS) {
         return Err(format!(
             "more than {MAX_CANDIDATE_PART_PAIRS} candidate part pairs (parts whose boxes come within the search \
              margin of each other), the most meshclash checks in one run: narrow it with \
@@ -881,7 +1042,7 @@ fn run_checked(a: &Mesh, b: &Mesh, sel: &Selection, settings: &Settings) -> Resu
         ));
     }
     let keep = |x, y| sel.hook.as_ref().is_none_or(|h| h.0.keep(x, y));
-    let ar = check_parts_kept([a, if sel.scene { a } else { b }], parts, &sa, &sb, pairing, settings, &keep);
+    let ar = check_parts_from(sources, parts, sa, sb, pairing, settings, &keep);
     let mut pairs_seen = std::collections::HashSet::new();
     let AssemblyResult {
         parts: ar_parts,

@@ -168,15 +168,7 @@ pub fn check_range(mesh: &Mesh, path: &Path) -> Result<Vec<String>> {
             }
         }
     }
-    Ok(tiny
-        .map(|(i, c)| {
-            format!(
-                "{tiny_count} coordinates are non-zero but below 2^-250 in magnitude (e.g. {c:e} at vertex {i}): \
-                 verdicts between triangles that small may be inexact"
-            )
-        })
-        .into_iter()
-        .collect())
+    Ok(tiny.map(|(i, c)| tiny_warning(tiny_count, i, c)).into_iter().collect())
 }
 
 /// Apply an affine transform to every vertex (f64), rejecting non-finite results.
@@ -368,6 +360,99 @@ impl MeshInfo {
             bounds: Aabb::of_points(&mesh.positions),
         }
     }
+}
+
+/// What one placed part of an instanced scene adds to its input's summary and range check.
+struct PartSummary {
+    vertices: usize,
+    triangles: usize,
+    degenerate: usize,
+    bounds: Aabb,
+    /// The first coordinate beyond the exact range: (part-local vertex, coordinate).
+    beyond: Option<(usize, f64)>,
+    /// Non-zero coordinates below the exact range, and the first: (part-local vertex, coordinate).
+    tiny: (usize, Option<(usize, f64)>),
+}
+
+impl PartSummary {
+    fn of(positions: &[DVec3], triangles: &[[u32; 3]]) -> PartSummary {
+        let degenerate = triangles
+            .iter()
+            .filter(|t| {
+                let [a, b, c] = t.map(|v| positions[v as usize]);
+                predicates::collinear(a, b, c)
+            })
+            .count();
+        let (mut beyond, mut tiny) = (None, (0usize, None));
+        'scan: for (i, p) in positions.iter().enumerate() {
+            for c in p.to_array() {
+                let m = c.abs();
+                if m > predicates::MAX_EXACT_MAGNITUDE {
+                    beyond = Some((i, c));
+                    break 'scan;
+                }
+                if m != 0.0 && m < predicates::MIN_EXACT_MAGNITUDE {
+                    tiny.0 += 1;
+                    tiny.1.get_or_insert((i, c));
+                }
+            }
+        }
+        PartSummary {
+            vertices: positions.len(),
+            triangles: triangles.len(),
+            degenerate,
+            bounds: Aabb::of_points(positions),
+            beyond,
+            tiny,
+        }
+    }
+}
+
+/// The summary ([`MeshInfo::of`]) and the range check ([`check_range`]) of an instanced
+/// scene's expanded mesh, with every number, warning and error the same, placing each part once
+/// (in parallel, never all at once). Parts never share vertices, so the counts add up part by
+/// part; the box and the first out-of-range vertex are taken in part order.
+pub fn scene_info(scene: &load::InstancedScene, path: &Path) -> Result<(MeshInfo, Vec<String>)> {
+    let parts: Vec<PartSummary> = (0..scene.parts.len())
+        .into_par_iter()
+        .map(|k| match scene.place(k) {
+            Ok((positions, triangles)) => Ok(PartSummary::of(&positions, &triangles)),
+            Err(e) => Err(e),
+        })
+        .collect::<Result<_>>()?;
+    let (mut vertices, mut triangles, mut degenerate) = (0usize, 0usize, 0usize);
+    let mut bounds = Aabb::EMPTY;
+    let (mut tiny_count, mut tiny) = (0usize, None);
+    for p in &parts {
+        if let Some((i, c)) = p.beyond {
+            let problem = InputProblem::CoordinateBeyondExactRange { coordinate: c };
+            return Err(Error::at(path, Location::Vertex(vertices + i), problem));
+        }
+        tiny_count += p.tiny.0;
+        if tiny.is_none() {
+            tiny = p.tiny.1.map(|(i, c)| (vertices + i, c));
+        }
+        vertices += p.vertices;
+        triangles += p.triangles;
+        degenerate += p.degenerate;
+        bounds = bounds.union(p.bounds);
+    }
+    let info = MeshInfo {
+        vertices,
+        triangles,
+        degenerate_triangles: degenerate,
+        objects: scene.parts.iter().zip(&parts).map(|(s, p)| (s.name.clone(), p.triangles)).collect(),
+        bounds,
+    };
+    Ok((info, tiny.map(|(i, c)| tiny_warning(tiny_count, i, c)).into_iter().collect()))
+}
+
+/// The warning for `count` coordinates below the exact range, the first `c` at vertex `i`.
+fn tiny_warning(count: usize, i: usize, c: f64) -> String {
+    format!(
+        "{count} coordinates are non-zero but below 2^-250 in magnitude (e.g. {c:e} at vertex {i}): verdicts \
+         between triangles that small may be inexact"
+    )
 }
 
 /// Phase times in milliseconds.

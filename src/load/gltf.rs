@@ -204,6 +204,17 @@ impl InstancedScene {
         Ok((one.positions, one.triangles))
     }
 
+    /// Part `k`'s world positions alone: those [`Self::place`] gives, by the same arithmetic,
+    /// without its triangles or the check for non-finite coordinates (the load made it).
+    pub fn place_positions(&self, k: usize) -> Vec<DVec3> {
+        let p = &self.parts[k];
+        let prims = self.prims(p);
+        let mut positions = Vec::with_capacity(counts(prims).0);
+        // Nothing to check, so this cannot fail.
+        let _ = place_vertices(&mut positions, prims, p.world, |_| Ok(()));
+        positions
+    }
+
     /// The vertices and triangles part `k` expands to, without placing it.
     pub fn part_counts(&self, k: usize) -> (usize, usize) {
         counts(self.prims(&self.parts[k]))
@@ -333,8 +344,35 @@ fn add_instance(
 ) -> Result<()> {
     let object = mesh.objects.len() as u32;
     mesh.objects.push(Object { name, gltf_mesh: Some(at.mesh as u32), world: Some(world) });
-    // Where each primitive's vertices start (a primitive sharing an earlier one's accessor
-    // uses that one's, placed once).
+    let bases = place_vertices(&mut mesh.positions, prims, world, |placed| {
+        // Look for the first non-finite result of each run (one tight loop each).
+        match placed.iter().enumerate().find_map(|(i, w)| Some((i, super::non_finite(w.to_array())?))) {
+            Some((i, value)) => {
+                let at =
+                    Location::Placed { mesh: at.mesh, position: i, node: at.node, instance: at.instance };
+                Err(Error::at(path, at, InputProblem::NonFiniteAfterTransform { value: Some(value) }))
+            }
+            None => Ok(()),
+        }
+    })?;
+    for (p, base) in prims.iter().zip(bases) {
+        let Some(base) = base else { continue };
+        mesh.triangles.extend(p.triangles.iter().map(|t| t.map(|i| base + i)));
+        mesh.tri_object.resize(mesh.tri_object.len() + p.triangles.len(), object);
+    }
+    Ok(())
+}
+
+/// Appends the vertices of `prims` placed by `world` to `positions` and returns where each
+/// primitive's vertices start (a primitive sharing an earlier one's accessor uses that one's,
+/// placed once; `None` for a primitive that places nothing). `check` sees each run of vertices
+/// as it is appended, and its error stops the placement.
+fn place_vertices(
+    positions: &mut Vec<DVec3>,
+    prims: &[Prim],
+    world: DMat4,
+    mut check: impl FnMut(&[DVec3]) -> Result<()>,
+) -> Result<Vec<Option<u32>>> {
     let mut bases: Vec<Option<u32>> = vec![None; prims.len()];
     for (k, p) in prims.iter().enumerate() {
         if p.triangles.is_empty() && p.shares.is_none() {
@@ -345,24 +383,13 @@ fn add_instance(
             bases[k] = Some(base);
             continue;
         }
-        let base = mesh.positions.len() as u32;
+        let base = positions.len() as u32;
         bases[k] = Some(base);
-        // Transform all, then look for the first non-finite result (one tight loop each).
-        mesh.positions.extend(prims[owner].positions.iter().map(|&v| world.transform_point3(v)));
-        let placed = &mesh.positions[base as usize..];
-        if let Some((i, value)) =
-            placed.iter().enumerate().find_map(|(i, w)| Some((i, super::non_finite(w.to_array())?)))
-        {
-            let at = Location::Placed { mesh: at.mesh, position: i, node: at.node, instance: at.instance };
-            return Err(Error::at(path, at, InputProblem::NonFiniteAfterTransform { value: Some(value) }));
-        }
+        // Transform all, then check the run.
+        positions.extend(prims[owner].positions.iter().map(|&v| world.transform_point3(v)));
+        check(&positions[base as usize..])?;
     }
-    for (p, base) in prims.iter().zip(bases) {
-        let Some(base) = base else { continue };
-        mesh.triangles.extend(p.triangles.iter().map(|t| t.map(|i| base + i)));
-        mesh.tri_object.resize(mesh.tri_object.len() + p.triangles.len(), object);
-    }
-    Ok(())
+    Ok(bases)
 }
 
 /// The decoded attributes of one `EXT_mesh_gpu_instancing` node (components decoded by

@@ -85,6 +85,7 @@ fn same_instanced(path: &std::path::Path, bytes: &[u8], l: &Loaded) {
             (Some(&object.name), object.gltf_mesh, object.world)
         );
         let (pos, tris) = scene.place(k).unwrap();
+        assert_eq!(bits(&scene.place_positions(k)), bits(&pos), "part {k}");
         assert_eq!(scene.part_counts(k), (pos.len(), tris.len()));
         let mine = &l.mesh.triangles[first_tri..first_tri + tris.len()];
         assert!(l.mesh.tri_object[first_tri..first_tri + tris.len()].iter().all(|&o| o as usize == k));

@@ -427,14 +427,129 @@ impl Request {
 /// A loaded, placed input as the check saw it.
 #[derive(Debug, Clone)]
 pub struct LoadedInput {
-    /// The mesh in world coordinates, with its path, format and warnings.
+    /// The mesh in world coordinates, with its path, format and warnings. For an instanced
+    /// input (`instanced`) the mesh is empty: read it through [`LoadedInput::mesh`].
     pub input: Input,
+    /// A glTF scene checked without expanding its instances ([`instanced_path`]).
+    pub instanced: Option<std::sync::Arc<InstancedInput>>,
     /// The placement applied.
     pub transform: DMat4,
     /// The units block (when units or scales were given).
     pub units: Option<InputUnitsReport>,
     /// An in-memory mesh (reported with format `array`).
     pub array: bool,
+}
+
+impl LoadedInput {
+    /// The mesh in world coordinates. An instanced input is expanded on first use (by an
+    /// output that draws the geometry), exactly as the file's plain load gives it.
+    pub fn mesh(&self) -> &Mesh {
+        match &self.instanced {
+            Some(i) => i.expanded.get_or_init(|| i.scene.expand().map(|l| l.mesh).unwrap_or_default()),
+            None => &self.input.mesh,
+        }
+    }
+
+    /// The summary the report gives of the input (counts, zero-area triangles, objects, box).
+    pub fn info(&self) -> std::borrow::Cow<'_, query::MeshInfo> {
+        match &self.instanced {
+            Some(i) => std::borrow::Cow::Borrowed(&i.info),
+            None => std::borrow::Cow::Owned(query::MeshInfo::of(&self.input.mesh)),
+        }
+    }
+
+    /// The object triangle `t` belongs to; `parts` are the check's parts of this input.
+    pub fn object_of(&self, parts: &[assembly::Part], t: u32) -> u32 {
+        if self.instanced.is_none() {
+            return self.input.mesh.tri_object[t as usize];
+        }
+        // An instanced scene's parts hold consecutive runs of its triangles, in object order.
+        let k = parts.partition_point(|p| p.triangles.first().is_some_and(|&f| f <= t));
+        parts[k.saturating_sub(1)].object
+    }
+}
+
+/// A loaded input reads as its world mesh ([`LoadedInput::mesh`]: an instanced scene is
+/// expanded on first use).
+impl std::ops::Deref for LoadedInput {
+    type Target = Mesh;
+    fn deref(&self) -> &Mesh {
+        self.mesh()
+    }
+}
+
+/// A glTF scene checked without expanding its instances: each mesh once in its own coordinates
+/// and every part as (mesh, world matrix), placed when the check reads it.
+pub struct InstancedInput {
+    /// The scene.
+    pub scene: crate::load::InstancedScene,
+    /// The expanded mesh's summary, computed part by part.
+    pub info: query::MeshInfo,
+    expanded: std::sync::OnceLock<Mesh>,
+}
+
+impl std::fmt::Debug for InstancedInput {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("InstancedInput").field("parts", &self.scene.parts.len()).finish_non_exhaustive()
+    }
+}
+
+/// Whether `req` runs on its glTF scene instanced ([`InstancedInput`]) rather than expanded:
+/// the one place that decides it. A scene checked part by part without the triangle-pair lists
+/// (`scene --detail parts`), with nothing that reads the whole world mesh: no cache (its keys
+/// hash the mesh), sharding hook, scene self-check, penetration estimates, baseline,
+/// cross-check, `--split-bodies`, units, scales or placement. Every other request expands the
+/// scene as it is loaded. Both paths give the same outcome; this path's memory grows with the
+/// distinct meshes, not the instances. Without pair lists the regions, finding ids and listed
+/// pairs are empty, so nothing downstream of the check reads the (empty) expanded mesh; an
+/// output that draws the geometry expands it through [`LoadedInput::mesh`].
+pub fn instanced_path(req: &Request) -> bool {
+    req.selection.scene
+        && req.settings.detail == Detail::Parts
+        && req.cache.is_none()
+        && req.selection.hook.is_none()
+        && req.self_check.is_none()
+        && !req.penetration
+        && req.baseline.is_none()
+        && !req.cross_check
+        && !req.split_bodies
+        && !req.units.active()
+        && req.inputs.len() == 1
+        && req.inputs[0].transform == DMat4::IDENTITY
+        && matches!(req.inputs[0].source, Source::File(_))
+}
+
+/// Load a glTF scene file instanced (see [`instanced_path`]); any other format loads as usual.
+fn load_scene_instanced(req: &Request, path: &Path) -> Result<LoadedInput> {
+    use crate::error::Reading;
+    let bytes = crate::load::read_regular_file(path, Reading::File, u64::MAX)?;
+    let format = crate::load::detect_format(path, &bytes)?;
+    if !matches!(format, Format::Gltf | Format::Glb) {
+        let loaded = crate::load::load_bytes(path, &bytes, format)?;
+        let spec = InputSpec { path: path.to_path_buf(), transform: req.inputs[0].transform };
+        let input = query::prepare_input(&spec, loaded, format, 1.0, None)?;
+        return Ok(LoadedInput {
+            input,
+            instanced: None,
+            transform: req.inputs[0].transform,
+            units: None,
+            array: false,
+        });
+    }
+    let scene = crate::load::load_gltf_instanced(path, &bytes)?;
+    drop(bytes);
+    let (info, range_warnings) = query::scene_info(&scene, path)?;
+    let mut warnings = scene.warnings.clone();
+    warnings.extend(range_warnings);
+    let input = Input { path: path.to_path_buf(), format, mesh: Mesh::default(), warnings };
+    let instanced = InstancedInput { scene, info, expanded: std::sync::OnceLock::new() };
+    Ok(LoadedInput {
+        input,
+        instanced: Some(std::sync::Arc::new(instanced)),
+        transform: req.inputs[0].transform,
+        units: None,
+        array: false,
+    })
 }
 
 /// The baseline comparison of a run.
@@ -497,9 +612,10 @@ pub struct Outcome {
 }
 
 impl Outcome {
-    /// The two meshes the check ran on.
-    pub fn meshes(&self) -> [&Mesh; 2] {
-        [&self.inputs[0].input.mesh, &self.inputs[1].input.mesh]
+    /// The two meshes the check ran on, each read as a [`Mesh`] through [`LoadedInput`]'s
+    /// `Deref`: an instanced scene is expanded only when an output reads its geometry.
+    pub fn meshes(&self) -> [&LoadedInput; 2] {
+        [&self.inputs[0], &self.inputs[1]]
     }
 
     /// Loader and units warnings, each prefixed with its file (in scene mode once).
@@ -536,7 +652,7 @@ fn load_input(req: &Request, i: usize, flag: &str) -> Result<LoadedInput> {
     if req.split_bodies {
         crate::scene::bodies::split_bodies(&mut input.mesh);
     }
-    Ok(LoadedInput { input, transform: r.transform, units, array })
+    Ok(LoadedInput { input, instanced: None, transform: r.transform, units, array })
 }
 
 /// The input whose file a selection error names: A's when A's selection (`--select-a`,
@@ -587,6 +703,17 @@ pub fn listed_pairs(pairs: &[PairFinding], max: usize) -> Vec<usize> {
 
 /// Run a check: see the module docs. `progress` is called as each phase starts.
 pub fn run(req: &Request, progress: &(dyn Fn(Phase) + Sync)) -> Result<Outcome> {
+    run_on(req, progress, instanced_path(req))
+}
+
+/// [`run`] with the input expanded whatever [`instanced_path`] says: the same outcome, for
+/// comparing the two paths.
+#[doc(hidden)]
+pub fn run_expanded(req: &Request, progress: &(dyn Fn(Phase) + Sync)) -> Result<Outcome> {
+    run_on(req, progress, false)
+}
+
+fn run_on(req: &Request, progress: &(dyn Fn(Phase) + Sync), instanced: bool) -> Result<Outcome> {
     req.validate()?;
     // Read the baseline first: a bad one costs nothing, and it is read before any output is
     // written (so `--baseline r.json -o r.json` updates a baseline in place).
@@ -595,7 +722,10 @@ pub fn run(req: &Request, progress: &(dyn Fn(Phase) + Sync)) -> Result<Outcome> 
     // A cache directory that cannot be used is refused before anything is loaded.
     let store = req.cache.as_ref().map(|c| crate::cache::Store::open(&c.dir, c.max_bytes)).transpose()?;
     let t0 = Instant::now();
-    let inputs = if req.selection.scene {
+    let inputs = if instanced {
+        let one = std::sync::Arc::new(load_scene_instanced(req, req.inputs[0].path())?);
+        [one.clone(), one]
+    } else if req.selection.scene {
         let one = std::sync::Arc::new(load_input(req, 0, "--units-a")?);
         [one.clone(), one]
     } else {
@@ -604,7 +734,12 @@ pub fn run(req: &Request, progress: &(dyn Fn(Phase) + Sync)) -> Result<Outcome> 
     };
     let (a, b) = (&inputs[0].input, &inputs[1].input);
     let load_ms = t0.elapsed().as_secs_f64() * 1e3;
-    let size = Aabb::of_points(&a.mesh.positions).union(Aabb::of_points(&b.mesh.positions)).extent().length();
+    let size = match &inputs[0].instanced {
+        Some(i) => i.info.bounds.extent().length(),
+        None => {
+            Aabb::of_points(&a.mesh.positions).union(Aabb::of_points(&b.mesh.positions)).extent().length()
+        }
+    };
     let mut settings = req.settings;
     settings.tolerances =
         Tolerances { touch: req.touch.resolve(size), clearance: req.clearance.resolve(size) };
@@ -629,10 +764,11 @@ pub fn run(req: &Request, progress: &(dyn Fn(Phase) + Sync)) -> Result<Outcome> 
         )
     });
     let selection = cache.as_ref().map(|c| c.selection(&req.selection));
-    let outcome = assembly::run(&a.mesh, &b.mesh, selection.as_ref().unwrap_or(&req.selection), &settings)
-        .map_err(|e| {
-            Error::in_file(req.inputs[problem_side(req, &a.mesh)].path(), InputProblem::Selection(e))
-        })?;
+    let outcome = match &inputs[0].instanced {
+        Some(i) => assembly::run_instanced(&i.scene, &req.selection, &settings),
+        None => assembly::run(&a.mesh, &b.mesh, selection.as_ref().unwrap_or(&req.selection), &settings),
+    }
+    .map_err(|e| Error::in_file(req.inputs[problem_side(req, &a.mesh)].path(), InputProblem::Selection(e)))?;
     let cross_check = if req.cross_check {
         progress(Phase::CrossCheck);
         let p = crate::check::cross_check::parry_f64(&a.mesh, &b.mesh, true)
@@ -663,7 +799,7 @@ pub fn run(req: &Request, progress: &(dyn Fn(Phase) + Sync)) -> Result<Outcome> 
         Vec::new()
     };
     let compute = |need: &(dyn Fn(usize) -> bool + Sync)| {
-        overlaps::overlaps(&outcome, &a.mesh, &b.mesh, req.selection.scene, req.settings.bvh, need)
+        overlaps::overlaps(&outcome, [&inputs[0], &inputs[1]], req.selection.scene, req.settings.bvh, need)
     };
     // With the cache, the boxes of reused pairs come from it (and the new ones are stored).
     let overlaps = match &cache {

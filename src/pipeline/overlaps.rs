@@ -12,13 +12,15 @@ use std::borrow::Cow;
 /// and pairs run in parallel, and the answer does not depend on the thread count.
 pub fn overlaps(
     o: &assembly::Outcome,
-    a: &Mesh,
-    b: &Mesh,
+    inputs: [&LoadedInput; 2],
     scene: bool,
     opts: BuildOptions,
     need: impl Fn(usize) -> bool + Sync,
 ) -> Vec<Option<crate::check::overlap::Overlap>> {
     use rayon::prelude::*;
+    if inputs.iter().any(|i| i.instanced.is_some()) {
+        return overlaps_placed(o, inputs, scene, opts, need);
+    }
     let clashing =
         |(k, pp): &(usize, &assembly::PartPairSummary)| pp.verdict == query::Verdict::Clash && need(*k);
     let mut wanted: Vec<usize> = o
@@ -35,7 +37,7 @@ pub fn overlaps(
         .par_iter()
         .map(|&i| {
             let part = &o.parts[i];
-            (i, part_mesh(if part.input == 0 || scene { a } else { b }, part))
+            (i, input_part_mesh(inputs[if part.input == 0 || scene { 0 } else { 1 }], part))
         })
         .collect();
     let solids: std::collections::HashMap<usize, (&Mesh, PartTree<'_>)> = meshes
@@ -54,6 +56,40 @@ pub fn overlaps(
                 return None;
             };
             crate::check::overlap::overlap_box(*ma, ta, *mb, tb)
+        })
+        .collect()
+}
+
+/// [`overlaps`] when a side is an instanced scene: each pair places its two parts, builds their
+/// trees and drops them, so memory holds a pair per thread instead of every clashing part at once
+/// (a part in several pairs is placed for each). The boxes are the same: a box is a function of
+/// the two solids alone.
+fn overlaps_placed(
+    o: &assembly::Outcome,
+    inputs: [&LoadedInput; 2],
+    scene: bool,
+    opts: BuildOptions,
+    need: impl Fn(usize) -> bool + Sync,
+) -> Vec<Option<crate::check::overlap::Overlap>> {
+    use rayon::prelude::*;
+    let copy = |i: usize| {
+        let part = &o.parts[i];
+        input_part_mesh(inputs[if part.input == 0 || scene { 0 } else { 1 }], part)
+    };
+    let solid = |m: &Mesh| crate::check::containment::topology(m).closed;
+    o.part_pairs
+        .par_iter()
+        .enumerate()
+        .map(|(k, pp)| {
+            if pp.verdict != query::Verdict::Clash || !need(k) {
+                return None;
+            }
+            let (ma, mb) = (copy(pp.a), copy(pp.b));
+            if !solid(ma.as_ref()) || !solid(mb.as_ref()) {
+                return None;
+            }
+            let (ta, tb) = (PartTree::new(ma.as_ref(), opts), PartTree::new(mb.as_ref(), opts));
+            crate::check::overlap::overlap_box(ma.as_ref(), &ta, mb.as_ref(), &tb)
         })
         .collect()
 }
@@ -85,6 +121,24 @@ pub fn files_overlap<'m>(
     let (ma, mb) = (sa?, sb?);
     let (ta, tb) = rayon::join(|| PartTree::new(ma.as_ref(), opts), || PartTree::new(mb.as_ref(), opts));
     crate::check::overlap::overlap_box(ma.as_ref(), &ta, mb.as_ref(), &tb)
+}
+
+/// The part's triangles as a mesh of their own ([`part_mesh`]); a part of an instanced scene
+/// placed, as the same copy of the expanded mesh would be.
+fn input_part_mesh<'m>(input: &'m LoadedInput, part: &assembly::Part) -> Cow<'m, Mesh> {
+    let Some(i) = &input.instanced else { return part_mesh(&input.input.mesh, part) };
+    let (positions, triangles) = i.scene.place(part.object as usize).unwrap_or_default();
+    let placed = Mesh {
+        tri_object: vec![0; triangles.len()],
+        objects: vec![crate::scene::mesh::Object {
+            name: part.name.clone(),
+            gltf_mesh: part.gltf_mesh,
+            world: Some(i.scene.parts[part.object as usize].world),
+        }],
+        positions,
+        triangles,
+    };
+    Cow::Owned(placed.sub_mesh(&(0..placed.triangles.len() as u32).collect::<Vec<_>>()))
 }
 
 /// The part's triangles as a mesh of their own: the input itself when the part is all of it

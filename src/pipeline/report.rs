@@ -37,12 +37,12 @@ fn tree_report(s: &TreeStats) -> TreeReport {
     }
 }
 
-fn pair_report(p: &PairFinding, ca: &[u32], cb: &[u32]) -> PairReport {
+fn pair_report(p: &PairFinding, oa: impl Fn(u32) -> u32, ob: impl Fn(u32) -> u32) -> PairReport {
     PairReport {
         a: p.a,
         b: p.b,
-        a_object: ca[p.a as usize],
-        b_object: cb[p.b as usize],
+        a_object: oa(p.a),
+        b_object: ob(p.b),
         kind: p.kind.into(),
         contact: match (p.contact, p.kind) {
             (Some(c), _) => Some(c.into()),
@@ -63,13 +63,15 @@ pub fn build(o: &Outcome) -> Report {
     let [ia, ib] = [&o.inputs[0], &o.inputs[1]];
     let r = &o.assembly.result;
     // A scene's two sides are one input: summarise it once.
-    let (infa, infb) = if std::sync::Arc::ptr_eq(ia, ib) {
-        let info = MeshInfo::of(&ia.input.mesh);
+    let (infa, infb): (MeshInfo, MeshInfo) = if std::sync::Arc::ptr_eq(ia, ib) {
+        let info = ia.info().into_owned();
         (info.clone(), info)
     } else {
-        rayon::join(|| MeshInfo::of(&ia.input.mesh), || MeshInfo::of(&ib.input.mesh))
+        rayon::join(|| ia.info().into_owned(), || ib.info().into_owned())
     };
-    let (oa, ob) = (&ia.input.mesh.tri_object, &ib.input.mesh.tri_object);
+    // The object of a triangle of A, of B.
+    let parts = &o.assembly.parts;
+    let (oa, ob) = (|t| ia.object_of(parts, t), |t| ib.object_of(parts, t));
     let (assembly, parts, mut part_pairs) = assembly_view(&o.assembly, o.settings.max_pairs);
     for (pp, ov) in part_pairs.iter_mut().zip(&o.overlaps) {
         pp.overlap = ov.as_ref().map(OverlapReport::of);
@@ -111,8 +113,8 @@ pub fn build(o: &Outcome) -> Report {
         },
         closest: r.closest.map(|c| ClosestReport {
             distance: c.distance,
-            a: Witness { triangle: c.a.0, object: oa[c.a.0 as usize], point: v3(c.a.1) },
-            b: Witness { triangle: c.b.0, object: ob[c.b.0 as usize], point: v3(c.b.1) },
+            a: Witness { triangle: c.a.0, object: oa(c.a.0), point: v3(c.a.1) },
+            b: Witness { triangle: c.b.0, object: ob(c.b.0), point: v3(c.b.1) },
         }),
         pairs,
         pairs_truncated: o.listed.len() < r.pairs.len() || (r.pairs.is_empty() && r.counts.total() > 0),
@@ -128,8 +130,8 @@ pub fn build(o: &Outcome) -> Report {
             .zip(region_overlap)
             .enumerate()
             .map(|(i, (g, overlap))| RegionReport {
-                a_name: ia.input.mesh.objects[g.objects.0 as usize].name.clone(),
-                b_name: ib.input.mesh.objects[g.objects.1 as usize].name.clone(),
+                a_name: ia.mesh().objects[g.objects.0 as usize].name.clone(),
+                b_name: ib.mesh().objects[g.objects.1 as usize].name.clone(),
                 id: g.id.clone(),
                 a_object: g.objects.0,
                 b_object: g.objects.1,
