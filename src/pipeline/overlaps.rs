@@ -5,6 +5,7 @@ use super::*;
 use crate::bvh::lazy::LazyBvh;
 use crate::bvh::traverse::Tree;
 use std::borrow::Cow;
+use std::sync::Arc;
 
 /// The exact overlap box of every clashing part pair of two closed parts (None for the other
 /// pairs, and for the pairs `need` declines, by their index in `o.part_pairs`). Each part involved gets a lazy tree once, however many pairs it is in (a part that is a whole
@@ -60,10 +61,11 @@ pub fn overlaps(
         .collect()
 }
 
-/// [`overlaps`] when a side is an instanced scene: each pair places its two parts, builds their
-/// trees and drops them, so memory holds a pair per thread instead of every clashing part at once
-/// (a part in several pairs is placed for each). The boxes are the same: a box is a function of
-/// the two solids alone.
+/// [`overlaps`] when a side is an instanced scene: whether each part is closed is decided once
+/// per part (placed, then dropped); then each pair of closed parts has its two parts placed (a
+/// worker keeps the last three it placed), builds their trees and drops them, so memory holds a
+/// few parts per thread instead of every clashing part at once. The boxes are the same: a box
+/// is a function of the two solids alone.
 fn overlaps_placed(
     o: &assembly::Outcome,
     inputs: [&LoadedInput; 2],
@@ -76,22 +78,82 @@ fn overlaps_placed(
         let part = &o.parts[i];
         input_part_mesh(inputs[if part.input == 0 || scene { 0 } else { 1 }], part)
     };
-    let solid = |m: &Mesh| crate::check::containment::topology(m).closed;
+    let clashing = |k: usize, pp: &assembly::PartPairSummary| pp.verdict == query::Verdict::Clash && need(k);
+    // Whether each part of a clashing pair is closed, each part placed once for it.
+    let mut wanted: Vec<usize> = o
+        .part_pairs
+        .iter()
+        .enumerate()
+        .filter(|(k, pp)| clashing(*k, pp))
+        .flat_map(|(_, pp)| [pp.a, pp.b])
+        .collect();
+    wanted.sort_unstable();
+    wanted.dedup();
+    let closed: std::collections::HashSet<usize> = wanted
+        .par_iter()
+        .filter(|&&i| crate::check::containment::topology(copy(i).as_ref()).closed)
+        .copied()
+        .collect();
+    // The part pairs are sorted by part, so a worker's consecutive pairs mostly share a part:
+    // the last few placed are kept.
+    let memo = WorkerMemo::new(3);
+    let solid = |i: usize| memo.get(i, || Arc::new(copy(i).into_owned()));
     o.part_pairs
         .par_iter()
         .enumerate()
         .map(|(k, pp)| {
-            if pp.verdict != query::Verdict::Clash || !need(k) {
+            if !clashing(k, pp) || !closed.contains(&pp.a) || !closed.contains(&pp.b) {
                 return None;
             }
-            let (ma, mb) = (copy(pp.a), copy(pp.b));
-            if !solid(ma.as_ref()) || !solid(mb.as_ref()) {
-                return None;
-            }
-            let (ta, tb) = (PartTree::new(ma.as_ref(), opts), PartTree::new(mb.as_ref(), opts));
-            crate::check::overlap::overlap_box(ma.as_ref(), &ta, mb.as_ref(), &tb)
+            let (ma, mb) = (solid(pp.a), solid(pp.b));
+            let (ma, mb): (&Mesh, &Mesh) = (&ma, &mb);
+            let (ta, tb) = (PartTree::new(ma, opts), PartTree::new(mb, opts));
+            crate::check::overlap::overlap_box(ma, &ta, mb, &tb)
         })
         .collect()
+}
+
+/// The values made last by each rayon worker, a few per worker, for work whose consecutive
+/// items share keys. It lives for one computation, and a value is a function of its key alone,
+/// so what it hands back is what making it again would give.
+struct WorkerMemo<V> {
+    keep: usize,
+    slots: Vec<std::sync::Mutex<Kept<V>>>,
+}
+
+/// One worker's kept values, least recently used first.
+type Kept<V> = Vec<(usize, Arc<V>)>;
+
+impl<V> WorkerMemo<V> {
+    fn new(keep: usize) -> Self {
+        let workers = rayon::current_num_threads() + 1;
+        WorkerMemo { keep, slots: (0..workers).map(|_| Default::default()).collect() }
+    }
+
+    /// The value of `key`, kept or made by `make` (outside the lock, so making may itself run in
+    /// parallel).
+    fn get(&self, key: usize, make: impl FnOnce() -> Arc<V>) -> Arc<V> {
+        let last = self.slots.len() - 1;
+        let worker = rayon::current_thread_index().map_or(last, |w| w.min(last));
+        let slot = || self.slots[worker].lock().unwrap_or_else(|e| e.into_inner());
+        {
+            let mut kept = slot();
+            if let Some(at) = kept.iter().position(|(k, _)| *k == key) {
+                // The most recently used goes last: the first is the one to drop.
+                let hit = kept.remove(at);
+                let v = hit.1.clone();
+                kept.push(hit);
+                return v;
+            }
+        }
+        let v = make();
+        let mut kept = slot();
+        if kept.len() == self.keep {
+            kept.remove(0);
+        }
+        kept.push((key, v.clone()));
+        v
+    }
 }
 
 /// The exact box of A ∩ B in two-file mode when each file is one part, both closed, and they
@@ -206,5 +268,29 @@ impl Tree for PartTree<'_> {
     }
     fn stats(&self) -> crate::bvh::Stats {
         self.tree().stats()
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::WorkerMemo;
+    use std::sync::atomic::{AtomicUsize, Ordering};
+    use std::sync::Arc;
+
+    #[test]
+    fn a_worker_memo_gives_what_making_gives_and_keeps_only_the_last_few() {
+        let made = AtomicUsize::new(0);
+        let memo = WorkerMemo::new(2);
+        let get = |k: usize| {
+            *memo.get(k, || {
+                made.fetch_add(1, Ordering::Relaxed);
+                Arc::new(k * 10)
+            })
+        };
+        // Outside a pool every call shares one slot: 1, 2 are kept; 1 again is kept (and now the
+        // most recent), so 3 drops 2; 1 is still kept; 2 is made again.
+        assert_eq!([get(1), get(2), get(1), get(3), get(1), get(2)], [10, 20, 10, 30, 10, 20]);
+        assert_eq!(made.load(Ordering::Relaxed), 4);
+        assert!(memo.slots.iter().all(|s| s.lock().unwrap().len() <= 2));
     }
 }
