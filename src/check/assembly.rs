@@ -221,26 +221,23 @@ fn placed_part(scene: &InstancedScene, k: usize) -> Mesh {
 }
 
 /// The parts of an instanced scene (see [`parts_of`]): the same list the expanded mesh gives,
-/// each part placed once, in parallel, for its box.
-pub fn parts_of_scene(scene: &InstancedScene) -> Vec<Part> {
-    let mut first = Vec::with_capacity(scene.parts.len());
+/// `bounds[k]` the box of part `k`'s triangles (found when the scene was summarised:
+/// [`crate::check::query::scene_info`]).
+pub fn parts_of_scene(scene: &InstancedScene, bounds: &[Aabb]) -> Vec<Part> {
     let mut t0 = 0u32;
-    for k in 0..scene.parts.len() {
-        first.push(t0);
-        t0 = t0.saturating_add(scene.part_counts(k).1 as u32);
-    }
-    (0..scene.parts.len())
-        .into_par_iter()
-        .map(|k| {
-            let one = placed_part(scene, k);
-            let bounds = (0..one.triangles.len() as u32)
-                .fold(Aabb::EMPTY, |b, t| b.union(Aabb::of_triangle(&crate::bvh::triangle(&one, t))));
-            let p = &scene.parts[k];
+    scene
+        .parts
+        .iter()
+        .zip(bounds)
+        .enumerate()
+        .map(|(k, (p, &bounds))| {
+            let first = t0;
+            t0 = t0.saturating_add(scene.part_counts(k).1 as u32);
             Part {
                 input: 0,
                 object: k as u32,
                 name: p.name.clone(),
-                triangles: (first[k]..first[k] + one.triangles.len() as u32).collect(),
+                triangles: (first..t0).collect(),
                 bounds,
                 gltf_mesh: Some(p.mesh),
             }
@@ -992,17 +989,19 @@ fn run_checked(a: &Mesh, b: &Mesh, sel: &Selection, settings: &Settings) -> Resu
 }
 
 /// [`run`] in scene mode on an instanced glTF scene: the same outcome as [`run`] on the
-/// scene's expanded mesh, each part placed when the check reads it (never all at once). The
-/// selection must be a scene's without a sharding hook.
+/// scene's expanded mesh, each part placed when the check reads it (never all at once);
+/// `bounds[k]` is the box of part `k`'s triangles. The selection must be a scene's without a
+/// sharding hook.
 pub fn run_instanced(
     scene: &InstancedScene,
+    bounds: &[Aabb],
     sel: &Selection,
     settings: &Settings,
 ) -> Result<Outcome, String> {
     if !sel.scene || sel.hook.is_some() {
         return Err("an instanced scene is checked in scene mode without a sharding hook".to_string());
     }
-    let parts = parts_of_scene(scene);
+    let parts = parts_of_scene(scene, bounds);
     let (sa, sb) = selected(&parts, sel)?;
     by_parts([Source::Placed(scene); 2], parts, &sa, &sb, sel, settings)
 }

@@ -368,6 +368,8 @@ struct PartSummary {
     triangles: usize,
     degenerate: usize,
     bounds: Aabb,
+    /// The box of its triangles (the box the check's broad phase gives the part).
+    triangle_bounds: Aabb,
     /// The first coordinate beyond the exact range: (part-local vertex, coordinate).
     beyond: Option<(usize, f64)>,
     /// Non-zero coordinates below the exact range, and the first: (part-local vertex, coordinate).
@@ -376,13 +378,12 @@ struct PartSummary {
 
 impl PartSummary {
     fn of(positions: &[DVec3], triangles: &[[u32; 3]]) -> PartSummary {
-        let degenerate = triangles
-            .iter()
-            .filter(|t| {
-                let [a, b, c] = t.map(|v| positions[v as usize]);
-                predicates::collinear(a, b, c)
-            })
-            .count();
+        let (mut degenerate, mut triangle_bounds) = (0usize, Aabb::EMPTY);
+        for t in triangles {
+            let [a, b, c] = t.map(|v| positions[v as usize]);
+            degenerate += predicates::collinear(a, b, c) as usize;
+            triangle_bounds = triangle_bounds.union(Aabb::of_triangle(&[a, b, c]));
+        }
         let (mut beyond, mut tiny) = (None, (0usize, None));
         'scan: for (i, p) in positions.iter().enumerate() {
             for c in p.to_array() {
@@ -402,6 +403,7 @@ impl PartSummary {
             triangles: triangles.len(),
             degenerate,
             bounds: Aabb::of_points(positions),
+            triangle_bounds,
             beyond,
             tiny,
         }
@@ -411,8 +413,9 @@ impl PartSummary {
 /// The summary ([`MeshInfo::of`]) and the range check ([`check_range`]) of an instanced
 /// scene's expanded mesh, with every number, warning and error the same, placing each part once
 /// (in parallel, never all at once). Parts never share vertices, so the counts add up part by
-/// part; the box and the first out-of-range vertex are taken in part order.
-pub fn scene_info(scene: &load::InstancedScene, path: &Path) -> Result<(MeshInfo, Vec<String>)> {
+/// part; the box and the first out-of-range vertex are taken in part order. Also each part's
+/// triangle box, in part order, for the check ([`crate::check::assembly::run_instanced`]).
+pub fn scene_info(scene: &load::InstancedScene, path: &Path) -> Result<(MeshInfo, Vec<String>, Vec<Aabb>)> {
     let parts: Vec<PartSummary> = (0..scene.parts.len())
         .into_par_iter()
         .map(|k| match scene.place(k) {
@@ -444,7 +447,8 @@ pub fn scene_info(scene: &load::InstancedScene, path: &Path) -> Result<(MeshInfo
         objects: scene.parts.iter().zip(&parts).map(|(s, p)| (s.name.clone(), p.triangles)).collect(),
         bounds,
     };
-    Ok((info, tiny.map(|(i, c)| tiny_warning(tiny_count, i, c)).into_iter().collect()))
+    let warnings = tiny.map(|(i, c)| tiny_warning(tiny_count, i, c)).into_iter().collect();
+    Ok((info, warnings, parts.iter().map(|p| p.triangle_bounds).collect()))
 }
 
 /// The warning for `count` coordinates below the exact range, the first `c` at vertex `i`.

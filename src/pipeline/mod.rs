@@ -485,6 +485,9 @@ pub struct InstancedInput {
     pub scene: crate::load::InstancedScene,
     /// The expanded mesh's summary, computed part by part.
     pub info: query::MeshInfo,
+    /// Each part's triangle box, in part order (found with the summary, so the check need not
+    /// place every part again for it).
+    pub part_bounds: Vec<Aabb>,
     expanded: std::sync::OnceLock<Mesh>,
 }
 
@@ -526,23 +529,15 @@ fn load_scene_instanced(req: &Request, path: &Path) -> Result<LoadedInput> {
     let format = crate::load::detect_format(path, &bytes)?;
     if !matches!(format, Format::Gltf | Format::Glb) {
         let loaded = crate::load::load_bytes(path, &bytes, format)?;
-        let spec = InputSpec { path: path.to_path_buf(), transform: req.inputs[0].transform };
-        let input = query::prepare_input(&spec, loaded, format, 1.0, None)?;
-        return Ok(LoadedInput {
-            input,
-            instanced: None,
-            transform: req.inputs[0].transform,
-            units: None,
-            array: false,
-        });
+        return prepare_loaded(req, 0, "--units-a", loaded, format, false);
     }
     let scene = crate::load::load_gltf_instanced(path, &bytes)?;
     drop(bytes);
-    let (info, range_warnings) = query::scene_info(&scene, path)?;
+    let (info, range_warnings, part_bounds) = query::scene_info(&scene, path)?;
     let mut warnings = scene.warnings.clone();
     warnings.extend(range_warnings);
     let input = Input { path: path.to_path_buf(), format, mesh: Mesh::default(), warnings };
-    let instanced = InstancedInput { scene, info, expanded: std::sync::OnceLock::new() };
+    let instanced = InstancedInput { scene, info, part_bounds, expanded: std::sync::OnceLock::new() };
     Ok(LoadedInput {
         input,
         instanced: Some(std::sync::Arc::new(instanced)),
@@ -634,15 +629,28 @@ impl Outcome {
 
 /// Load input `i` of `req`: units, placement, `--split-bodies`.
 fn load_input(req: &Request, i: usize, flag: &str) -> Result<LoadedInput> {
-    let r = &req.inputs[i];
-    let spec = InputSpec { path: r.path().to_path_buf(), transform: r.transform };
-    let (loaded, format, array) = match &r.source {
+    let (loaded, format, array) = match &req.inputs[i].source {
         Source::File(p) => {
             let (loaded, format) = crate::load::load_path(p)?;
             (loaded, format, false)
         }
         Source::Mesh { mesh, .. } => (Loaded { mesh: mesh.clone(), warnings: Vec::new() }, Format::Obj, true),
     };
+    prepare_loaded(req, i, flag, loaded, format, array)
+}
+
+/// Input `i` of `req` from what its loader gave (`array`: handed over in memory): units,
+/// placement, `--split-bodies`.
+fn prepare_loaded(
+    req: &Request,
+    i: usize,
+    flag: &str,
+    loaded: Loaded,
+    format: Format,
+    array: bool,
+) -> Result<LoadedInput> {
+    let r = &req.inputs[i];
+    let spec = InputSpec { path: r.path().to_path_buf(), transform: r.transform };
     let (mut input, units) = if req.units.active() {
         let (multiplier, block, warning) = req.units.resolve(i, format, flag);
         (query::prepare_input(&spec, loaded, format, multiplier, warning)?, Some(block))
@@ -765,7 +773,7 @@ fn run_on(req: &Request, progress: &(dyn Fn(Phase) + Sync), instanced: bool) -> 
     });
     let selection = cache.as_ref().map(|c| c.selection(&req.selection));
     let outcome = match &inputs[0].instanced {
-        Some(i) => assembly::run_instanced(&i.scene, &req.selection, &settings),
+        Some(i) => assembly::run_instanced(&i.scene, &i.part_bounds, &req.selection, &settings),
         None => assembly::run(&a.mesh, &b.mesh, selection.as_ref().unwrap_or(&req.selection), &settings),
     }
     .map_err(|e| Error::in_file(req.inputs[problem_side(req, &a.mesh)].path(), InputProblem::Selection(e)))?;
@@ -892,7 +900,7 @@ fn compare(
     contained: Option<crate::report::ReportContainment>,
 ) -> Comparison {
     let block = baseline::compare(all, base, contained);
-    let persistent = listed.iter().map(|&i| base.contains(&all[i].id)).collect();
+    let persistent = listed.iter().map(|&i| base.contains(all[i].id)).collect();
     Comparison { block, persistent }
 }
 

@@ -22,24 +22,9 @@ pub fn overlaps(
     if inputs.iter().any(|i| i.instanced.is_some()) {
         return overlaps_placed(o, inputs, scene, opts, need);
     }
-    let clashing =
-        |(k, pp): &(usize, &assembly::PartPairSummary)| pp.verdict == query::Verdict::Clash && need(*k);
-    let mut wanted: Vec<usize> = o
-        .part_pairs
-        .iter()
-        .enumerate()
-        .filter(clashing)
-        .map(|(_, pp)| pp)
-        .flat_map(|pp| [pp.a, pp.b])
-        .collect();
-    wanted.sort_unstable();
-    wanted.dedup();
-    let meshes: Vec<(usize, Cow<'_, Mesh>)> = wanted
+    let meshes: Vec<(usize, Cow<'_, Mesh>)> = clashing_parts(o, &need)
         .par_iter()
-        .map(|&i| {
-            let part = &o.parts[i];
-            (i, input_part_mesh(inputs[if part.input == 0 || scene { 0 } else { 1 }], part))
-        })
+        .map(|&i| (i, input_part_mesh(inputs, scene, &o.parts[i])))
         .collect();
     let solids: std::collections::HashMap<usize, (&Mesh, PartTree<'_>)> = meshes
         .par_iter()
@@ -50,7 +35,7 @@ pub fn overlaps(
         .par_iter()
         .enumerate()
         .map(|(k, pp)| {
-            if pp.verdict != query::Verdict::Clash || !need(k) {
+            if !clashing(k, pp, &need) {
                 return None;
             }
             let (Some((ma, ta)), Some((mb, tb))) = (solids.get(&pp.a), solids.get(&pp.b)) else {
@@ -74,22 +59,9 @@ fn overlaps_placed(
     need: impl Fn(usize) -> bool + Sync,
 ) -> Vec<Option<crate::check::overlap::Overlap>> {
     use rayon::prelude::*;
-    let copy = |i: usize| {
-        let part = &o.parts[i];
-        input_part_mesh(inputs[if part.input == 0 || scene { 0 } else { 1 }], part)
-    };
-    let clashing = |k: usize, pp: &assembly::PartPairSummary| pp.verdict == query::Verdict::Clash && need(k);
+    let copy = |i: usize| input_part_mesh(inputs, scene, &o.parts[i]);
     // Whether each part of a clashing pair is closed, each part placed once for it.
-    let mut wanted: Vec<usize> = o
-        .part_pairs
-        .iter()
-        .enumerate()
-        .filter(|(k, pp)| clashing(*k, pp))
-        .flat_map(|(_, pp)| [pp.a, pp.b])
-        .collect();
-    wanted.sort_unstable();
-    wanted.dedup();
-    let closed: std::collections::HashSet<usize> = wanted
+    let closed: std::collections::HashSet<usize> = clashing_parts(o, &need)
         .par_iter()
         .filter(|&&i| crate::check::containment::topology(copy(i).as_ref()).closed)
         .copied()
@@ -102,7 +74,7 @@ fn overlaps_placed(
         .par_iter()
         .enumerate()
         .map(|(k, pp)| {
-            if !clashing(k, pp) || !closed.contains(&pp.a) || !closed.contains(&pp.b) {
+            if !clashing(k, pp, &need) || !closed.contains(&pp.a) || !closed.contains(&pp.b) {
                 return None;
             }
             let (ma, mb) = (solid(pp.a), solid(pp.b));
@@ -185,9 +157,30 @@ pub fn files_overlap<'m>(
     crate::check::overlap::overlap_box(ma.as_ref(), &ta, mb.as_ref(), &tb)
 }
 
-/// The part's triangles as a mesh of their own ([`part_mesh`]); a part of an instanced scene
-/// placed, as the same copy of the expanded mesh would be.
-fn input_part_mesh<'m>(input: &'m LoadedInput, part: &assembly::Part) -> Cow<'m, Mesh> {
+/// Whether part pair `k` gets an overlap box: a clash that `need` asks for.
+fn clashing(k: usize, pp: &assembly::PartPairSummary, need: &impl Fn(usize) -> bool) -> bool {
+    pp.verdict == query::Verdict::Clash && need(k)
+}
+
+/// The parts of the pairs that get an overlap box ([`clashing`]), sorted, each once.
+fn clashing_parts(o: &assembly::Outcome, need: &impl Fn(usize) -> bool) -> Vec<usize> {
+    let mut parts: Vec<usize> = o
+        .part_pairs
+        .iter()
+        .enumerate()
+        .filter(|&(k, pp)| clashing(k, pp, need))
+        .flat_map(|(_, pp)| [pp.a, pp.b])
+        .collect();
+    parts.sort_unstable();
+    parts.dedup();
+    parts
+}
+
+/// The part's triangles as a mesh of their own ([`part_mesh`]), from its input (in scene mode
+/// the one input); a part of an instanced scene placed, as the same copy of the expanded mesh
+/// would be.
+fn input_part_mesh<'m>(inputs: [&'m LoadedInput; 2], scene: bool, part: &assembly::Part) -> Cow<'m, Mesh> {
+    let input = inputs[if part.input == 0 || scene { 0 } else { 1 }];
     let Some(i) = &input.instanced else { return part_mesh(&input.input.mesh, part) };
     let (positions, triangles) = i.scene.place(part.object as usize).unwrap_or_default();
     let placed = Mesh {

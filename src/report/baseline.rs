@@ -74,37 +74,13 @@ pub struct Baseline {
 }
 
 impl Baseline {
-    /// Does the baseline have a finding with this id (its 16 hex digits, or its number)?
-    pub fn contains<I: AsFindingId + ?Sized>(&self, id: &I) -> bool {
-        id.finding_id().is_some_and(|k| self.ids.contains_key(&k))
+    /// Does the baseline have a finding with this id (the number its 16 hex digits spell)?
+    pub fn contains(&self, id: u64) -> bool {
+        self.ids.contains_key(&id)
     }
 
-    fn crossing<I: AsFindingId + ?Sized>(&self, id: &I) -> bool {
-        id.finding_id().and_then(|k| self.ids.get(&k)).copied().unwrap_or(false)
-    }
-}
-
-/// A finding id as written (16 hex digits) or as its number.
-pub trait AsFindingId {
-    /// The id's number, or None when it is malformed.
-    fn finding_id(&self) -> Option<u64>;
-}
-
-impl AsFindingId for u64 {
-    fn finding_id(&self) -> Option<u64> {
-        Some(*self)
-    }
-}
-
-impl AsFindingId for str {
-    fn finding_id(&self) -> Option<u64> {
-        parse_hex(self)
-    }
-}
-
-impl AsFindingId for String {
-    fn finding_id(&self) -> Option<u64> {
-        parse_hex(self)
+    fn crossing(&self, id: u64) -> bool {
+        self.ids.get(&id).copied().unwrap_or(false)
     }
 }
 
@@ -325,9 +301,9 @@ fn is_containment_clash(c: Option<ReportContainment>) -> bool {
 /// `contained` is this run's containment.
 pub fn compare(all: &[Finding], base: &Baseline, contained: Option<ReportContainment>) -> BaselineReport {
     let now: HashSet<u64> = all.iter().map(|f| f.id).collect();
-    let persistent = all.iter().filter(|f| base.contains(&f.id)).count() as u64;
+    let persistent = all.iter().filter(|f| base.contains(f.id)).count() as u64;
     let new_crossing =
-        all.iter().filter(|f| f.kind == PairKind::Crossing && !base.crossing(&f.id)).count() as u64;
+        all.iter().filter(|f| f.kind == PairKind::Crossing && !base.crossing(f.id)).count() as u64;
     let resolved: BTreeSet<u64> = base.ids.keys().filter(|id| !now.contains(id)).copied().collect();
     BaselineReport {
         path: base.path.clone(),
@@ -420,15 +396,16 @@ mod tests {
         let e = parse("x.json", br#"{"pairs": []}"#).unwrap_err();
         assert_eq!(e, "baseline is not a meshclash report: it has no \"schema\"");
         let (id1, id2, id3) = ("00000000000000a1", "00000000000000a2", "00000000000000a3");
+        let n = |id: &str| parse_hex(id).expect("16 hex digits");
         let ok = format!(
             r#"{{"schema": "meshclash.report/1", "pairs_truncated": false, "summary": {{"contained": "a_in_b"}},
             "pairs": [{{"id": "{id1}", "kind": "touching"}}, {{"id": "{id1}", "kind": "crossing"}}, {{"id": "{id2}", "kind": "touching"}}]}}"#
         );
         let b = parse("b.json", ok.as_bytes()).unwrap();
         assert_eq!(b.ids.len(), 2);
-        assert!(b.contains(id1) && b.crossing(id1));
-        assert!(b.contains(id2) && !b.crossing(id2));
-        assert!(!b.contains(id3));
+        assert!(b.contains(n(id1)) && b.crossing(n(id1)));
+        assert!(b.contains(n(id2)) && !b.crossing(n(id2)));
+        assert!(!b.contains(n(id3)));
         // A cut list without the ids of what it does not list cannot be compared: refused.
         let cut = ok.replace("\"pairs_truncated\": false", "\"pairs_truncated\": true");
         let e = parse("b.json", cut.as_bytes()).unwrap_err();
@@ -441,7 +418,7 @@ mod tests {
         );
         let b = parse("b.json", whole.as_bytes()).unwrap();
         assert_eq!(b.ids.len(), 3);
-        assert!(b.contains(id3) && b.crossing(id3));
+        assert!(b.contains(n(id3)) && b.crossing(n(id3)));
         // A first-hit report or a malformed id is refused too.
         let fh = ok.replacen("{\"schema\"", "{\"settings\": {\"first_hit\": true}, \"schema\"", 1);
         assert!(parse("b.json", fh.as_bytes()).unwrap_err().contains("--first-hit"));
