@@ -556,6 +556,17 @@ mod chunked {
         matches!(b, Some(b' ' | b'\t'))
     }
 
+    /// Moves `*i` past the blanks there, of which a field separator has at least one (false
+    /// when there is none).
+    #[inline(always)]
+    fn skip_blanks(rest: &[u8], i: &mut usize) -> bool {
+        let start = *i;
+        while blank(rest.get(*i)) {
+            *i += 1;
+        }
+        *i > start
+    }
+
     /// After a line's leading `v`: blanks, three coordinates the decimal fast path reads, each
     /// after blanks, and nothing but blanks after the third. On such a line the general path
     /// reads the same three tokens with the same reader ([`decimal::parse`] of a token is
@@ -566,11 +577,8 @@ mod chunked {
         let mut p = [0.0f64; 3];
         let mut i = 0;
         for slot in &mut p {
-            if !blank(rest.get(i)) {
+            if !skip_blanks(rest, &mut i) {
                 return None;
-            }
-            while blank(rest.get(i)) {
-                i += 1;
             }
             let (x, used) = decimal::prefix(&rest[i..])?;
             if !x.is_finite() {
@@ -591,11 +599,8 @@ mod chunked {
         let mut v = [0u32; 3];
         let mut i = 0;
         for slot in &mut v {
-            if !blank(rest.get(i)) {
+            if !skip_blanks(rest, &mut i) {
                 return None;
-            }
-            while blank(rest.get(i)) {
-                i += 1;
             }
             let start = i;
             let mut x: u64 = 0;
