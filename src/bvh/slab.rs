@@ -38,14 +38,18 @@ impl Oriented {
     /// strongly curved set, where a box does as well) or there are none.
     pub fn of_triangles<I>(tris: I) -> Option<Oriented>
     where
-        I: Iterator<Item = [DVec3; 3]> + Clone,
+        I: Iterator<Item = [DVec3; 3]>,
     {
+        // One read of the triangles: the normal pass keeps their corners for the projection
+        // pass (a node's triangles come from scattered mesh slots; the copy is contiguous).
+        let mut corners: Vec<DVec3> = Vec::with_capacity(3 * tris.size_hint().0);
         let mut nsum = DVec3::ZERO;
         let mut area = 0.0;
-        for [a, b, c] in tris.clone() {
+        for [a, b, c] in tris {
             let n = (b - a).cross(c - a);
             nsum += n;
             area += n.length();
+            corners.extend([a, b, c]);
         }
         let len = nsum.length();
         // A patch whose normals mostly cancel gains nothing over a box.
@@ -61,12 +65,10 @@ impl Oriented {
         let v = n.cross(u);
         let mut lo = DVec3::INFINITY;
         let mut hi = DVec3::NEG_INFINITY;
-        for t in tris {
-            for p in t {
-                let q = DVec3::new(n.dot(p), u.dot(p), v.dot(p));
-                lo = lo.min(q);
-                hi = hi.max(q);
-            }
+        for p in corners {
+            let q = DVec3::new(n.dot(p), u.dot(p), v.dot(p));
+            lo = lo.min(q);
+            hi = hi.max(q);
         }
         Some(Oriented { axes: [n, u, v], lo, hi })
     }
@@ -111,10 +113,40 @@ impl Oriented {
     /// half-thicknesses. Returns `gap` when it is not positive. Subtract the rounding margin
     /// before pruning, as for `gap`.
     pub fn swept_rect_bound(&self, o: &Oriented, gap: f64) -> f64 {
+        self.swept_rect_bound_above(o, gap, f64::NEG_INFINITY)
+    }
+
+    /// As [`Oriented::swept_rect_bound`] for a search that can use the bound only where it
+    /// exceeds `need` (the pruning cut plus the rounding margin): the same value whenever that
+    /// value exceeds `need` (one within rounding of `need` may come back as `gap`), else `gap`,
+    /// a lower bound no greater than it. Gives up
+    /// as soon as the answer is known not to exceed `need`: first when the rectangles' centres
+    /// (points of both rectangles, so their distance is at least the rectangles') are within
+    /// `need` plus both half-thicknesses, then at the first corner or edge pair that is.
+    pub fn swept_rect_bound_above(&self, o: &Oriented, gap: f64, need: f64) -> f64 {
         if gap <= 0.0 {
             return gap;
         }
-        gap.max(self.rect_distance(o) - self.half_thickness() - o.half_thickness())
+        let reach = need + self.half_thickness() + o.half_thickness();
+        // Nothing to gain when even the centres are within reach (a NaN stops here too).
+        let centres = (self.centre() - o.centre()).length();
+        if reach >= 0.0 && centres.partial_cmp(&reach) != Some(std::cmp::Ordering::Greater) {
+            return gap;
+        }
+        let stop = if reach >= 0.0 { reach * reach } else { f64::NEG_INFINITY };
+        match self.rect_distance_sq(o, stop) {
+            Some(d2) => gap.max(d2.sqrt() - self.half_thickness() - o.half_thickness()),
+            None => gap,
+        }
+    }
+
+    /// The centre of the mid-plane rectangle.
+    #[inline]
+    fn centre(&self) -> DVec3 {
+        let [n, u, v] = self.axes;
+        n * (0.5 * (self.lo.x + self.hi.x))
+            + u * (0.5 * (self.lo.y + self.hi.y))
+            + v * (0.5 * (self.lo.z + self.hi.z))
     }
 
     /// Half the slab's thickness along its normal.
@@ -147,11 +179,17 @@ impl Oriented {
     /// convex polygons are closest at a corner of one against the other, or at two edges, so
     /// eight corner–rectangle and sixteen edge–edge distances give it (a third of the work of
     /// splitting each rectangle into two triangles and taking four triangle distances).
-    fn rect_distance(&self, o: &Oriented) -> f64 {
+    ///
+    /// Squared; `None` as soon as one candidate is at most `stop` (the caller then has no use
+    /// for the exact value).
+    fn rect_distance_sq(&self, o: &Oriented, stop: f64) -> Option<f64> {
         let (ca, cb) = (self.corners(), o.corners());
         let mut d2 = f64::INFINITY;
         for k in 0..4 {
             d2 = d2.min(o.rect_point_sq(ca[k])).min(self.rect_point_sq(cb[k]));
+            if d2 <= stop {
+                return None;
+            }
         }
         let edges = |c: [DVec3; 4]| {
             [0, 1, 2, 3].map(|k| {
@@ -165,8 +203,11 @@ impl Oriented {
                 let (x, y) = crate::narrow::distance::segments_core(p1, d1, a, p2, d2_, e);
                 d2 = d2.min((x - y).length_squared());
             }
+            if d2 <= stop {
+                return None;
+            }
         }
-        d2.sqrt()
+        Some(d2)
     }
 }
 
@@ -261,6 +302,53 @@ mod tests {
         }
         // Flat patches facing each other are bounded tightly most of the time.
         assert!(tight > 300, "only {tight} tight bounds");
+    }
+
+    #[test]
+    fn the_bound_above_a_need_equals_the_full_bound_where_it_exceeds_the_need() {
+        // Curved and flat patches at every offset, and needs below, around and above the full
+        // bound: where the full bound clears the need (by more than rounding) the early-exit
+        // form returns it bit for bit; elsewhere it returns the plain gap, never more than the
+        // need, so a search pruning at the need prunes exactly the same pairs.
+        let mut rng = Rng(0x2545_f491_4f6c_dd1d);
+        let (mut same, mut gave_up) = (0, 0);
+        for case in 0..3000 {
+            let flat = [0.01, 0.1, 1.0][case % 3];
+            let a = patch(&mut rng, DVec3::ZERO, 1.0, flat);
+            let off = DVec3::new(4.0 * rng.next() - 2.0, 4.0 * rng.next() - 2.0, 0.1 + 2.0 * rng.next());
+            let size = 0.2 + rng.next();
+            let b = patch(&mut rng, off, size, flat);
+            let (Some(oa), Some(ob)) =
+                (Oriented::of_triangles(a.iter().copied()), Oriented::of_triangles(b.iter().copied()))
+            else {
+                continue;
+            };
+            let g = oa.gap(&ob);
+            let full = oa.swept_rect_bound(&ob, g);
+            for need in [
+                f64::NEG_INFINITY,
+                -1.0,
+                0.0,
+                g,
+                0.5 * (g + full),
+                full,
+                full * (1.0 + 1e-9),
+                2.0 * full + 1.0,
+            ] {
+                let r = oa.swept_rect_bound_above(&ob, g, need);
+                if full > need * (1.0 + 1e-9) + 1e-12 {
+                    assert_eq!(r.to_bits(), full.to_bits(), "case {case}, need {need}: {r} != {full}");
+                    same += 1;
+                } else {
+                    assert!(
+                        r == full || (r == g && r <= need.max(g)),
+                        "case {case}, need {need}: {r} ({g}, {full})"
+                    );
+                    gave_up += usize::from(r != full);
+                }
+            }
+        }
+        assert!(same > 3000 && gave_up > 1000, "{same} equal, {gave_up} given up");
     }
 
     #[test]
