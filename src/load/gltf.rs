@@ -79,7 +79,7 @@ use super::gltf_data::{
 use crate::error::{
     AccessorUser, Error, GltfProblem, InputProblem, InstancingProblem, Location, Quantity, Result,
 };
-use crate::scene::mesh::{Loaded, Mesh, Object};
+use crate::scene::mesh::{Loaded, Mesh, Object, WorldTriangles};
 
 /// The deepest node hierarchy accepted.
 pub(crate) const MAX_DEPTH: usize = 1024;
@@ -111,7 +111,36 @@ pub(crate) fn load(path: &Path, bytes: &[u8]) -> Result<Loaded> {
 pub(crate) fn load_instanced(path: &Path, bytes: &[u8]) -> Result<InstancedScene> {
     let mut sink = PartSink { parts: Vec::new(), scratch: Mesh::default() };
     let (meshes, warnings) = walk(path, bytes, &mut sink)?;
-    Ok(InstancedScene { path: path.to_path_buf(), meshes, parts: sink.parts, warnings })
+    // Where each mesh's primitives, and each part, start in triangle order.
+    let prim_starts: Vec<Vec<u32>> = meshes
+        .iter()
+        .map(|m| {
+            let mut at = 0u32;
+            let start = |p: &Prim| {
+                let s = at;
+                at += p.triangles.len() as u32;
+                s
+            };
+            m.as_deref().unwrap_or(&[]).iter().map(start).collect()
+        })
+        .collect();
+    let mut tri_starts = Vec::with_capacity(sink.parts.len() + 1);
+    let mut at = 0u32;
+    tri_starts.push(at);
+    for p in &sink.parts {
+        let prims = meshes.get(p.mesh as usize).and_then(Option::as_deref).unwrap_or(&[]);
+        // The limits keep the expanded scene's triangle numbers within u32.
+        at = at.saturating_add(counts(prims).1 as u32);
+        tri_starts.push(at);
+    }
+    Ok(InstancedScene {
+        path: path.to_path_buf(),
+        meshes,
+        prim_starts,
+        tri_starts,
+        parts: sink.parts,
+        warnings,
+    })
 }
 
 /// What [`walk`] hands the scene's parts to, in object order.
@@ -172,6 +201,11 @@ struct Placement {
 pub struct InstancedScene {
     path: std::path::PathBuf,
     meshes: Decoded,
+    /// For each glTF mesh, the first triangle of each of its primitives (in the mesh's
+    /// triangle order).
+    prim_starts: Vec<Vec<u32>>,
+    /// The first triangle of each part in the expanded mesh, and the triangle count last.
+    tri_starts: Vec<u32>,
     /// The parts, in object order (the expanded mesh's `objects`).
     pub parts: Vec<ScenePart>,
     /// The loader's warnings, as [`load`] gives them.
@@ -215,6 +249,13 @@ impl InstancedScene {
         positions
     }
 
+    /// The expanded mesh's objects (one per part, in order), without placing anything.
+    pub fn objects(&self) -> Vec<Object> {
+        let object =
+            |p: &ScenePart| Object { name: p.name.clone(), gltf_mesh: Some(p.mesh), world: Some(p.world) };
+        self.parts.iter().map(object).collect()
+    }
+
     /// The vertices and triangles part `k` expands to, without placing it.
     pub fn part_counts(&self, k: usize) -> (usize, usize) {
         counts(self.prims(&self.parts[k]))
@@ -240,6 +281,38 @@ impl InstancedScene {
 
     fn prims(&self, p: &ScenePart) -> &[Prim] {
         self.meshes.get(p.mesh as usize).and_then(Option::as_deref).unwrap_or(&[])
+    }
+
+    /// The part holding triangle `t` of the expanded mesh, and `t`'s index within the part.
+    fn locate(&self, t: u32) -> (usize, u32) {
+        let k = self.tri_starts.partition_point(|&s| s <= t).saturating_sub(1).min(self.parts.len() - 1);
+        (k, t - self.tri_starts[k])
+    }
+}
+
+/// The expanded mesh's triangles read one at a time: a triangle's corners are its part's
+/// vertices placed by the part's matrix with [`place_vertices`]' arithmetic (each vertex on its
+/// own), so they are the expanded mesh's coordinates, bit for bit, without placing the part.
+impl WorldTriangles for InstancedScene {
+    fn corners(&self, t: u32) -> [DVec3; 3] {
+        let (k, local) = self.locate(t);
+        let p = &self.parts[k];
+        let prims = self.prims(p);
+        let starts = &self.prim_starts[p.mesh as usize];
+        // The primitive holding the triangle: the last one starting at or before it that has
+        // triangles (one without triangles starts where the next one does).
+        let j = starts.partition_point(|&s| s <= local) - 1;
+        let prim = &prims[j];
+        let positions = &prims[prim.shares.unwrap_or(j)].positions;
+        prim.triangles[(local - starts[j]) as usize].map(|i| p.world.transform_point3(positions[i as usize]))
+    }
+
+    fn object_of(&self, t: u32) -> u32 {
+        self.locate(t).0 as u32
+    }
+
+    fn object_name(&self, o: u32) -> &str {
+        self.parts.get(o as usize).map_or("", |p| &p.name)
     }
 }
 

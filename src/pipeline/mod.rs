@@ -26,7 +26,7 @@ use crate::load::Format;
 use crate::report::baseline::{self, Baseline, BaselineReport, Finding};
 use crate::report::self_report::{SceneSelfReport, SelfFailOn};
 use crate::report::{CrossCheckReport, InputUnitsReport, SettingsReport};
-use crate::scene::mesh::{Loaded, Mesh};
+use crate::scene::mesh::{Loaded, Mesh, WorldTriangles};
 use glam::DMat4;
 use std::path::{Path, PathBuf};
 use std::time::Instant;
@@ -441,11 +441,32 @@ pub struct LoadedInput {
 }
 
 impl LoadedInput {
-    /// The mesh in world coordinates. An instanced input is expanded on first use (by an
-    /// output that draws the geometry), exactly as the file's plain load gives it.
+    /// The mesh as the report reads it: the mesh in world coordinates, or for an instanced
+    /// input its objects alone (names, glTF meshes and matrices, as the expanded mesh has
+    /// them) without the geometry, made on first use. An output that draws the geometry reads
+    /// the world mesh through `Deref` ([`LoadedInput::world_mesh`]).
     pub fn mesh(&self) -> &Mesh {
         match &self.instanced {
+            Some(i) => i.objects.get_or_init(|| Mesh { objects: i.scene.objects(), ..Mesh::default() }),
+            None => &self.input.mesh,
+        }
+    }
+
+    /// The mesh in world coordinates. An instanced input is expanded on first use (by an
+    /// output that draws the geometry), exactly as the file's plain load gives it.
+    pub fn world_mesh(&self) -> &Mesh {
+        match &self.instanced {
             Some(i) => i.expanded.get_or_init(|| i.scene.expand().map(|l| l.mesh).unwrap_or_default()),
+            None => &self.input.mesh,
+        }
+    }
+
+    /// Where the input's triangles come from, by their index in the world mesh: the mesh
+    /// itself, or for an instanced input the scene, placing each triangle read (never the
+    /// whole scene).
+    pub fn world_triangles(&self) -> &dyn WorldTriangles {
+        match &self.instanced {
+            Some(i) => &i.scene,
             None => &self.input.mesh,
         }
     }
@@ -469,12 +490,12 @@ impl LoadedInput {
     }
 }
 
-/// A loaded input reads as its world mesh ([`LoadedInput::mesh`]: an instanced scene is
+/// A loaded input reads as its world mesh ([`LoadedInput::world_mesh`]: an instanced scene is
 /// expanded on first use).
 impl std::ops::Deref for LoadedInput {
     type Target = Mesh;
     fn deref(&self) -> &Mesh {
-        self.mesh()
+        self.world_mesh()
     }
 }
 
@@ -489,6 +510,7 @@ pub struct InstancedInput {
     /// place every part again for it).
     pub part_bounds: Vec<Aabb>,
     expanded: std::sync::OnceLock<Mesh>,
+    objects: std::sync::OnceLock<Mesh>,
 }
 
 impl std::fmt::Debug for InstancedInput {
@@ -498,17 +520,17 @@ impl std::fmt::Debug for InstancedInput {
 }
 
 /// Whether `req` runs on its glTF scene instanced ([`InstancedInput`]) rather than expanded:
-/// the one place that decides it. A scene checked part by part without the triangle-pair lists
-/// (`scene --detail parts`), with nothing that reads the whole world mesh: no cache (its keys
-/// hash the mesh), sharding hook, scene self-check, penetration estimates, baseline,
-/// cross-check, `--split-bodies`, units, scales or placement. Every other request expands the
-/// scene as it is loaded. Both paths give the same outcome; this path's memory grows with the
-/// distinct meshes, not the instances. Without pair lists the regions, finding ids and listed
-/// pairs are empty, so nothing downstream of the check reads the (empty) expanded mesh; an
-/// output that draws the geometry expands it through [`LoadedInput::mesh`].
+/// the one place that decides it. A scene check (at either detail) with nothing that reads the
+/// whole world mesh: no cache (its keys hash the mesh), sharding hook, scene self-check,
+/// penetration estimates, baseline, cross-check, `--split-bodies`, units, scales or placement.
+/// Every other request expands the scene as it is loaded. Both paths give the same outcome;
+/// this path's memory grows with the distinct meshes, not the instances. The pair lists keep
+/// the expanded mesh's triangle numbers; finding ids and regions read the triangles of the
+/// pairs through [`LoadedInput::world_triangles`] (placed one by one), so nothing downstream
+/// of the check expands the scene but an output that draws the geometry
+/// ([`LoadedInput::world_mesh`]).
 pub fn instanced_path(req: &Request) -> bool {
     req.selection.scene
-        && req.settings.detail == Detail::Parts
         && req.cache.is_none()
         && req.selection.hook.is_none()
         && req.self_check.is_none()
@@ -537,7 +559,13 @@ fn load_scene_instanced(req: &Request, path: &Path) -> Result<LoadedInput> {
     let mut warnings = scene.warnings.clone();
     warnings.extend(range_warnings);
     let input = Input { path: path.to_path_buf(), format, mesh: Mesh::default(), warnings };
-    let instanced = InstancedInput { scene, info, part_bounds, expanded: std::sync::OnceLock::new() };
+    let instanced = InstancedInput {
+        scene,
+        info,
+        part_bounds,
+        expanded: std::sync::OnceLock::new(),
+        objects: std::sync::OnceLock::new(),
+    };
     Ok(LoadedInput {
         input,
         instanced: Some(std::sync::Arc::new(instanced)),
@@ -789,8 +817,11 @@ fn run_on(req: &Request, progress: &(dyn Fn(Phase) + Sync), instanced: bool) -> 
     let result = &outcome.result;
     // Every finding's id, computed once: regions take theirs from them, an uncut list shows
     // them all, a cut one records the rest under `unlisted`, and a baseline compares them all.
-    let ids = crate::check::finding_id::finding_hashes(&result.pairs, &a.mesh, &b.mesh);
-    let mut regions = crate::check::regions::regions_with_ids(&result.pairs, &a.mesh, &b.mesh, &ids);
+    // The triangles of the pairs are read where they come from: an instanced scene places
+    // only those.
+    let (ta, tb) = (inputs[0].world_triangles(), inputs[1].world_triangles());
+    let ids = crate::check::finding_id::finding_hashes(&result.pairs, ta, tb);
+    let mut regions = crate::check::regions::regions_with_ids(&result.pairs, ta, tb, &ids);
     if req.penetration && !settings.first_hit {
         let opts = BuildOptions::default();
         crate::check::regions::estimate_penetration(&mut regions, &result.pairs, &a.mesh, &b.mesh, opts);
