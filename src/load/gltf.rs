@@ -46,7 +46,10 @@
 //! - **Limits**: a scene expanding to more than [`MAX_SCENE_VERTICES`] vertices,
 //!   [`MAX_SCENE_TRIANGLES`] triangles or [`MAX_SCENE_PARTS`] parts (node instances plus GPU
 //!   instances) is refused from the declared counts, before any instance is read or anything
-//!   is allocated for it.
+//!   is allocated for it. Loaded without expansion ([`load_instanced`]), where memory grows
+//!   with the parts and not with the world coordinates, the limits are
+//!   [`MAX_INSTANCED_TRIANGLES`] triangles and the same parts, with no vertex limit; expanding
+//!   it later ([`InstancedScene::expand`]) applies the expanded limits.
 //! - **Vertices**: every primitive instance contributes its own vertices, transformed to world
 //!   space in f64 (no merging across primitives or instances).
 //! - **Triangle order**: scene traversal order (depth-first pre-order over the scene's root
@@ -97,6 +100,10 @@ pub(crate) const MAX_SCENE_TRIANGLES: usize = 1 << 28;
 /// 12 bytes of file, so a tiny mesh instanced many times must fail too.
 pub(crate) const MAX_SCENE_PARTS: usize = 1 << 24;
 
+/// The most triangles a scene loaded without expanding its instances ([`load_instanced`]) may
+/// have after instancing: the expanded scene's triangles are numbered in u32.
+pub(crate) const MAX_INSTANCED_TRIANGLES: usize = u32::MAX as usize;
+
 /// Loads `.gltf` or `.glb` `bytes` (the GLB magic decides); see the module doc.
 pub(crate) fn load(path: &Path, bytes: &[u8]) -> Result<Loaded> {
     let mut mesh = Mesh::default();
@@ -145,6 +152,9 @@ pub(crate) fn load_instanced(path: &Path, bytes: &[u8]) -> Result<InstancedScene
 
 /// What [`walk`] hands the scene's parts to, in object order.
 trait Sink {
+    /// Whether the parts are placed into one world mesh ([`load`]) rather than kept as (mesh,
+    /// matrix) ([`load_instanced`]): the limits and the memory estimate depend on it.
+    fn expands(&self) -> bool;
     /// Called once, before any part, with the expanded scene's vertex, triangle and part counts.
     fn reserve(&mut self, vertices: usize, triangles: usize, parts: usize);
     /// One part: `prims` placed by `world` (see [`add_instance`]).
@@ -152,6 +162,9 @@ trait Sink {
 }
 
 impl Sink for Mesh {
+    fn expands(&self) -> bool {
+        true
+    }
     fn reserve(&mut self, vertices: usize, triangles: usize, parts: usize) {
         self.positions.reserve_exact(vertices);
         self.triangles.reserve_exact(triangles);
@@ -171,6 +184,9 @@ struct PartSink {
 }
 
 impl Sink for PartSink {
+    fn expands(&self) -> bool {
+        false
+    }
     fn reserve(&mut self, _: usize, _: usize, parts: usize) {
         self.parts.reserve_exact(parts);
     }
@@ -270,6 +286,9 @@ impl InstancedScene {
             let (pv, pt) = self.part_counts(k);
             (v, t) = (v.saturating_add(pv), t.saturating_add(pt));
         }
+        // The instanced load admits scenes the expanded one refuses: refuse those here, as
+        // the expanded load would, before anything is allocated.
+        check_scene_size(&self.path, (v, t, self.parts.len()), true)?;
         mesh.reserve(v, t, self.parts.len());
         for p in &self.parts {
             add_instance(&mut mesh, &self.path, p.at, self.prims(p), p.name.clone(), p.world)?;
@@ -316,6 +335,53 @@ impl WorldTriangles for InstancedScene {
     }
 }
 
+/// Refuses a scene of `(vertices, triangles, parts)` after instancing beyond what the load can
+/// hold: when it `expands` the scene, [`MAX_SCENE_VERTICES`], [`MAX_SCENE_TRIANGLES`],
+/// [`MAX_SCENE_PARTS`] and [`super::scene_estimate`] against the memory this process may use;
+/// when it keeps the instances ([`load_instanced`]), whose memory grows with the parts and
+/// not with the world coordinates, no vertex limit, triangles numbered in u32
+/// ([`MAX_INSTANCED_TRIANGLES`]), the same parts limit, and
+/// [`super::instanced_scene_estimate`].
+fn check_scene_size(path: &Path, (v, t, parts): (usize, usize, usize), expands: bool) -> Result<()> {
+    let limits = if expands {
+        [
+            (v, MAX_SCENE_VERTICES, Quantity::SceneVertices),
+            (t, MAX_SCENE_TRIANGLES, Quantity::SceneTriangles),
+            (parts, MAX_SCENE_PARTS, Quantity::SceneParts),
+        ]
+    } else {
+        [
+            (v, usize::MAX, Quantity::SceneVertices),
+            (t, MAX_INSTANCED_TRIANGLES, Quantity::SceneTriangles),
+            (parts, MAX_SCENE_PARTS, Quantity::SceneParts),
+        ]
+    };
+    for (total, limit, quantity) in limits {
+        if total > limit {
+            let problem = InputProblem::TooLarge { quantity, count: total as u64, limit: limit as u64 };
+            return Err(Error::in_file(path, problem));
+        }
+    }
+    // Instancing multiplies what a small file asks for: refuse up front, before anything is
+    // expanded, a scene whose check cannot fit in the memory this process may use.
+    let need = if expands {
+        super::scene_estimate(v as u64, t as u64, parts as u64)
+    } else {
+        super::instanced_scene_estimate(t as u64, parts as u64)
+    };
+    if let Some(available) = super::available_memory().filter(|&a| need > a) {
+        let problem = InputProblem::NeedsMemory {
+            triangles: t as u64,
+            need,
+            available,
+            // The whole estimate per triangle (parts included), so the message adds up.
+            per_triangle: need / (t as u64).max(1),
+        };
+        return Err(Error::in_file(path, problem));
+    }
+    Ok(())
+}
+
 /// The vertices (a shared accessor once) and triangles one instance of `prims` places.
 fn counts(prims: &[Prim]) -> (usize, usize) {
     let (mut v, mut t) = (0usize, 0usize);
@@ -355,29 +421,7 @@ fn walk(path: &Path, bytes: &[u8], sink: &mut dyn Sink) -> Result<(Decoded, Vec<
             total_parts = total_parts.saturating_add(copies);
         }
     }
-    for (total, limit, quantity) in [
-        (total_v, MAX_SCENE_VERTICES, Quantity::SceneVertices),
-        (total_t, MAX_SCENE_TRIANGLES, Quantity::SceneTriangles),
-        (total_parts, MAX_SCENE_PARTS, Quantity::SceneParts),
-    ] {
-        if total > limit {
-            let problem = InputProblem::TooLarge { quantity, count: total as u64, limit: limit as u64 };
-            return Err(Error::in_file(path, problem));
-        }
-    }
-    // Instancing multiplies what a small file asks for: refuse up front, before anything is
-    // expanded, a scene whose check cannot fit in the memory this process may use.
-    let need = super::scene_estimate(total_v as u64, total_t as u64, total_parts as u64);
-    if let Some(available) = super::available_memory().filter(|&a| need > a) {
-        let problem = InputProblem::NeedsMemory {
-            triangles: total_t as u64,
-            need,
-            available,
-            // The whole estimate per triangle (parts included), so the message adds up.
-            per_triangle: need / (total_t as u64).max(1),
-        };
-        return Err(Error::in_file(path, problem));
-    }
+    check_scene_size(path, (total_v, total_t, total_parts), sink.expands())?;
 
     sink.reserve(total_v, total_t, total_parts);
     let names = node_names(&doc);

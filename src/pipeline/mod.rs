@@ -453,11 +453,26 @@ impl LoadedInput {
     }
 
     /// The mesh in world coordinates. An instanced input is expanded on first use (by an
-    /// output that draws the geometry), exactly as the file's plain load gives it.
+    /// output that draws the geometry), exactly as the file's plain load gives it; a scene too
+    /// large to expand (the expanded load's limits, which the instanced load does not apply)
+    /// reads as an empty mesh here, and as the load's error through
+    /// [`LoadedInput::try_world_mesh`].
     pub fn world_mesh(&self) -> &Mesh {
+        static EMPTY: Mesh = Mesh {
+            positions: Vec::new(),
+            triangles: Vec::new(),
+            tri_object: Vec::new(),
+            objects: Vec::new(),
+        };
+        self.try_world_mesh().unwrap_or(&EMPTY)
+    }
+
+    /// [`LoadedInput::world_mesh`], or the error the expanded load of an instanced scene gives
+    /// (a scene beyond its limits or the memory available).
+    pub fn try_world_mesh(&self) -> std::result::Result<&Mesh, &Error> {
         match &self.instanced {
-            Some(i) => i.expanded.get_or_init(|| i.scene.expand().map(|l| l.mesh).unwrap_or_default()),
-            None => &self.input.mesh,
+            Some(i) => i.expanded.get_or_init(|| i.scene.expand().map(|l| l.mesh)).as_ref(),
+            None => Ok(&self.input.mesh),
         }
     }
 
@@ -509,7 +524,7 @@ pub struct InstancedInput {
     /// Each part's triangle box, in part order (found with the summary, so the check need not
     /// place every part again for it).
     pub part_bounds: Vec<Aabb>,
-    expanded: std::sync::OnceLock<Mesh>,
+    expanded: std::sync::OnceLock<Result<Mesh>>,
     objects: std::sync::OnceLock<Mesh>,
 }
 
