@@ -98,6 +98,36 @@ fn shipped_gltf_scenes_give_the_same_report_with_pairs_instanced_and_expanded() 
     }
 }
 
+/// A baseline compares the run's finding ids with a report's: the same comparison on both
+/// paths, against a baseline written by a run with another touch tolerance (so some findings
+/// are new) and cut to a few listed pairs (the rest under `unlisted`).
+fn baseline_runs_agree(file: &Path) {
+    let dir = tempfile::tempdir().unwrap();
+    let base = dir.path().join("base.json");
+    let earlier = pipeline::run_expanded(
+        &pairs_request(file, |r| {
+            r.touch = Tolerance::Rel(1e-3);
+            r.max_pairs = 5;
+        }),
+        &|_| {},
+    )
+    .unwrap();
+    std::fs::write(&base, json(&earlier)).unwrap();
+    both_paths_agree(&pairs_request(file, |r| r.baseline = Some(base.clone())));
+    both_paths_agree(&pairs_request(file, |r| {
+        r.baseline = Some(base.clone());
+        r.gate = meshclash::pipeline::Gate::New;
+    }));
+}
+
+#[test]
+fn a_baseline_gives_the_same_comparison_instanced_and_expanded() {
+    baseline_runs_agree(&shared("pins.glb"));
+    if let Some(file) = corpus("2CylinderEngine.glb") {
+        baseline_runs_agree(&file);
+    }
+}
+
 #[test]
 fn engine_scene_gives_the_same_report_with_pairs_instanced_and_expanded() {
     let Some(file) = corpus("2CylinderEngine.glb") else { return };

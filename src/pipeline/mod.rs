@@ -537,7 +537,8 @@ impl std::fmt::Debug for InstancedInput {
 /// Whether `req` runs on its glTF scene instanced ([`InstancedInput`]) rather than expanded:
 /// the one place that decides it. A scene check (at either detail) with nothing that reads the
 /// whole world mesh: no cache (its keys hash the mesh), sharding hook, scene self-check,
-/// penetration estimates, baseline, cross-check, `--split-bodies`, units, scales or placement.
+/// penetration estimates, cross-check, `--split-bodies`, units, scales or placement (a
+/// baseline compares finding ids alone, so it runs here).
 /// Every other request expands the scene as it is loaded. Both paths give the same outcome;
 /// this path's memory grows with the distinct meshes, not the instances. The pair lists keep
 /// the expanded mesh's triangle numbers; finding ids and regions read the triangles of the
@@ -550,7 +551,6 @@ pub fn instanced_path(req: &Request) -> bool {
         && req.selection.hook.is_none()
         && req.self_check.is_none()
         && !req.penetration
-        && req.baseline.is_none()
         && !req.cross_check
         && !req.split_bodies
         && !req.units.active()
