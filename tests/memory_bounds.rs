@@ -291,3 +291,72 @@ fn self_on_100k_collinear_overlapping_triangles_counts_every_pair_under_1_gb() {
     // The first pairs in (a, b) order: triangle 0 with 1, 2, ..., 1000.
     assert!(pairs.iter().enumerate().all(|(k, p)| p["a"] == 0 && p["b"] == k as u64 + 1));
 }
+
+/// One node with `n` EXT_mesh_gpu_instancing instances (translations 2 apart along x) of a mesh
+/// of `vertices` vertices (a sparse accessor over zeros: the first three make its one triangle),
+/// all in a data URI: a few bytes per instance, `n * vertices` vertices after instancing.
+fn instances_of_many_vertices(path: &Path, n: usize, vertices: usize) {
+    use base64::Engine;
+    let mut bin: Vec<u8> = [0u16, 1, 2, 0].iter().flat_map(|i| i.to_le_bytes()).collect(); // indices, sparse indices
+    bin.extend(triangle_bytes()); // sparse values, at 8
+    for i in 0..n {
+        bin.extend([2.0 * i as f32, 0.0, 0.0].iter().flat_map(|x| x.to_le_bytes()));
+        // at 44
+    }
+    let data = base64::engine::general_purpose::STANDARD.encode(&bin);
+    let json = format!(
+        r#"{{"asset":{{"version":"2.0"}},"extensionsUsed":["EXT_mesh_gpu_instancing"],"scene":0,"scenes":[{{"nodes":[0]}}],
+"nodes":[{{"mesh":0,"extensions":{{"EXT_mesh_gpu_instancing":{{"attributes":{{"TRANSLATION":2}}}}}}}}],
+"meshes":[{{"primitives":[{{"attributes":{{"POSITION":0}},"indices":1}}]}}],
+"buffers":[{{"byteLength":{len},"uri":"data:application/octet-stream;base64,{data}"}}],
+"bufferViews":[{{"buffer":0,"byteLength":6}},{{"buffer":0,"byteLength":6}},{{"buffer":0,"byteOffset":8,"byteLength":36}},
+{{"buffer":0,"byteOffset":44,"byteLength":{t}}}],
+"accessors":[{{"componentType":5126,"count":{vertices},"type":"VEC3","min":[0,0,0],"max":[1,1,0],
+  "sparse":{{"count":3,"indices":{{"bufferView":1,"componentType":5123}},"values":{{"bufferView":2}}}}}},
+{{"bufferView":0,"componentType":5123,"count":3,"type":"SCALAR"}},
+{{"bufferView":3,"componentType":5126,"count":{n},"type":"VEC3"}}]}}"#,
+        len = bin.len(),
+        t = 12 * n,
+    );
+    std::fs::write(path, json).unwrap();
+}
+
+/// The scene check keeps a glTF scene's instances as (mesh, matrix) and places a part when it
+/// reads it, so a scene past the expanded load's vertex limit loads there (and in far less
+/// memory than its expansion); a request that expands the scene refuses it as before, with
+/// exit 2 and the one-line message, before anything is allocated.
+#[test]
+fn instances_past_the_expanded_vertex_limit_load_instanced_and_are_refused_expanded() {
+    let d = tempfile::tempdir().unwrap();
+    let file = d.path().join("wide.gltf");
+    // 4097 instances of 65,536 vertices: 2^28 + 2^16 vertices after instancing, 4097 triangles.
+    instances_of_many_vertices(&file, 4097, 1 << 16);
+    assert!(std::fs::metadata(&file).unwrap().len() < 100_000);
+    let f = file.to_str().unwrap();
+    let expanded_is_refused = |args: &[&str]| {
+        let out = std::process::Command::new(exe()).args(args).output().unwrap();
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert_eq!(out.status.code(), Some(2), "{args:?}: {err}");
+        assert_eq!(err.trim_end().lines().count(), 1, "not one line: {err}");
+        let message = "glTF scene has 268500992 vertices after instancing, more than the 268435456 supported";
+        assert!(err.contains(f) && err.contains(message), "{args:?}: {err}");
+    };
+    // Splitting bodies reads the whole world mesh; two files are expanded as they load.
+    expanded_is_refused(&["scene", f, "--split-bodies", "-o", "/dev/null"]);
+    expanded_is_refused(&[f, concat!(env!("CARGO_MANIFEST_DIR"), "/meshes/fcl_rob.obj"), "-o", "/dev/null"]);
+    // Instanced, it is checked (the instances are 2 apart: clear), its 6 GiB of expanded world
+    // coordinates never made: it fits under 1 GiB of address space where that can be set.
+    let report = d.path().join("r.json");
+    let args = ["scene", f, "--no-timings", "-o", report.to_str().unwrap()];
+    let (code, err) = if cfg!(target_os = "linux") {
+        under_limit(1 << 20, &args)
+    } else {
+        let out = std::process::Command::new(exe()).args(args).output().unwrap();
+        (out.status.code(), String::from_utf8_lossy(&out.stderr).into_owned())
+    };
+    assert_eq!(code, Some(0), "{err}");
+    let r: serde_json::Value = serde_json::from_slice(&std::fs::read(&report).unwrap()).unwrap();
+    assert_eq!(r["inputs"]["a"]["vertices"], 4097u64 << 16, "{}", r["inputs"]["a"]);
+    assert_eq!(r["inputs"]["a"]["triangles"], 4097, "{}", r["inputs"]["a"]);
+    assert_eq!(r["verdict"], "clear");
+}

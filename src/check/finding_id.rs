@@ -3,7 +3,7 @@
 //! in [`crate::report::baseline`]'s module docs.
 
 use crate::check::query::PairFinding;
-use crate::scene::mesh::Mesh;
+use crate::scene::mesh::WorldTriangles;
 
 const FNV_OFFSET: u64 = 0xcbf2_9ce4_8422_2325;
 const FNV_PRIME: u64 = 0x0000_0100_0000_01b3;
@@ -18,9 +18,8 @@ impl Fnv {
         }
     }
 
-    fn triangle(&mut self, mesh: &Mesh, t: u32) {
-        let mut v: [[u64; 3]; 3] = mesh.triangles[t as usize].map(|i| {
-            let p = mesh.positions[i as usize];
+    fn triangle<M: WorldTriangles + ?Sized>(&mut self, mesh: &M, t: u32) {
+        let mut v: [[u64; 3]; 3] = mesh.corners(t).map(|p| {
             [p.x, p.y, p.z].map(|c| (c + 0.0).to_bits()) // -0.0 + 0.0 = +0.0
         });
         v.sort_unstable();
@@ -44,17 +43,21 @@ impl Fnv {
 }
 
 /// The stable id of the pair (triangle `ta` of `a`, triangle `tb` of `b`), see the module docs.
-pub fn finding_id(a: &Mesh, ta: u32, b: &Mesh, tb: u32) -> String {
+pub fn finding_id<A, B>(a: &A, ta: u32, b: &B, tb: u32) -> String
+where
+    A: WorldTriangles + ?Sized,
+    B: WorldTriangles + ?Sized,
+{
     format_id(finding_hash(a, ta, b, tb))
 }
 
-fn object_name(m: &Mesh, t: u32) -> &str {
-    m.objects.get(m.tri_object[t as usize] as usize).map_or("", |o| &o.name)
+fn object_name<M: WorldTriangles + ?Sized>(m: &M, t: u32) -> &str {
+    m.object_name(m.object_of(t))
 }
 
 /// The hash state after A's triangle `ta` and its object name: the first half of every id
 /// whose A triangle is `ta`.
-fn a_half(a: &Mesh, ta: u32) -> Fnv {
+fn a_half<A: WorldTriangles + ?Sized>(a: &A, ta: u32) -> Fnv {
     let mut h = Fnv(FNV_OFFSET);
     h.triangle(a, ta);
     h.name(object_name(a, ta));
@@ -62,7 +65,7 @@ fn a_half(a: &Mesh, ta: u32) -> Fnv {
 }
 
 /// Complete an id begun by [`a_half`] with B's triangle `tb`.
-fn b_half(mut h: Fnv, b: &Mesh, tb: u32) -> u64 {
+fn b_half<B: WorldTriangles + ?Sized>(mut h: Fnv, b: &B, tb: u32) -> u64 {
     h.triangle(b, tb);
     h.name(object_name(b, tb));
     h.finish()
@@ -70,14 +73,23 @@ fn b_half(mut h: Fnv, b: &Mesh, tb: u32) -> u64 {
 
 /// The 64-bit hash behind [`finding_id`] (the id is its 16 hex digits, so ids order as their
 /// hashes do).
-pub fn finding_hash(a: &Mesh, ta: u32, b: &Mesh, tb: u32) -> u64 {
+pub fn finding_hash<A, B>(a: &A, ta: u32, b: &B, tb: u32) -> u64
+where
+    A: WorldTriangles + ?Sized,
+    B: WorldTriangles + ?Sized,
+{
     b_half(a_half(a, ta), b, tb)
 }
 
 /// [`finding_hash`] of every pair, in the order of `pairs`, computed in parallel. Consecutive
 /// pairs with the same A triangle (a list sorted by (a, b)) share the first half of the hash,
-/// which is computed once for them.
-pub fn finding_hashes(pairs: &[PairFinding], a: &Mesh, b: &Mesh) -> Vec<u64> {
+/// which is computed once for them. `a` and `b` are where the triangles come from: the world
+/// meshes, or an instanced scene that places only the triangles read.
+pub fn finding_hashes<A, B>(pairs: &[PairFinding], a: &A, b: &B) -> Vec<u64>
+where
+    A: WorldTriangles + ?Sized,
+    B: WorldTriangles + ?Sized,
+{
     use rayon::prelude::*;
     const CHUNK: usize = 2048;
     let mut out = vec![0u64; pairs.len()];

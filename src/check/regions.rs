@@ -13,7 +13,7 @@ use crate::check::containment::{self, Inside};
 use crate::check::query::{PairFinding, PairKind};
 use crate::geom::{Aabb, DVec3};
 use crate::scene::bodies::{find, union, vertex_key};
-use crate::scene::mesh::Mesh;
+use crate::scene::mesh::{Mesh, WorldTriangles};
 use rayon::prelude::*;
 use std::collections::HashMap;
 
@@ -60,8 +60,13 @@ pub struct Penetration {
     pub samples: usize,
 }
 
-/// Group `pairs` (triangle indices into `a` and `b`) into regions, sorted by id.
-pub fn regions(pairs: &[PairFinding], a: &Mesh, b: &Mesh) -> Vec<Region> {
+/// Group `pairs` (triangle indices into `a` and `b`) into regions, sorted by id. `a` and `b`
+/// are where the triangles come from ([`WorldTriangles`]): only the pairs' triangles are read.
+pub fn regions<A, B>(pairs: &[PairFinding], a: &A, b: &B) -> Vec<Region>
+where
+    A: WorldTriangles + ?Sized,
+    B: WorldTriangles + ?Sized,
+{
     regions_with_ids(pairs, a, b, &crate::check::finding_id::finding_hashes(pairs, a, b))
 }
 
@@ -71,9 +76,13 @@ pub fn regions(pairs: &[PairFinding], a: &Mesh, b: &Mesh) -> Vec<Region> {
 /// Regions never span part pairs, so each part pair's pairs are grouped on their own (in
 /// parallel): the (side, vertex) keys of its pairs' triangles are sorted, and pairs with equal
 /// keys joined.
-pub fn regions_with_ids(pairs: &[PairFinding], a: &Mesh, b: &Mesh, ids: &[u64]) -> Vec<Region> {
+pub fn regions_with_ids<A, B>(pairs: &[PairFinding], a: &A, b: &B, ids: &[u64]) -> Vec<Region>
+where
+    A: WorldTriangles + ?Sized,
+    B: WorldTriangles + ?Sized,
+{
     assert_eq!(pairs.len(), ids.len(), "one finding id per pair");
-    let objects = |p: &PairFinding| (a.tri_object[p.a as usize], b.tri_object[p.b as usize]);
+    let objects = |p: &PairFinding| (a.object_of(p.a), b.object_of(p.b));
     // The pairs of each part pair, in pair order.
     let mut order: Vec<((u32, u32), u32)> =
         pairs.par_iter().enumerate().map(|(i, p)| (objects(p), i as u32)).collect();
@@ -94,15 +103,36 @@ pub fn regions_with_ids(pairs: &[PairFinding], a: &Mesh, b: &Mesh, ids: &[u64]) 
     out.into_iter().map(|(_, r)| r).collect()
 }
 
+/// Join the nodes of one side (`tris`, distinct triangles of `m`, node `base + k` for
+/// `tris[k]`) whose triangles share a vertex position.
+fn join_shared_vertices<M: WorldTriangles + ?Sized>(m: &M, tris: &[u32], base: u32, parent: &mut [u32]) {
+    let mut keys: Vec<([u64; 3], u32)> = Vec::with_capacity(3 * tris.len());
+    for (k, &t) in tris.iter().enumerate() {
+        for p in m.corners(t) {
+            keys.push((vertex_key(&p), base + k as u32));
+        }
+    }
+    keys.sort_unstable();
+    for w in keys.windows(2) {
+        if w[0].0 == w[1].0 {
+            union(parent, w[0].1, w[1].1);
+        }
+    }
+}
+
 /// The regions of one part pair's pairs (`members`: their indices into `pairs`, ascending),
 /// each with its id's number.
-fn part_pair_regions(
+fn part_pair_regions<A, B>(
     pairs: &[PairFinding],
-    a: &Mesh,
-    b: &Mesh,
+    a: &A,
+    b: &B,
     ids: &[u64],
     members: &[usize],
-) -> Vec<(u64, Region)> {
+) -> Vec<(u64, Region)>
+where
+    A: WorldTriangles + ?Sized,
+    B: WorldTriangles + ?Sized,
+{
     // Nodes: the distinct A triangles of these pairs, then the distinct B triangles. Two
     // nodes of one side are joined when their triangles share a vertex position, and a pair
     // joins its two nodes; pairs are in one region exactly when their nodes are joined (pairs
@@ -115,21 +145,8 @@ fn part_pair_regions(
     }
     let na = tris[0].len();
     let mut parent: Vec<u32> = (0..(na + tris[1].len()) as u32).collect();
-    for (side, m) in [(0usize, a), (1usize, b)] {
-        let base = if side == 0 { 0 } else { na as u32 };
-        let mut keys: Vec<([u64; 3], u32)> = Vec::with_capacity(3 * tris[side].len());
-        for (k, &t) in tris[side].iter().enumerate() {
-            for v in m.triangles[t as usize] {
-                keys.push((vertex_key(&m.positions[v as usize]), base + k as u32));
-            }
-        }
-        keys.sort_unstable();
-        for w in keys.windows(2) {
-            if w[0].0 == w[1].0 {
-                union(&mut parent, w[0].1, w[1].1);
-            }
-        }
-    }
+    join_shared_vertices(a, &tris[0], 0, &mut parent);
+    join_shared_vertices(b, &tris[1], na as u32, &mut parent);
     let node = |side: usize, t: u32| -> u32 {
         let k = tris[side].binary_search(&t).expect("the triangle is a node") as u32;
         if side == 0 {
@@ -164,7 +181,7 @@ fn part_pair_regions(
                 let (lo, hi) = match p.segment {
                     Some([s, t]) => (s, t),
                     None => {
-                        let tb = Aabb::of_triangle(&crate::bvh::triangle(a, p.a));
+                        let tb = Aabb::of_triangle(&a.corners(p.a));
                         (tb.min, tb.max)
                     }
                 };
@@ -176,7 +193,7 @@ fn part_pair_regions(
             let p0 = &pairs[members[0]];
             let region = Region {
                 id: crate::check::finding_id::format_id(id),
-                objects: (a.tri_object[p0.a as usize], b.tri_object[p0.b as usize]),
+                objects: (a.object_of(p0.a), b.object_of(p0.b)),
                 pairs: members.len(),
                 crossing,
                 center: sum / members.len() as f64,

@@ -46,7 +46,10 @@
 //! - **Limits**: a scene expanding to more than [`MAX_SCENE_VERTICES`] vertices,
 //!   [`MAX_SCENE_TRIANGLES`] triangles or [`MAX_SCENE_PARTS`] parts (node instances plus GPU
 //!   instances) is refused from the declared counts, before any instance is read or anything
-//!   is allocated for it.
+//!   is allocated for it. Loaded without expansion ([`load_instanced`]), where memory grows
+//!   with the parts and not with the world coordinates, the limits are
+//!   [`MAX_INSTANCED_TRIANGLES`] triangles and the same parts, with no vertex limit; expanding
+//!   it later ([`InstancedScene::expand`]) applies the expanded limits.
 //! - **Vertices**: every primitive instance contributes its own vertices, transformed to world
 //!   space in f64 (no merging across primitives or instances).
 //! - **Triangle order**: scene traversal order (depth-first pre-order over the scene's root
@@ -79,7 +82,7 @@ use super::gltf_data::{
 use crate::error::{
     AccessorUser, Error, GltfProblem, InputProblem, InstancingProblem, Location, Quantity, Result,
 };
-use crate::scene::mesh::{Loaded, Mesh, Object};
+use crate::scene::mesh::{Loaded, Mesh, Object, WorldTriangles};
 
 /// The deepest node hierarchy accepted.
 pub(crate) const MAX_DEPTH: usize = 1024;
@@ -97,6 +100,10 @@ pub(crate) const MAX_SCENE_TRIANGLES: usize = 1 << 28;
 /// 12 bytes of file, so a tiny mesh instanced many times must fail too.
 pub(crate) const MAX_SCENE_PARTS: usize = 1 << 24;
 
+/// The most triangles a scene loaded without expanding its instances ([`load_instanced`]) may
+/// have after instancing: the expanded scene's triangles are numbered in u32.
+pub(crate) const MAX_INSTANCED_TRIANGLES: usize = u32::MAX as usize;
+
 /// Loads `.gltf` or `.glb` `bytes` (the GLB magic decides); see the module doc.
 pub(crate) fn load(path: &Path, bytes: &[u8]) -> Result<Loaded> {
     let mut mesh = Mesh::default();
@@ -111,11 +118,43 @@ pub(crate) fn load(path: &Path, bytes: &[u8]) -> Result<Loaded> {
 pub(crate) fn load_instanced(path: &Path, bytes: &[u8]) -> Result<InstancedScene> {
     let mut sink = PartSink { parts: Vec::new(), scratch: Mesh::default() };
     let (meshes, warnings) = walk(path, bytes, &mut sink)?;
-    Ok(InstancedScene { path: path.to_path_buf(), meshes, parts: sink.parts, warnings })
+    // Where each mesh's primitives, and each part, start in triangle order.
+    let prim_starts: Vec<Vec<u32>> = meshes
+        .iter()
+        .map(|m| {
+            let mut at = 0u32;
+            let start = |p: &Prim| {
+                let s = at;
+                at += p.triangles.len() as u32;
+                s
+            };
+            m.as_deref().unwrap_or(&[]).iter().map(start).collect()
+        })
+        .collect();
+    let mut tri_starts = Vec::with_capacity(sink.parts.len() + 1);
+    let mut at = 0u32;
+    tri_starts.push(at);
+    for p in &sink.parts {
+        let prims = meshes.get(p.mesh as usize).and_then(Option::as_deref).unwrap_or(&[]);
+        // The limits keep the expanded scene's triangle numbers within u32.
+        at = at.saturating_add(counts(prims).1 as u32);
+        tri_starts.push(at);
+    }
+    Ok(InstancedScene {
+        path: path.to_path_buf(),
+        meshes,
+        prim_starts,
+        tri_starts,
+        parts: sink.parts,
+        warnings,
+    })
 }
 
 /// What [`walk`] hands the scene's parts to, in object order.
 trait Sink {
+    /// Whether the parts are placed into one world mesh ([`load`]) rather than kept as (mesh,
+    /// matrix) ([`load_instanced`]): the limits and the memory estimate depend on it.
+    fn expands(&self) -> bool;
     /// Called once, before any part, with the expanded scene's vertex, triangle and part counts.
     fn reserve(&mut self, vertices: usize, triangles: usize, parts: usize);
     /// One part: `prims` placed by `world` (see [`add_instance`]).
@@ -123,6 +162,9 @@ trait Sink {
 }
 
 impl Sink for Mesh {
+    fn expands(&self) -> bool {
+        true
+    }
     fn reserve(&mut self, vertices: usize, triangles: usize, parts: usize) {
         self.positions.reserve_exact(vertices);
         self.triangles.reserve_exact(triangles);
@@ -142,6 +184,9 @@ struct PartSink {
 }
 
 impl Sink for PartSink {
+    fn expands(&self) -> bool {
+        false
+    }
     fn reserve(&mut self, _: usize, _: usize, parts: usize) {
         self.parts.reserve_exact(parts);
     }
@@ -172,6 +217,11 @@ struct Placement {
 pub struct InstancedScene {
     path: std::path::PathBuf,
     meshes: Decoded,
+    /// For each glTF mesh, the first triangle of each of its primitives (in the mesh's
+    /// triangle order).
+    prim_starts: Vec<Vec<u32>>,
+    /// The first triangle of each part in the expanded mesh, and the triangle count last.
+    tri_starts: Vec<u32>,
     /// The parts, in object order (the expanded mesh's `objects`).
     pub parts: Vec<ScenePart>,
     /// The loader's warnings, as [`load`] gives them.
@@ -215,6 +265,13 @@ impl InstancedScene {
         positions
     }
 
+    /// The expanded mesh's objects (one per part, in order), without placing anything.
+    pub fn objects(&self) -> Vec<Object> {
+        let object =
+            |p: &ScenePart| Object { name: p.name.clone(), gltf_mesh: Some(p.mesh), world: Some(p.world) };
+        self.parts.iter().map(object).collect()
+    }
+
     /// The vertices and triangles part `k` expands to, without placing it.
     pub fn part_counts(&self, k: usize) -> (usize, usize) {
         counts(self.prims(&self.parts[k]))
@@ -229,6 +286,9 @@ impl InstancedScene {
             let (pv, pt) = self.part_counts(k);
             (v, t) = (v.saturating_add(pv), t.saturating_add(pt));
         }
+        // The instanced load admits scenes the expanded one refuses: refuse those here, as
+        // the expanded load would, before anything is allocated.
+        check_scene_size(&self.path, (v, t, self.parts.len()), true)?;
         mesh.reserve(v, t, self.parts.len());
         for p in &self.parts {
             add_instance(&mut mesh, &self.path, p.at, self.prims(p), p.name.clone(), p.world)?;
@@ -241,6 +301,85 @@ impl InstancedScene {
     fn prims(&self, p: &ScenePart) -> &[Prim] {
         self.meshes.get(p.mesh as usize).and_then(Option::as_deref).unwrap_or(&[])
     }
+
+    /// The part holding triangle `t` of the expanded mesh, and `t`'s index within the part.
+    fn locate(&self, t: u32) -> (usize, u32) {
+        let k = self.tri_starts.partition_point(|&s| s <= t).saturating_sub(1).min(self.parts.len() - 1);
+        (k, t - self.tri_starts[k])
+    }
+}
+
+/// The expanded mesh's triangles read one at a time: a triangle's corners are its part's
+/// vertices placed by the part's matrix with [`place_vertices`]' arithmetic (each vertex on its
+/// own), so they are the expanded mesh's coordinates, bit for bit, without placing the part.
+impl WorldTriangles for InstancedScene {
+    fn corners(&self, t: u32) -> [DVec3; 3] {
+        let (k, local) = self.locate(t);
+        let p = &self.parts[k];
+        let prims = self.prims(p);
+        let starts = &self.prim_starts[p.mesh as usize];
+        // The primitive holding the triangle: the last one starting at or before it that has
+        // triangles (one without triangles starts where the next one does).
+        let j = starts.partition_point(|&s| s <= local) - 1;
+        let prim = &prims[j];
+        let positions = &prims[prim.shares.unwrap_or(j)].positions;
+        prim.triangles[(local - starts[j]) as usize].map(|i| p.world.transform_point3(positions[i as usize]))
+    }
+
+    fn object_of(&self, t: u32) -> u32 {
+        self.locate(t).0 as u32
+    }
+
+    fn object_name(&self, o: u32) -> &str {
+        self.parts.get(o as usize).map_or("", |p| &p.name)
+    }
+}
+
+/// Refuses a scene of `(vertices, triangles, parts)` after instancing beyond what the load can
+/// hold: when it `expands` the scene, [`MAX_SCENE_VERTICES`], [`MAX_SCENE_TRIANGLES`],
+/// [`MAX_SCENE_PARTS`] and [`super::scene_estimate`] against the memory this process may use;
+/// when it keeps the instances ([`load_instanced`]), whose memory grows with the parts and
+/// not with the world coordinates, no vertex limit, triangles numbered in u32
+/// ([`MAX_INSTANCED_TRIANGLES`]), the same parts limit, and
+/// [`super::instanced_scene_estimate`].
+fn check_scene_size(path: &Path, (v, t, parts): (usize, usize, usize), expands: bool) -> Result<()> {
+    let limits = if expands {
+        [
+            (v, MAX_SCENE_VERTICES, Quantity::SceneVertices),
+            (t, MAX_SCENE_TRIANGLES, Quantity::SceneTriangles),
+            (parts, MAX_SCENE_PARTS, Quantity::SceneParts),
+        ]
+    } else {
+        [
+            (v, usize::MAX, Quantity::SceneVertices),
+            (t, MAX_INSTANCED_TRIANGLES, Quantity::SceneTriangles),
+            (parts, MAX_SCENE_PARTS, Quantity::SceneParts),
+        ]
+    };
+    for (total, limit, quantity) in limits {
+        if total > limit {
+            let problem = InputProblem::TooLarge { quantity, count: total as u64, limit: limit as u64 };
+            return Err(Error::in_file(path, problem));
+        }
+    }
+    // Instancing multiplies what a small file asks for: refuse up front, before anything is
+    // expanded, a scene whose check cannot fit in the memory this process may use.
+    let need = if expands {
+        super::scene_estimate(v as u64, t as u64, parts as u64)
+    } else {
+        super::instanced_scene_estimate(t as u64, parts as u64)
+    };
+    if let Some(available) = super::available_memory().filter(|&a| need > a) {
+        let problem = InputProblem::NeedsMemory {
+            triangles: t as u64,
+            need,
+            available,
+            // The whole estimate per triangle (parts included), so the message adds up.
+            per_triangle: need / (t as u64).max(1),
+        };
+        return Err(Error::in_file(path, problem));
+    }
+    Ok(())
 }
 
 /// The vertices (a shared accessor once) and triangles one instance of `prims` places.
@@ -282,29 +421,7 @@ fn walk(path: &Path, bytes: &[u8], sink: &mut dyn Sink) -> Result<(Decoded, Vec<
             total_parts = total_parts.saturating_add(copies);
         }
     }
-    for (total, limit, quantity) in [
-        (total_v, MAX_SCENE_VERTICES, Quantity::SceneVertices),
-        (total_t, MAX_SCENE_TRIANGLES, Quantity::SceneTriangles),
-        (total_parts, MAX_SCENE_PARTS, Quantity::SceneParts),
-    ] {
-        if total > limit {
-            let problem = InputProblem::TooLarge { quantity, count: total as u64, limit: limit as u64 };
-            return Err(Error::in_file(path, problem));
-        }
-    }
-    // Instancing multiplies what a small file asks for: refuse up front, before anything is
-    // expanded, a scene whose check cannot fit in the memory this process may use.
-    let need = super::scene_estimate(total_v as u64, total_t as u64, total_parts as u64);
-    if let Some(available) = super::available_memory().filter(|&a| need > a) {
-        let problem = InputProblem::NeedsMemory {
-            triangles: total_t as u64,
-            need,
-            available,
-            // The whole estimate per triangle (parts included), so the message adds up.
-            per_triangle: need / (total_t as u64).max(1),
-        };
-        return Err(Error::in_file(path, problem));
-    }
+    check_scene_size(path, (total_v, total_t, total_parts), sink.expands())?;
 
     sink.reserve(total_v, total_t, total_parts);
     let names = node_names(&doc);

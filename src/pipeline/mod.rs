@@ -26,7 +26,7 @@ use crate::load::Format;
 use crate::report::baseline::{self, Baseline, BaselineReport, Finding};
 use crate::report::self_report::{SceneSelfReport, SelfFailOn};
 use crate::report::{CrossCheckReport, InputUnitsReport, SettingsReport};
-use crate::scene::mesh::{Loaded, Mesh};
+use crate::scene::mesh::{Loaded, Mesh, WorldTriangles};
 use glam::DMat4;
 use std::path::{Path, PathBuf};
 use std::time::Instant;
@@ -441,11 +441,47 @@ pub struct LoadedInput {
 }
 
 impl LoadedInput {
-    /// The mesh in world coordinates. An instanced input is expanded on first use (by an
-    /// output that draws the geometry), exactly as the file's plain load gives it.
+    /// The mesh as the report reads it: the mesh in world coordinates, or for an instanced
+    /// input its objects alone (names, glTF meshes and matrices, as the expanded mesh has
+    /// them) without the geometry, made on first use. An output that draws the geometry reads
+    /// the world mesh through `Deref` ([`LoadedInput::world_mesh`]).
     pub fn mesh(&self) -> &Mesh {
         match &self.instanced {
-            Some(i) => i.expanded.get_or_init(|| i.scene.expand().map(|l| l.mesh).unwrap_or_default()),
+            Some(i) => i.objects.get_or_init(|| Mesh { objects: i.scene.objects(), ..Mesh::default() }),
+            None => &self.input.mesh,
+        }
+    }
+
+    /// The mesh in world coordinates. An instanced input is expanded on first use (by an
+    /// output that draws the geometry), exactly as the file's plain load gives it; a scene too
+    /// large to expand (the expanded load's limits, which the instanced load does not apply)
+    /// reads as an empty mesh here, and as the load's error through
+    /// [`LoadedInput::try_world_mesh`].
+    pub fn world_mesh(&self) -> &Mesh {
+        static EMPTY: Mesh = Mesh {
+            positions: Vec::new(),
+            triangles: Vec::new(),
+            tri_object: Vec::new(),
+            objects: Vec::new(),
+        };
+        self.try_world_mesh().unwrap_or(&EMPTY)
+    }
+
+    /// [`LoadedInput::world_mesh`], or the error the expanded load of an instanced scene gives
+    /// (a scene beyond its limits or the memory available).
+    pub fn try_world_mesh(&self) -> std::result::Result<&Mesh, &Error> {
+        match &self.instanced {
+            Some(i) => i.expanded.get_or_init(|| i.scene.expand().map(|l| l.mesh)).as_ref(),
+            None => Ok(&self.input.mesh),
+        }
+    }
+
+    /// Where the input's triangles come from, by their index in the world mesh: the mesh
+    /// itself, or for an instanced input the scene, placing each triangle read (never the
+    /// whole scene).
+    pub fn world_triangles(&self) -> &dyn WorldTriangles {
+        match &self.instanced {
+            Some(i) => &i.scene,
             None => &self.input.mesh,
         }
     }
@@ -469,12 +505,12 @@ impl LoadedInput {
     }
 }
 
-/// A loaded input reads as its world mesh ([`LoadedInput::mesh`]: an instanced scene is
+/// A loaded input reads as its world mesh ([`LoadedInput::world_mesh`]: an instanced scene is
 /// expanded on first use).
 impl std::ops::Deref for LoadedInput {
     type Target = Mesh;
     fn deref(&self) -> &Mesh {
-        self.mesh()
+        self.world_mesh()
     }
 }
 
@@ -488,7 +524,8 @@ pub struct InstancedInput {
     /// Each part's triangle box, in part order (found with the summary, so the check need not
     /// place every part again for it).
     pub part_bounds: Vec<Aabb>,
-    expanded: std::sync::OnceLock<Mesh>,
+    expanded: std::sync::OnceLock<Result<Mesh>>,
+    objects: std::sync::OnceLock<Mesh>,
 }
 
 impl std::fmt::Debug for InstancedInput {
@@ -498,22 +535,22 @@ impl std::fmt::Debug for InstancedInput {
 }
 
 /// Whether `req` runs on its glTF scene instanced ([`InstancedInput`]) rather than expanded:
-/// the one place that decides it. A scene checked part by part without the triangle-pair lists
-/// (`scene --detail parts`), with nothing that reads the whole world mesh: no cache (its keys
-/// hash the mesh), sharding hook, scene self-check, penetration estimates, baseline,
-/// cross-check, `--split-bodies`, units, scales or placement. Every other request expands the
-/// scene as it is loaded. Both paths give the same outcome; this path's memory grows with the
-/// distinct meshes, not the instances. Without pair lists the regions, finding ids and listed
-/// pairs are empty, so nothing downstream of the check reads the (empty) expanded mesh; an
-/// output that draws the geometry expands it through [`LoadedInput::mesh`].
+/// the one place that decides it. A scene check (at either detail) with nothing that reads the
+/// whole world mesh: no cache (its keys hash the mesh), sharding hook, scene self-check,
+/// penetration estimates, cross-check, `--split-bodies`, units, scales or placement (a
+/// baseline compares finding ids alone, so it runs here).
+/// Every other request expands the scene as it is loaded. Both paths give the same outcome;
+/// this path's memory grows with the distinct meshes, not the instances. The pair lists keep
+/// the expanded mesh's triangle numbers; finding ids and regions read the triangles of the
+/// pairs through [`LoadedInput::world_triangles`] (placed one by one), so nothing downstream
+/// of the check expands the scene but an output that draws the geometry
+/// ([`LoadedInput::world_mesh`]).
 pub fn instanced_path(req: &Request) -> bool {
     req.selection.scene
-        && req.settings.detail == Detail::Parts
         && req.cache.is_none()
         && req.selection.hook.is_none()
         && req.self_check.is_none()
         && !req.penetration
-        && req.baseline.is_none()
         && !req.cross_check
         && !req.split_bodies
         && !req.units.active()
@@ -537,7 +574,13 @@ fn load_scene_instanced(req: &Request, path: &Path) -> Result<LoadedInput> {
     let mut warnings = scene.warnings.clone();
     warnings.extend(range_warnings);
     let input = Input { path: path.to_path_buf(), format, mesh: Mesh::default(), warnings };
-    let instanced = InstancedInput { scene, info, part_bounds, expanded: std::sync::OnceLock::new() };
+    let instanced = InstancedInput {
+        scene,
+        info,
+        part_bounds,
+        expanded: std::sync::OnceLock::new(),
+        objects: std::sync::OnceLock::new(),
+    };
     Ok(LoadedInput {
         input,
         instanced: Some(std::sync::Arc::new(instanced)),
@@ -789,8 +832,11 @@ fn run_on(req: &Request, progress: &(dyn Fn(Phase) + Sync), instanced: bool) -> 
     let result = &outcome.result;
     // Every finding's id, computed once: regions take theirs from them, an uncut list shows
     // them all, a cut one records the rest under `unlisted`, and a baseline compares them all.
-    let ids = crate::check::finding_id::finding_hashes(&result.pairs, &a.mesh, &b.mesh);
-    let mut regions = crate::check::regions::regions_with_ids(&result.pairs, &a.mesh, &b.mesh, &ids);
+    // The triangles of the pairs are read where they come from: an instanced scene places
+    // only those.
+    let (ta, tb) = (inputs[0].world_triangles(), inputs[1].world_triangles());
+    let ids = crate::check::finding_id::finding_hashes(&result.pairs, ta, tb);
+    let mut regions = crate::check::regions::regions_with_ids(&result.pairs, ta, tb, &ids);
     if req.penetration && !settings.first_hit {
         let opts = BuildOptions::default();
         crate::check::regions::estimate_penetration(&mut regions, &result.pairs, &a.mesh, &b.mesh, opts);

@@ -122,6 +122,35 @@ pub trait TriMesh: Sync {
     }
 }
 
+/// Where a triangle's world corners and its object come from, by the triangle's index in the
+/// world mesh: the loaded [`Mesh`] itself, or an instanced scene
+/// ([`crate::load::InstancedScene`]) that places a triangle's corners when they are read, by
+/// the arithmetic that expands it (so both give the same coordinates, bit for bit). What reads
+/// only the triangles it needs (finding ids, regions) reads them through this, never through
+/// the whole world mesh.
+pub trait WorldTriangles: Sync {
+    /// The world corners of triangle `t`.
+    fn corners(&self, t: u32) -> [DVec3; 3];
+    /// The object (index into the mesh's objects) triangle `t` belongs to.
+    fn object_of(&self, t: u32) -> u32;
+    /// The name of object `o` (empty for an index past the objects).
+    fn object_name(&self, o: u32) -> &str;
+}
+
+impl WorldTriangles for Mesh {
+    #[inline]
+    fn corners(&self, t: u32) -> [DVec3; 3] {
+        self.triangles[t as usize].map(|i| self.positions[i as usize])
+    }
+    #[inline]
+    fn object_of(&self, t: u32) -> u32 {
+        self.tri_object[t as usize]
+    }
+    fn object_name(&self, o: u32) -> &str {
+        self.objects.get(o as usize).map_or("", |o| &o.name)
+    }
+}
+
 impl TriMesh for Mesh {
     #[inline]
     fn vertex_count(&self) -> usize {
