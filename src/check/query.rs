@@ -1114,7 +1114,14 @@ where
             // The rectangle bound costs four triangle distances: worth it only where a prune
             // saves subtrees on both sides (measured on linked tori and 2CylinderEngine).
             let leafy = ta.is_leaf(i) || tb.is_leaf(j);
-            let fine = if shrink(gap - margin) > cut || leafy { gap } else { oa.swept_rect_bound(ob, gap) };
+            // The rectangle bound prunes only above `cut` (less the margin): it may stop early
+            // below that (with an error allowance, `shrink` moves the line: no early stop).
+            let need = if err.rel == 0.0 && err.abs == 0.0 { cut + margin } else { f64::NEG_INFINITY };
+            let fine = if shrink(gap - margin) > cut || leafy {
+                gap
+            } else {
+                oa.swept_rect_bound_above(ob, gap, need)
+            };
             boxed.max(shrink(fine - margin))
         },
         slack,
