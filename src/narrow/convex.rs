@@ -163,16 +163,21 @@ pub fn penetration(a: &Polytope<'_>, b: &Polytope<'_>) -> Option<Penetration> {
     let mut cands: Vec<Candidate> = Vec::new();
     let na: Vec<Plane> = a.triangles.iter().map(|t| Plane::new(&t.map(|v| a.vertex(v)))).collect();
     let nb: Vec<Plane> = b.triangles.iter().map(|t| Plane::new(&t.map(|v| b.vertex(v)))).collect();
-    let prune = Prune::new(a, &na, b, &nb);
+    // Each face's unit normal (with its direction error), found once for every bound below.
+    let (ua, ub): (Vec<Unit>, Vec<Unit>) =
+        (na.iter().map(Plane::unit).collect(), nb.iter().map(Plane::unit).collect());
+    let prune = Prune::new(a, &na, &ua, b, &nb, &ub);
     if prune.separated {
         return None;
     }
+    // Each face's lower bound against the other polytope's ball ([`Prune::face_lows`]).
+    let (lows_a, lows_b) = (prune.face_lows(a, &ua, prune.ball_b), prune.face_lows(b, &ub, prune.ball_a));
     // Faces of A against the vertices of B, then faces of B against the vertices of A.
     for (side, (p, planes, q)) in [(a, &na, b), (b, &nb, a)].into_iter().enumerate() {
-        let ball = if side == 0 { prune.ball_b } else { prune.ball_a };
+        let (ball, lows) = if side == 0 { (prune.ball_b, &lows_a) } else { (prune.ball_a, &lows_b) };
         for (f, plane) in planes.iter().enumerate() {
             let t = p.tri(f as u32);
-            if plane.degenerate(&t) || prune.skips_face(plane, t[0], ball) {
+            if plane.degenerate(&t) || prune.skips_face(lows[f], ball) {
                 continue;
             }
             let (min_lo, min_hi) = q.surface.vertices.iter().fold((f64::INFINITY, f64::INFINITY), |m, &v| {
@@ -188,16 +193,17 @@ pub fn penetration(a: &Polytope<'_>, b: &Polytope<'_>) -> Option<Penetration> {
         }
     }
     // Edge pairs whose Gauss-map arcs cross (of the edges the bounds keep).
-    let keep = |p: &Polytope<'_>, planes: &[Plane], ball| -> Vec<usize> {
+    let keep = |p: &Polytope<'_>, units: &[Unit], lows: &[Option<f64>], ball| -> Vec<usize> {
         (0..p.surface.edges.len())
             .filter(|&i| {
                 let e = p.surface.edges[i];
-                let v = p.vertex(e.v[0]);
-                !prune.skips_edge(&planes[e.f[0] as usize], &planes[e.f[1] as usize], v, ball)
+                let [f0, f1] = e.f.map(|f| f as usize);
+                let faces = [(lows[f0], units[f0]), (lows[f1], units[f1])];
+                !prune.skips_edge(faces, p.vertex(e.v[0]), ball)
             })
             .collect()
     };
-    let (edges_a, edges_b) = (keep(a, &na, prune.ball_b), keep(b, &nb, prune.ball_a));
+    let (edges_a, edges_b) = (keep(a, &ua, &lows_a, prune.ball_b), keep(b, &ub, &lows_b, prune.ball_a));
     for &i in &edges_a {
         let ea = a.surface.edges[i];
         let (a0, a1) = (a.vertex(ea.v[0]), a.vertex(ea.v[1]));
@@ -228,22 +234,24 @@ pub fn penetration(a: &Polytope<'_>, b: &Polytope<'_>) -> Option<Penetration> {
         return None;
     }
     let contenders: Vec<&Candidate> = cands.iter().filter(|c| c.d.lo <= upper).collect();
-    let winner = match contenders.as_slice() {
+    // The winning axis, its exact `(h, |n|²)` when already computed, and an interval holding
+    // its depth.
+    let (winner, exact, d) = match contenders.as_slice() {
         [] => return None, // no axis at all (cannot happen for closed polytopes)
-        [only] if only.d.lo > 0.0 => only.axis,
+        [only] if only.d.lo > 0.0 => (only.axis, None, only.d),
         _ => {
-            let mut best: Option<(Axis, Dyadic, Dyadic)> = None;
+            let mut best: Option<(Axis, Dyadic, Dyadic, Iv)> = None;
             for c in &contenders {
                 let (h, n2) = exact_axis(a, b, c.axis);
                 let better = match &best {
                     None => true,
-                    Some((_, bh, bn)) => compare_depths(&h, &n2, bh, bn) == Ordering::Less,
+                    Some((_, bh, bn, _)) => compare_depths(&h, &n2, bh, bn) == Ordering::Less,
                 };
                 if better {
-                    best = Some((c.axis, h, n2));
+                    best = Some((c.axis, h, n2, c.d));
                 }
             }
-            let (axis, h, _) = best?;
+            let (axis, h, n2, d) = best?;
             if h.signum() < 0 {
                 return None;
             }
@@ -251,11 +259,11 @@ pub fn penetration(a: &Polytope<'_>, b: &Polytope<'_>) -> Option<Penetration> {
                 let (normal, point) = witness(a, b, axis, 0.0);
                 return Some(Penetration { depth: 0.0, normal, point, axis });
             }
-            axis
+            (axis, Some((h, n2)), d)
         }
     };
-    let (h, n2) = exact_axis(a, b, winner);
-    let depth = rounded_depth(&h, &n2);
+    let (h, n2) = exact.unwrap_or_else(|| exact_axis(a, b, winner));
+    let depth = rounded_depth(&h, &n2, (d.lo, d.hi));
     let (normal, point) = witness(a, b, winner, depth);
     Some(Penetration { depth, normal, point, axis: winner })
 }
@@ -296,8 +304,18 @@ struct Prune {
     separated: bool,
 }
 
+/// A face's f64 unit normal and a bound on its direction error ([`Plane::unit`]).
+type Unit = Option<(DVec3, f64)>;
+
 impl Prune {
-    fn new(a: &Polytope<'_>, na: &[Plane], b: &Polytope<'_>, nb: &[Plane]) -> Prune {
+    fn new(
+        a: &Polytope<'_>,
+        na: &[Plane],
+        ua: &[Unit],
+        b: &Polytope<'_>,
+        nb: &[Plane],
+        ub: &[Unit],
+    ) -> Prune {
         let verts =
             |p: &Polytope<'_>| -> Vec<DVec3> { p.surface.vertices.iter().map(|&v| p.vertex(v)).collect() };
         let (va, vb) = (verts(a), verts(b));
@@ -309,14 +327,15 @@ impl Prune {
         let max_a = va.iter().map(|v| v.dot(d)).fold(f64::NEG_INFINITY, f64::max);
         let min_b = vb.iter().map(|v| v.dot(d)).fold(f64::INFINITY, f64::min);
         let u = max_a - min_b + slack;
-        let ball = |p: &Polytope<'_>, planes: &[Plane], c: DVec3| -> Option<(DVec3, f64)> {
-            let r = planes
+        let ball = |p: &Polytope<'_>, planes: &[Plane], units: &[Unit], c: DVec3| -> Option<(DVec3, f64)> {
+            debug_assert_eq!(planes.len(), units.len());
+            let r = units
                 .iter()
                 .zip(p.triangles)
-                .map(|(pl, t)| match pl.unit() {
+                .map(|(unit, t)| match unit {
                     Some((n, err)) => {
                         let lever = p.vertex(t[0]) - c;
-                        lever.dot(n) - lever.length() * err - slack
+                        lever.dot(*n) - lever.length() * err - slack
                     }
                     None => f64::INFINITY, // degenerate: no facet
                 })
@@ -324,42 +343,54 @@ impl Prune {
             (r > 0.0 && r.is_finite()).then_some((c, r))
         };
         let separated = max_a - min_b + 2.0 * slack < 0.0;
-        Prune { u, slack, ball_a: ball(a, na, ca), ball_b: ball(b, nb, cb), separated }
+        Prune { u, slack, ball_a: ball(a, na, ua, ca), ball_b: ball(b, nb, ub, cb), separated }
     }
 
-    /// A lower bound of `(p - c)·n` for the exact unit normal `n` of `plane` (through `p`), with
-    /// `|p - c|`, the f64 unit normal and its direction error; `None` when the normal's
+    /// A lower bound of `(p - c)·n` for the exact unit normal `n` of a face (through its vertex
+    /// `p`), from the f64 unit normal and its direction error; `None` when the normal's
     /// direction is not known well enough.
-    fn lower(&self, plane: &Plane, p: DVec3, c: DVec3) -> Option<(f64, f64, DVec3, f64)> {
-        let (n, err) = plane.unit()?;
+    fn lower(&self, unit: Unit, p: DVec3, c: DVec3) -> Option<f64> {
+        let (n, err) = unit?;
         let lever = p - c;
-        let len = lever.length();
-        Some((lever.dot(n) - len * err - self.slack, len, n, err))
+        Some(lever.dot(n) - lever.length() * err - self.slack)
     }
 
-    /// Can the face with this plane (through `p`) be skipped against the other polytope's ball?
-    /// Its depth is at least `(p - c)·n + r`, whatever the sign of `(p - c)·n`.
-    fn skips_face(&self, plane: &Plane, p: DVec3, ball: Option<(DVec3, f64)>) -> bool {
-        let Some((c, r)) = ball else { return false };
-        self.lower(plane, p, c).is_some_and(|(x, ..)| x + r > self.u)
+    /// Every face's [`Prune::lower`] bound (at its first vertex) against the center of the
+    /// other polytope's ball; all `None` without a ball. The exact `(p - c)·n` is the same for
+    /// every point `p` of the face's plane, so the bound holds at each of its vertices.
+    fn face_lows(&self, p: &Polytope<'_>, units: &[Unit], ball: Option<(DVec3, f64)>) -> Vec<Option<f64>> {
+        match ball {
+            None => vec![None; units.len()],
+            Some((c, _)) => {
+                units.iter().zip(p.triangles).map(|(&unit, t)| self.lower(unit, p.vertex(t[0]), c)).collect()
+            }
+        }
     }
 
-    /// Can every axis of the edge between the faces of `p0` and `p1` (through its vertex `v`)
-    /// be skipped against the other polytope's ball? Its axes are the unit vectors `m` on the
-    /// arc between the two normals, where the depth is at least `(v - c)·m + r`. When that is
-    /// not negative at both normals it is at least the smaller of the two along the arc (a
-    /// sinusoid below both ends of an arc shorter than π would be negative at one of them);
-    /// otherwise it falls at most `|v - c|` times half the arc's angle below the smaller (the
-    /// slope along the arc is at most `|v - c|`), and half the angle is at most `π/4` times the
-    /// chord between the normals (the f64 chord plus both normals' direction errors).
-    fn skips_edge(&self, p0: &Plane, p1: &Plane, v: DVec3, ball: Option<(DVec3, f64)>) -> bool {
+    /// Can the face with this lower bound ([`Prune::face_lows`]) be skipped against the other
+    /// polytope's ball? Its depth is at least `(p - c)·n + r`, whatever the sign of `(p - c)·n`.
+    fn skips_face(&self, low: Option<f64>, ball: Option<(DVec3, f64)>) -> bool {
+        let Some((_, r)) = ball else { return false };
+        low.is_some_and(|x| x + r > self.u)
+    }
+
+    /// Can every axis of the edge between two faces (their lower bounds and unit normals) be
+    /// skipped against the other polytope's ball, `v` a vertex of the edge? Its axes are the
+    /// unit vectors `m` on the arc between the two normals, where the depth is at least
+    /// `(v - c)·m + r`. When that is not negative at both normals it is at least the smaller of
+    /// the two along the arc (a sinusoid below both ends of an arc shorter than π would be
+    /// negative at one of them); otherwise it falls at most `|v - c|` times half the arc's angle
+    /// below the smaller (the slope along the arc is at most `|v - c|`), and half the angle is at
+    /// most `π/4` times the chord between the normals (the f64 chord plus both normals'
+    /// direction errors). `v` lies on both faces' planes, so their bounds hold at `v`.
+    fn skips_edge(&self, faces: [(Option<f64>, Unit); 2], v: DVec3, ball: Option<(DVec3, f64)>) -> bool {
         let Some((c, r)) = ball else { return false };
-        let (Some((x0, len, n0, e0)), Some((x1, _, n1, e1))) = (self.lower(p0, v, c), self.lower(p1, v, c))
-        else {
+        let [(Some(x0), Some((n0, e0))), (Some(x1), Some((n1, e1)))] = faces else {
             return false;
         };
         let mut x = x0.min(x1);
         if x < 0.0 {
+            let len = (v - c).length();
             let chord = up((n0 - n1).length() + e0 + e1);
             x = x - up(len * up(chord * std::f64::consts::FRAC_PI_4)) - self.slack;
         }
@@ -636,7 +667,10 @@ fn compare_depths(h1: &Dyadic, n1: &Dyadic, h2: &Dyadic, n2: &Dyadic) -> Orderin
 /// `h / √n2` (`n2 > 0`) correctly rounded to f64 (nearest, ties to even), 0 when `h <= 0`: a
 /// bisection over the bit patterns of non-negative floats (ordered as their values), each step an
 /// exact comparison of `x² · n2` with `h²`, then the midpoint rule between the two neighbours.
-fn rounded_depth(h: &Dyadic, n2: &Dyadic) -> f64 {
+/// `near` is an interval that should hold the depth (an f64 estimate's bounds): each end is
+/// compared exactly first and narrows the bisection only where the comparison allows, so a wrong
+/// interval costs steps, never the answer.
+fn rounded_depth(h: &Dyadic, n2: &Dyadic, near: (f64, f64)) -> f64 {
     if h.signum() <= 0 {
         return 0.0;
     }
@@ -648,6 +682,13 @@ fn rounded_depth(h: &Dyadic, n2: &Dyadic) -> f64 {
     };
     // The largest float not above the depth: bits in [lo, hi], `lo` always not above.
     let (mut lo, mut hi) = (0u64, f64::MAX.to_bits());
+    let usable = |x: f64| x.is_finite() && x > 0.0;
+    if usable(near.0) && against(near.0) != Ordering::Greater {
+        lo = near.0.to_bits();
+    }
+    if usable(near.1) && near.1.to_bits() > lo && against(near.1) == Ordering::Greater {
+        hi = near.1.to_bits() - 1;
+    }
     while lo < hi {
         let mid = lo + (hi - lo).div_ceil(2);
         if against(f64::from_bits(mid)) == Ordering::Greater {

@@ -341,8 +341,26 @@ proptest! {
 
 /// `h / √n2` is correctly rounded: the two midpoints around the result bracket the exact value
 /// (compared squared, in rationals), and exact quotients come out exact.
+/// Any interval given as a hint (holding the depth or not) gives the same result.
 fn assert_correctly_rounded(h: f64, n2: f64) {
-    let r = rounded_depth(&Dyadic::from_f64(h), &Dyadic::from_f64(n2));
+    let (hd, nd) = (Dyadic::from_f64(h), Dyadic::from_f64(n2));
+    let r = rounded_depth(&hd, &nd, (0.0, f64::INFINITY));
+    let e = h / n2.sqrt();
+    let step =
+        |x: f64, k: i64| if x > 0.0 { f64::from_bits((x.to_bits() as i64 + k).max(1) as u64) } else { x };
+    for near in [
+        (step(e, -2), step(e, 2)),
+        (step(e, -1), step(e, 1)),
+        (e, e),
+        (step(e, 1), step(e, 3)),
+        (step(e, -3), step(e, -1)),
+        (e * 0.5, e * 2.0),
+        (e * 2.0, e * 0.5),
+        (-1.0, f64::NAN),
+        (f64::MIN_POSITIVE, f64::MAX),
+    ] {
+        assert_eq!(rounded_depth(&hd, &nd, near).to_bits(), r.to_bits(), "{h} / sqrt({n2}) with {near:?}");
+    }
     if h <= 0.0 {
         assert_eq!(r, 0.0);
         return;
@@ -359,10 +377,10 @@ fn assert_correctly_rounded(h: f64, n2: f64) {
 fn depths_are_correctly_rounded() {
     for (h, n2, want) in [(3.0, 4.0, 1.5), (0.75, 1.0, 0.75), (7.0 * 1e-3, 1.0, 7.0 * 1e-3), (6.0, 9.0, 2.0)]
     {
-        assert_eq!(rounded_depth(&Dyadic::from_f64(h), &Dyadic::from_f64(n2)), want);
+        assert_eq!(rounded_depth(&Dyadic::from_f64(h), &Dyadic::from_f64(n2), (0.0, f64::INFINITY)), want);
         assert_correctly_rounded(h, n2);
     }
-    assert_eq!(rounded_depth(&Dyadic::from_f64(-1.0), &Dyadic::from_f64(2.0)), 0.0);
+    assert_eq!(rounded_depth(&Dyadic::from_f64(-1.0), &Dyadic::from_f64(2.0), (0.0, 1.0)), 0.0);
     assert_correctly_rounded(1.0, 2.0);
     assert_correctly_rounded(1e-300, 3.0);
     assert_correctly_rounded(1e300, 3.0);
