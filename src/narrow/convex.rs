@@ -99,9 +99,55 @@ pub struct Polytope<'a> {
     pub triangles: &'a [[u32; 3]],
     /// Their surface.
     pub surface: &'a Surface,
+    /// The face frames ([`Frames`]) of coordinates of which `positions` are an exact
+    /// translation (or of `positions` themselves); `None`: found here, for each query.
+    pub frames: Option<&'a Frames>,
+}
+
+/// The parts of a polytope's face planes that depend only on differences of its coordinates:
+/// each face's f64 normal `(q - p) × (r - p)` and the permanents of its error bound, and its
+/// unit normal with a bound on its direction error ([`Plane::unit`]). Coordinates that are an
+/// exact translation of those the frames were found on have the same frames: each difference is
+/// the same real number, so its f64 rounding is the same (a placed mesh reuses its prepared
+/// mesh's).
+#[derive(Debug, Clone)]
+pub struct Frames {
+    faces: Vec<(DVec3, DVec3)>,
+    units: Vec<Unit>,
+}
+
+impl Frames {
+    /// The frames of every triangle of `triangles` on `positions`.
+    pub fn of(positions: &[DVec3], triangles: &[[u32; 3]]) -> Frames {
+        let planes: Vec<Plane> =
+            triangles.iter().map(|t| Plane::new(&t.map(|v| positions[v as usize]))).collect();
+        Frames {
+            units: planes.iter().map(Plane::unit).collect(),
+            faces: planes.iter().map(|p| (p.n, p.perm)).collect(),
+        }
+    }
 }
 
 impl Polytope<'_> {
+    /// Every face's plane and unit normal, from the frames when given.
+    fn planes(&self) -> (Vec<Plane>, std::borrow::Cow<'_, [Unit]>) {
+        match self.frames {
+            Some(f) if f.faces.len() == self.triangles.len() => {
+                let planes = (self.triangles.iter().zip(&f.faces))
+                    .map(|(t, &(n, perm))| Plane { origin: self.vertex(t[0]), n, perm })
+                    .collect();
+                (planes, std::borrow::Cow::Borrowed(&f.units))
+            }
+            _ => {
+                let planes: Vec<Plane> = self.triangles.iter().map(|t| Plane::new(&self.tri_of(t))).collect();
+                let units = planes.iter().map(Plane::unit).collect();
+                (planes, std::borrow::Cow::Owned(units))
+            }
+        }
+    }
+    fn tri_of(&self, t: &[u32; 3]) -> [DVec3; 3] {
+        t.map(|v| self.positions[v as usize])
+    }
     fn tri(&self, f: u32) -> [DVec3; 3] {
         self.triangles[f as usize].map(|v| self.positions[v as usize])
     }
@@ -161,11 +207,9 @@ pub struct Penetration {
 /// 0 when they only touch.
 pub fn penetration(a: &Polytope<'_>, b: &Polytope<'_>) -> Option<Penetration> {
     let mut cands: Vec<Candidate> = Vec::new();
-    let na: Vec<Plane> = a.triangles.iter().map(|t| Plane::new(&t.map(|v| a.vertex(v)))).collect();
-    let nb: Vec<Plane> = b.triangles.iter().map(|t| Plane::new(&t.map(|v| b.vertex(v)))).collect();
-    // Each face's unit normal (with its direction error), found once for every bound below.
-    let (ua, ub): (Vec<Unit>, Vec<Unit>) =
-        (na.iter().map(Plane::unit).collect(), nb.iter().map(Plane::unit).collect());
+    // Each face's plane and unit normal (with its direction error), found once for every bound
+    // below (or kept with the polytope's frames).
+    let ((na, ua), (nb, ub)) = (a.planes(), b.planes());
     let prune = Prune::new(a, &na, &ua, b, &nb, &ub);
     if prune.separated {
         return None;
@@ -278,8 +322,8 @@ pub fn exact_convex_penetration(
 ) -> Option<Option<Penetration>> {
     let sa = Surface::of(a.1).filter(|s| is_convex(a.0, a.1, s))?;
     let sb = Surface::of(b.1).filter(|s| is_convex(b.0, b.1, s))?;
-    let pa = Polytope { positions: a.0, triangles: a.1, surface: &sa };
-    let pb = Polytope { positions: b.0, triangles: b.1, surface: &sb };
+    let pa = Polytope { positions: a.0, triangles: a.1, surface: &sa, frames: None };
+    let pb = Polytope { positions: b.0, triangles: b.1, surface: &sb, frames: None };
     Some(penetration(&pa, &pb))
 }
 
