@@ -248,28 +248,57 @@ pub fn penetration(a: &Polytope<'_>, b: &Polytope<'_>) -> Option<Penetration> {
             .collect()
     };
     let (edges_a, edges_b) = (keep(a, &ua, &lows_a, prune.ball_b), keep(b, &ub, &lows_b, prune.ball_a));
-    for &i in &edges_a {
+    // The sign of a face normal of one polytope against a kept edge of the other is the same
+    // in every edge pair it appears in: each is decided once (exact, through the exact
+    // fallback where the filter cannot tell), kept in a table over the kept edges and the faces
+    // next to the other polytope's kept edges.
+    let (slots_a, count_a) = face_slots(a, &edges_a, na.len());
+    let (slots_b, count_b) = face_slots(b, &edges_b, nb.len());
+    let mut signs_a = vec![UNKNOWN; edges_b.len() * count_a]; // faces of A · edges of B
+    let mut signs_b = vec![UNKNOWN; edges_a.len() * count_b]; // faces of B · edges of A
+    let ends_b: Vec<(DVec3, DVec3, Dir)> = (edges_b.iter())
+        .map(|&j| {
+            let eb = b.surface.edges[j];
+            let (b0, b1) = (b.vertex(eb.v[0]), b.vertex(eb.v[1]));
+            (b0, b1, Dir::new(b0, b1))
+        })
+        .collect();
+    for (ii, &i) in edges_a.iter().enumerate() {
         let ea = a.surface.edges[i];
         let (a0, a1) = (a.vertex(ea.v[0]), a.vertex(ea.v[1]));
         let da = Dir::new(a0, a1);
-        for &j in &edges_b {
+        for (jj, &j) in edges_b.iter().enumerate() {
             let eb = b.surface.edges[j];
-            let s1 = face_dot_edge(b, &nb[eb.f[0] as usize], eb.f[0], &da, a0, a1);
-            let s2 = face_dot_edge(b, &nb[eb.f[1] as usize], eb.f[1], &da, a0, a1);
+            let mut sign_b = |f: u32| {
+                let slot = &mut signs_b[ii * count_b + slots_b[f as usize] as usize];
+                if *slot == UNKNOWN {
+                    *slot = face_dot_edge(b, &nb[f as usize], f, &da, a0, a1);
+                }
+                *slot
+            };
+            let s1 = sign_b(eb.f[0]);
+            let s2 = sign_b(eb.f[1]);
             if s1 * s2 >= 0 {
                 continue;
             }
-            let (b0, b1) = (b.vertex(eb.v[0]), b.vertex(eb.v[1]));
-            let db = Dir::new(b0, b1);
-            let t1 = face_dot_edge(a, &na[ea.f[0] as usize], ea.f[0], &db, b0, b1);
-            let t2 = face_dot_edge(a, &na[ea.f[1] as usize], ea.f[1], &db, b0, b1);
+            let (b0, b1, db) = &ends_b[jj];
+            let mut sign_a = |f: u32| {
+                let slot = &mut signs_a[jj * count_a + slots_a[f as usize] as usize];
+                if *slot == UNKNOWN {
+                    *slot = face_dot_edge(a, &na[f as usize], f, db, *b0, *b1);
+                }
+                *slot
+            };
+            let t1 = sign_a(ea.f[0]);
+            let t2 = sign_a(ea.f[1]);
             if t1 * t2 >= 0 || s1 != -t2 {
                 continue;
             }
+            let (b0, b1) = (*b0, *b1);
             // n = t1 · (eA × eB) points out of A; h = (a0 - b0)·n = t1 · orient3d(a0, a1, b0, b1).
             let o = Plane::new(&[a0, a1, b0]).value(b1);
             let h = if t1 > 0 { o } else { Iv { lo: -o.hi, hi: -o.lo } };
-            let d = h.div(cross_norm2(&da, &db).sqrt());
+            let d = h.div(cross_norm2(&da, db).sqrt());
             cands.push(Candidate { axis: Axis::Edges(i as u32, j as u32), d });
         }
     }
@@ -440,6 +469,25 @@ impl Prune {
         }
         x + r > self.u
     }
+}
+
+/// A sign not decided yet (in the tables of [`penetration`]'s edge pairs).
+const UNKNOWN: i8 = 2;
+
+/// A slot for each face next to one of `edges` (of `p`, which has `faces` faces), numbered from
+/// 0 in the order met: the slot of every face (`u32::MAX` for the others) and their count.
+fn face_slots(p: &Polytope<'_>, edges: &[usize], faces: usize) -> (Vec<u32>, usize) {
+    let mut slots = vec![u32::MAX; faces];
+    let mut count = 0;
+    for &e in edges {
+        for f in p.surface.edges[e].f {
+            if slots[f as usize] == u32::MAX {
+                slots[f as usize] = count as u32;
+                count += 1;
+            }
+        }
+    }
+    (slots, count)
 }
 
 /// One candidate axis with an interval holding its exact `h / |n|`.
