@@ -36,6 +36,9 @@ pub struct Prepared {
     pub label: PathBuf,
     surface: OnceLock<Option<Surface>>,
     convex: OnceLock<bool>,
+    /// The face frames of the mesh's own coordinates ([`convex::Frames`]), for the convex
+    /// depth of placements that are exact translations.
+    frames: OnceLock<convex::Frames>,
     topology: OnceLock<Arc<Topology>>,
     /// The ball of the mesh's own vertices, and whether their box lies in the tree's root box
     /// (where a box map's slack covers every vertex).
@@ -56,6 +59,7 @@ impl Prepared {
             label: label.to_path_buf(),
             surface: OnceLock::new(),
             convex: OnceLock::new(),
+            frames: OnceLock::new(),
             topology: OnceLock::new(),
             ball: OnceLock::new(),
             fragile: OnceLock::new(),
@@ -336,8 +340,12 @@ impl Placed {
         if !self.is_convex() {
             return None;
         }
-        let surface = self.prepared.surface()?;
-        Some(Polytope { positions: self.positions(), triangles: &self.prepared.mesh.triangles, surface })
+        let p = &self.prepared;
+        let surface = p.surface()?;
+        // Own coordinates or an exact translation of them: the prepared mesh's face frames.
+        let frames = (self.world.is_none() || self.translated())
+            .then(|| p.frames.get_or_init(|| convex::Frames::of(&p.mesh.positions, &p.mesh.triangles)));
+        Some(Polytope { positions: self.positions(), triangles: &p.mesh.triangles, surface, frames })
     }
 
     /// This placement's id, unique in the process: answers about a pair of placements can be

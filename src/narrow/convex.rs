@@ -99,9 +99,55 @@ pub struct Polytope<'a> {
     pub triangles: &'a [[u32; 3]],
     /// Their surface.
     pub surface: &'a Surface,
+    /// The face frames ([`Frames`]) of coordinates of which `positions` are an exact
+    /// translation (or of `positions` themselves); `None`: found here, for each query.
+    pub frames: Option<&'a Frames>,
+}
+
+/// The parts of a polytope's face planes that depend only on differences of its coordinates:
+/// each face's f64 normal `(q - p) × (r - p)` and the permanents of its error bound, and its
+/// unit normal with a bound on its direction error ([`Plane::unit`]). Coordinates that are an
+/// exact translation of those the frames were found on have the same frames: each difference is
+/// the same real number, so its f64 rounding is the same (a placed mesh reuses its prepared
+/// mesh's).
+#[derive(Debug, Clone)]
+pub struct Frames {
+    faces: Vec<(DVec3, DVec3)>,
+    units: Vec<Unit>,
+}
+
+impl Frames {
+    /// The frames of every triangle of `triangles` on `positions`.
+    pub fn of(positions: &[DVec3], triangles: &[[u32; 3]]) -> Frames {
+        let planes: Vec<Plane> =
+            triangles.iter().map(|t| Plane::new(&t.map(|v| positions[v as usize]))).collect();
+        Frames {
+            units: planes.iter().map(Plane::unit).collect(),
+            faces: planes.iter().map(|p| (p.n, p.perm)).collect(),
+        }
+    }
 }
 
 impl Polytope<'_> {
+    /// Every face's plane and unit normal, from the frames when given.
+    fn planes(&self) -> (Vec<Plane>, std::borrow::Cow<'_, [Unit]>) {
+        match self.frames {
+            Some(f) if f.faces.len() == self.triangles.len() => {
+                let planes = (self.triangles.iter().zip(&f.faces))
+                    .map(|(t, &(n, perm))| Plane { origin: self.vertex(t[0]), n, perm })
+                    .collect();
+                (planes, std::borrow::Cow::Borrowed(&f.units))
+            }
+            _ => {
+                let planes: Vec<Plane> = self.triangles.iter().map(|t| Plane::new(&self.tri_of(t))).collect();
+                let units = planes.iter().map(Plane::unit).collect();
+                (planes, std::borrow::Cow::Owned(units))
+            }
+        }
+    }
+    fn tri_of(&self, t: &[u32; 3]) -> [DVec3; 3] {
+        t.map(|v| self.positions[v as usize])
+    }
     fn tri(&self, f: u32) -> [DVec3; 3] {
         self.triangles[f as usize].map(|v| self.positions[v as usize])
     }
@@ -161,18 +207,21 @@ pub struct Penetration {
 /// 0 when they only touch.
 pub fn penetration(a: &Polytope<'_>, b: &Polytope<'_>) -> Option<Penetration> {
     let mut cands: Vec<Candidate> = Vec::new();
-    let na: Vec<Plane> = a.triangles.iter().map(|t| Plane::new(&t.map(|v| a.vertex(v)))).collect();
-    let nb: Vec<Plane> = b.triangles.iter().map(|t| Plane::new(&t.map(|v| b.vertex(v)))).collect();
-    let prune = Prune::new(a, &na, b, &nb);
+    // Each face's plane and unit normal (with its direction error), found once for every bound
+    // below (or kept with the polytope's frames).
+    let ((na, ua), (nb, ub)) = (a.planes(), b.planes());
+    let prune = Prune::new(a, &na, &ua, b, &nb, &ub);
     if prune.separated {
         return None;
     }
+    // Each face's lower bound against the other polytope's ball ([`Prune::face_lows`]).
+    let (lows_a, lows_b) = (prune.face_lows(a, &ua, prune.ball_b), prune.face_lows(b, &ub, prune.ball_a));
     // Faces of A against the vertices of B, then faces of B against the vertices of A.
     for (side, (p, planes, q)) in [(a, &na, b), (b, &nb, a)].into_iter().enumerate() {
-        let ball = if side == 0 { prune.ball_b } else { prune.ball_a };
+        let (ball, lows) = if side == 0 { (prune.ball_b, &lows_a) } else { (prune.ball_a, &lows_b) };
         for (f, plane) in planes.iter().enumerate() {
             let t = p.tri(f as u32);
-            if plane.degenerate(&t) || prune.skips_face(plane, t[0], ball) {
+            if plane.degenerate(&t) || prune.skips_face(lows[f], ball) {
                 continue;
             }
             let (min_lo, min_hi) = q.surface.vertices.iter().fold((f64::INFINITY, f64::INFINITY), |m, &v| {
@@ -188,38 +237,68 @@ pub fn penetration(a: &Polytope<'_>, b: &Polytope<'_>) -> Option<Penetration> {
         }
     }
     // Edge pairs whose Gauss-map arcs cross (of the edges the bounds keep).
-    let keep = |p: &Polytope<'_>, planes: &[Plane], ball| -> Vec<usize> {
+    let keep = |p: &Polytope<'_>, units: &[Unit], lows: &[Option<f64>], ball| -> Vec<usize> {
         (0..p.surface.edges.len())
             .filter(|&i| {
                 let e = p.surface.edges[i];
-                let v = p.vertex(e.v[0]);
-                !prune.skips_edge(&planes[e.f[0] as usize], &planes[e.f[1] as usize], v, ball)
+                let [f0, f1] = e.f.map(|f| f as usize);
+                let faces = [(lows[f0], units[f0]), (lows[f1], units[f1])];
+                !prune.skips_edge(faces, p.vertex(e.v[0]), ball)
             })
             .collect()
     };
-    let (edges_a, edges_b) = (keep(a, &na, prune.ball_b), keep(b, &nb, prune.ball_a));
-    for &i in &edges_a {
+    let (edges_a, edges_b) = (keep(a, &ua, &lows_a, prune.ball_b), keep(b, &ub, &lows_b, prune.ball_a));
+    // The sign of a face normal of one polytope against a kept edge of the other is the same
+    // in every edge pair it appears in: each is decided once (exact, through the exact
+    // fallback where the filter cannot tell), kept in a table over the kept edges and the faces
+    // next to the other polytope's kept edges.
+    let (slots_a, count_a) = face_slots(a, &edges_a, na.len());
+    let (slots_b, count_b) = face_slots(b, &edges_b, nb.len());
+    let mut signs_a = vec![UNKNOWN; edges_b.len() * count_a]; // faces of A · edges of B
+    let mut signs_b = vec![UNKNOWN; edges_a.len() * count_b]; // faces of B · edges of A
+    let ends_b: Vec<(DVec3, DVec3, Dir)> = (edges_b.iter())
+        .map(|&j| {
+            let eb = b.surface.edges[j];
+            let (b0, b1) = (b.vertex(eb.v[0]), b.vertex(eb.v[1]));
+            (b0, b1, Dir::new(b0, b1))
+        })
+        .collect();
+    for (ii, &i) in edges_a.iter().enumerate() {
         let ea = a.surface.edges[i];
         let (a0, a1) = (a.vertex(ea.v[0]), a.vertex(ea.v[1]));
         let da = Dir::new(a0, a1);
-        for &j in &edges_b {
+        for (jj, &j) in edges_b.iter().enumerate() {
             let eb = b.surface.edges[j];
-            let s1 = face_dot_edge(b, &nb[eb.f[0] as usize], eb.f[0], &da, a0, a1);
-            let s2 = face_dot_edge(b, &nb[eb.f[1] as usize], eb.f[1], &da, a0, a1);
+            let mut sign_b = |f: u32| {
+                let slot = &mut signs_b[ii * count_b + slots_b[f as usize] as usize];
+                if *slot == UNKNOWN {
+                    *slot = face_dot_edge(b, &nb[f as usize], f, &da, a0, a1);
+                }
+                *slot
+            };
+            let s1 = sign_b(eb.f[0]);
+            let s2 = sign_b(eb.f[1]);
             if s1 * s2 >= 0 {
                 continue;
             }
-            let (b0, b1) = (b.vertex(eb.v[0]), b.vertex(eb.v[1]));
-            let db = Dir::new(b0, b1);
-            let t1 = face_dot_edge(a, &na[ea.f[0] as usize], ea.f[0], &db, b0, b1);
-            let t2 = face_dot_edge(a, &na[ea.f[1] as usize], ea.f[1], &db, b0, b1);
+            let (b0, b1, db) = &ends_b[jj];
+            let mut sign_a = |f: u32| {
+                let slot = &mut signs_a[jj * count_a + slots_a[f as usize] as usize];
+                if *slot == UNKNOWN {
+                    *slot = face_dot_edge(a, &na[f as usize], f, db, *b0, *b1);
+                }
+                *slot
+            };
+            let t1 = sign_a(ea.f[0]);
+            let t2 = sign_a(ea.f[1]);
             if t1 * t2 >= 0 || s1 != -t2 {
                 continue;
             }
+            let (b0, b1) = (*b0, *b1);
             // n = t1 · (eA × eB) points out of A; h = (a0 - b0)·n = t1 · orient3d(a0, a1, b0, b1).
             let o = Plane::new(&[a0, a1, b0]).value(b1);
             let h = if t1 > 0 { o } else { Iv { lo: -o.hi, hi: -o.lo } };
-            let d = h.div(cross_norm2(&da, &db).sqrt());
+            let d = h.div(cross_norm2(&da, db).sqrt());
             cands.push(Candidate { axis: Axis::Edges(i as u32, j as u32), d });
         }
     }
@@ -228,22 +307,24 @@ pub fn penetration(a: &Polytope<'_>, b: &Polytope<'_>) -> Option<Penetration> {
         return None;
     }
     let contenders: Vec<&Candidate> = cands.iter().filter(|c| c.d.lo <= upper).collect();
-    let winner = match contenders.as_slice() {
+    // The winning axis, its exact `(h, |n|²)` when already computed, and an interval holding
+    // its depth.
+    let (winner, exact, d) = match contenders.as_slice() {
         [] => return None, // no axis at all (cannot happen for closed polytopes)
-        [only] if only.d.lo > 0.0 => only.axis,
+        [only] if only.d.lo > 0.0 => (only.axis, None, only.d),
         _ => {
-            let mut best: Option<(Axis, Dyadic, Dyadic)> = None;
+            let mut best: Option<(Axis, Dyadic, Dyadic, Iv)> = None;
             for c in &contenders {
                 let (h, n2) = exact_axis(a, b, c.axis);
                 let better = match &best {
                     None => true,
-                    Some((_, bh, bn)) => compare_depths(&h, &n2, bh, bn) == Ordering::Less,
+                    Some((_, bh, bn, _)) => compare_depths(&h, &n2, bh, bn) == Ordering::Less,
                 };
                 if better {
-                    best = Some((c.axis, h, n2));
+                    best = Some((c.axis, h, n2, c.d));
                 }
             }
-            let (axis, h, _) = best?;
+            let (axis, h, n2, d) = best?;
             if h.signum() < 0 {
                 return None;
             }
@@ -251,11 +332,11 @@ pub fn penetration(a: &Polytope<'_>, b: &Polytope<'_>) -> Option<Penetration> {
                 let (normal, point) = witness(a, b, axis, 0.0);
                 return Some(Penetration { depth: 0.0, normal, point, axis });
             }
-            axis
+            (axis, Some((h, n2)), d)
         }
     };
-    let (h, n2) = exact_axis(a, b, winner);
-    let depth = rounded_depth(&h, &n2);
+    let (h, n2) = exact.unwrap_or_else(|| exact_axis(a, b, winner));
+    let depth = rounded_depth(&h, &n2, (d.lo, d.hi));
     let (normal, point) = witness(a, b, winner, depth);
     Some(Penetration { depth, normal, point, axis: winner })
 }
@@ -270,8 +351,8 @@ pub fn exact_convex_penetration(
 ) -> Option<Option<Penetration>> {
     let sa = Surface::of(a.1).filter(|s| is_convex(a.0, a.1, s))?;
     let sb = Surface::of(b.1).filter(|s| is_convex(b.0, b.1, s))?;
-    let pa = Polytope { positions: a.0, triangles: a.1, surface: &sa };
-    let pb = Polytope { positions: b.0, triangles: b.1, surface: &sb };
+    let pa = Polytope { positions: a.0, triangles: a.1, surface: &sa, frames: None };
+    let pb = Polytope { positions: b.0, triangles: b.1, surface: &sb, frames: None };
     Some(penetration(&pa, &pb))
 }
 
@@ -296,8 +377,18 @@ struct Prune {
     separated: bool,
 }
 
+/// A face's f64 unit normal and a bound on its direction error ([`Plane::unit`]).
+type Unit = Option<(DVec3, f64)>;
+
 impl Prune {
-    fn new(a: &Polytope<'_>, na: &[Plane], b: &Polytope<'_>, nb: &[Plane]) -> Prune {
+    fn new(
+        a: &Polytope<'_>,
+        na: &[Plane],
+        ua: &[Unit],
+        b: &Polytope<'_>,
+        nb: &[Plane],
+        ub: &[Unit],
+    ) -> Prune {
         let verts =
             |p: &Polytope<'_>| -> Vec<DVec3> { p.surface.vertices.iter().map(|&v| p.vertex(v)).collect() };
         let (va, vb) = (verts(a), verts(b));
@@ -309,14 +400,15 @@ impl Prune {
         let max_a = va.iter().map(|v| v.dot(d)).fold(f64::NEG_INFINITY, f64::max);
         let min_b = vb.iter().map(|v| v.dot(d)).fold(f64::INFINITY, f64::min);
         let u = max_a - min_b + slack;
-        let ball = |p: &Polytope<'_>, planes: &[Plane], c: DVec3| -> Option<(DVec3, f64)> {
-            let r = planes
+        let ball = |p: &Polytope<'_>, planes: &[Plane], units: &[Unit], c: DVec3| -> Option<(DVec3, f64)> {
+            debug_assert_eq!(planes.len(), units.len());
+            let r = units
                 .iter()
                 .zip(p.triangles)
-                .map(|(pl, t)| match pl.unit() {
+                .map(|(unit, t)| match unit {
                     Some((n, err)) => {
                         let lever = p.vertex(t[0]) - c;
-                        lever.dot(n) - lever.length() * err - slack
+                        lever.dot(*n) - lever.length() * err - slack
                     }
                     None => f64::INFINITY, // degenerate: no facet
                 })
@@ -324,47 +416,78 @@ impl Prune {
             (r > 0.0 && r.is_finite()).then_some((c, r))
         };
         let separated = max_a - min_b + 2.0 * slack < 0.0;
-        Prune { u, slack, ball_a: ball(a, na, ca), ball_b: ball(b, nb, cb), separated }
+        Prune { u, slack, ball_a: ball(a, na, ua, ca), ball_b: ball(b, nb, ub, cb), separated }
     }
 
-    /// A lower bound of `(p - c)·n` for the exact unit normal `n` of `plane` (through `p`), with
-    /// `|p - c|`, the f64 unit normal and its direction error; `None` when the normal's
+    /// A lower bound of `(p - c)·n` for the exact unit normal `n` of a face (through its vertex
+    /// `p`), from the f64 unit normal and its direction error; `None` when the normal's
     /// direction is not known well enough.
-    fn lower(&self, plane: &Plane, p: DVec3, c: DVec3) -> Option<(f64, f64, DVec3, f64)> {
-        let (n, err) = plane.unit()?;
+    fn lower(&self, unit: Unit, p: DVec3, c: DVec3) -> Option<f64> {
+        let (n, err) = unit?;
         let lever = p - c;
-        let len = lever.length();
-        Some((lever.dot(n) - len * err - self.slack, len, n, err))
+        Some(lever.dot(n) - lever.length() * err - self.slack)
     }
 
-    /// Can the face with this plane (through `p`) be skipped against the other polytope's ball?
-    /// Its depth is at least `(p - c)·n + r`, whatever the sign of `(p - c)·n`.
-    fn skips_face(&self, plane: &Plane, p: DVec3, ball: Option<(DVec3, f64)>) -> bool {
-        let Some((c, r)) = ball else { return false };
-        self.lower(plane, p, c).is_some_and(|(x, ..)| x + r > self.u)
+    /// Every face's [`Prune::lower`] bound (at its first vertex) against the center of the
+    /// other polytope's ball; all `None` without a ball. The exact `(p - c)·n` is the same for
+    /// every point `p` of the face's plane, so the bound holds at each of its vertices.
+    fn face_lows(&self, p: &Polytope<'_>, units: &[Unit], ball: Option<(DVec3, f64)>) -> Vec<Option<f64>> {
+        match ball {
+            None => vec![None; units.len()],
+            Some((c, _)) => {
+                units.iter().zip(p.triangles).map(|(&unit, t)| self.lower(unit, p.vertex(t[0]), c)).collect()
+            }
+        }
     }
 
-    /// Can every axis of the edge between the faces of `p0` and `p1` (through its vertex `v`)
-    /// be skipped against the other polytope's ball? Its axes are the unit vectors `m` on the
-    /// arc between the two normals, where the depth is at least `(v - c)·m + r`. When that is
-    /// not negative at both normals it is at least the smaller of the two along the arc (a
-    /// sinusoid below both ends of an arc shorter than π would be negative at one of them);
-    /// otherwise it falls at most `|v - c|` times half the arc's angle below the smaller (the
-    /// slope along the arc is at most `|v - c|`), and half the angle is at most `π/4` times the
-    /// chord between the normals (the f64 chord plus both normals' direction errors).
-    fn skips_edge(&self, p0: &Plane, p1: &Plane, v: DVec3, ball: Option<(DVec3, f64)>) -> bool {
+    /// Can the face with this lower bound ([`Prune::face_lows`]) be skipped against the other
+    /// polytope's ball? Its depth is at least `(p - c)·n + r`, whatever the sign of `(p - c)·n`.
+    fn skips_face(&self, low: Option<f64>, ball: Option<(DVec3, f64)>) -> bool {
+        let Some((_, r)) = ball else { return false };
+        low.is_some_and(|x| x + r > self.u)
+    }
+
+    /// Can every axis of the edge between two faces (their lower bounds and unit normals) be
+    /// skipped against the other polytope's ball, `v` a vertex of the edge? Its axes are the
+    /// unit vectors `m` on the arc between the two normals, where the depth is at least
+    /// `(v - c)·m + r`. When that is not negative at both normals it is at least the smaller of
+    /// the two along the arc (a sinusoid below both ends of an arc shorter than π would be
+    /// negative at one of them); otherwise it falls at most `|v - c|` times half the arc's angle
+    /// below the smaller (the slope along the arc is at most `|v - c|`), and half the angle is at
+    /// most `π/4` times the chord between the normals (the f64 chord plus both normals'
+    /// direction errors). `v` lies on both faces' planes, so their bounds hold at `v`.
+    fn skips_edge(&self, faces: [(Option<f64>, Unit); 2], v: DVec3, ball: Option<(DVec3, f64)>) -> bool {
         let Some((c, r)) = ball else { return false };
-        let (Some((x0, len, n0, e0)), Some((x1, _, n1, e1))) = (self.lower(p0, v, c), self.lower(p1, v, c))
-        else {
+        let [(Some(x0), Some((n0, e0))), (Some(x1), Some((n1, e1)))] = faces else {
             return false;
         };
         let mut x = x0.min(x1);
         if x < 0.0 {
+            let len = (v - c).length();
             let chord = up((n0 - n1).length() + e0 + e1);
             x = x - up(len * up(chord * std::f64::consts::FRAC_PI_4)) - self.slack;
         }
         x + r > self.u
     }
+}
+
+/// A sign not decided yet (in the tables of [`penetration`]'s edge pairs).
+const UNKNOWN: i8 = 2;
+
+/// A slot for each face next to one of `edges` (of `p`, which has `faces` faces), numbered from
+/// 0 in the order met: the slot of every face (`u32::MAX` for the others) and their count.
+fn face_slots(p: &Polytope<'_>, edges: &[usize], faces: usize) -> (Vec<u32>, usize) {
+    let mut slots = vec![u32::MAX; faces];
+    let mut count = 0;
+    for &e in edges {
+        for f in p.surface.edges[e].f {
+            if slots[f as usize] == u32::MAX {
+                slots[f as usize] = count as u32;
+                count += 1;
+            }
+        }
+    }
+    (slots, count)
 }
 
 /// One candidate axis with an interval holding its exact `h / |n|`.
@@ -636,7 +759,10 @@ fn compare_depths(h1: &Dyadic, n1: &Dyadic, h2: &Dyadic, n2: &Dyadic) -> Orderin
 /// `h / √n2` (`n2 > 0`) correctly rounded to f64 (nearest, ties to even), 0 when `h <= 0`: a
 /// bisection over the bit patterns of non-negative floats (ordered as their values), each step an
 /// exact comparison of `x² · n2` with `h²`, then the midpoint rule between the two neighbours.
-fn rounded_depth(h: &Dyadic, n2: &Dyadic) -> f64 {
+/// `near` is an interval that should hold the depth (an f64 estimate's bounds): each end is
+/// compared exactly first and narrows the bisection only where the comparison allows, so a wrong
+/// interval costs steps, never the answer.
+fn rounded_depth(h: &Dyadic, n2: &Dyadic, near: (f64, f64)) -> f64 {
     if h.signum() <= 0 {
         return 0.0;
     }
@@ -648,6 +774,13 @@ fn rounded_depth(h: &Dyadic, n2: &Dyadic) -> f64 {
     };
     // The largest float not above the depth: bits in [lo, hi], `lo` always not above.
     let (mut lo, mut hi) = (0u64, f64::MAX.to_bits());
+    let usable = |x: f64| x.is_finite() && x > 0.0;
+    if usable(near.0) && against(near.0) != Ordering::Greater {
+        lo = near.0.to_bits();
+    }
+    if usable(near.1) && near.1.to_bits() > lo && against(near.1) == Ordering::Greater {
+        hi = near.1.to_bits() - 1;
+    }
     while lo < hi {
         let mid = lo + (hi - lo).div_ceil(2);
         if against(f64::from_bits(mid)) == Ordering::Greater {

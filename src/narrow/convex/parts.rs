@@ -39,7 +39,12 @@ impl ConvexPart {
 
     /// The polytope the depth computation reads.
     pub fn polytope(&self) -> Polytope<'_> {
-        Polytope { positions: &self.positions, triangles: &self.triangles, surface: &self.surface }
+        Polytope {
+            positions: &self.positions,
+            triangles: &self.triangles,
+            surface: &self.surface,
+            frames: None,
+        }
     }
 }
 

@@ -20,7 +20,12 @@ impl Shape {
         Shape { positions, triangles, surface }
     }
     fn poly(&self) -> Polytope<'_> {
-        Polytope { positions: &self.positions, triangles: &self.triangles, surface: &self.surface }
+        Polytope {
+            positions: &self.positions,
+            triangles: &self.triangles,
+            surface: &self.surface,
+            frames: None,
+        }
     }
     fn moved(&self, by: DVec3) -> Shape {
         Shape::new(self.positions.iter().map(|p| *p + by).collect(), self.triangles.clone())
@@ -341,8 +346,26 @@ proptest! {
 
 /// `h / √n2` is correctly rounded: the two midpoints around the result bracket the exact value
 /// (compared squared, in rationals), and exact quotients come out exact.
+/// Any interval given as a hint (holding the depth or not) gives the same result.
 fn assert_correctly_rounded(h: f64, n2: f64) {
-    let r = rounded_depth(&Dyadic::from_f64(h), &Dyadic::from_f64(n2));
+    let (hd, nd) = (Dyadic::from_f64(h), Dyadic::from_f64(n2));
+    let r = rounded_depth(&hd, &nd, (0.0, f64::INFINITY));
+    let e = h / n2.sqrt();
+    let step =
+        |x: f64, k: i64| if x > 0.0 { f64::from_bits((x.to_bits() as i64 + k).max(1) as u64) } else { x };
+    for near in [
+        (step(e, -2), step(e, 2)),
+        (step(e, -1), step(e, 1)),
+        (e, e),
+        (step(e, 1), step(e, 3)),
+        (step(e, -3), step(e, -1)),
+        (e * 0.5, e * 2.0),
+        (e * 2.0, e * 0.5),
+        (-1.0, f64::NAN),
+        (f64::MIN_POSITIVE, f64::MAX),
+    ] {
+        assert_eq!(rounded_depth(&hd, &nd, near).to_bits(), r.to_bits(), "{h} / sqrt({n2}) with {near:?}");
+    }
     if h <= 0.0 {
         assert_eq!(r, 0.0);
         return;
@@ -359,10 +382,10 @@ fn assert_correctly_rounded(h: f64, n2: f64) {
 fn depths_are_correctly_rounded() {
     for (h, n2, want) in [(3.0, 4.0, 1.5), (0.75, 1.0, 0.75), (7.0 * 1e-3, 1.0, 7.0 * 1e-3), (6.0, 9.0, 2.0)]
     {
-        assert_eq!(rounded_depth(&Dyadic::from_f64(h), &Dyadic::from_f64(n2)), want);
+        assert_eq!(rounded_depth(&Dyadic::from_f64(h), &Dyadic::from_f64(n2), (0.0, f64::INFINITY)), want);
         assert_correctly_rounded(h, n2);
     }
-    assert_eq!(rounded_depth(&Dyadic::from_f64(-1.0), &Dyadic::from_f64(2.0)), 0.0);
+    assert_eq!(rounded_depth(&Dyadic::from_f64(-1.0), &Dyadic::from_f64(2.0), (0.0, 1.0)), 0.0);
     assert_correctly_rounded(1.0, 2.0);
     assert_correctly_rounded(1e-300, 3.0);
     assert_correctly_rounded(1e300, 3.0);
@@ -373,4 +396,40 @@ proptest! {
     fn random_depths_are_correctly_rounded(h in 1e-30f64..1e30, n2 in 1e-30f64..1e30) {
         assert_correctly_rounded(h, n2);
     }
+}
+
+/// The same polytope with its coordinates snapped to multiples of 2^-10 (so that adding small
+/// integers is exact); `None` when snapping broke its exact convexity.
+fn snapped(s: &Shape) -> Option<Shape> {
+    let p: Vec<DVec3> = s.positions.iter().map(|v| (*v * 1024.0).round() / 1024.0).collect();
+    let out = Shape::new(p, s.triangles.clone());
+    is_convex(&out.positions, &out.triangles, &out.surface).then_some(out)
+}
+
+/// Frames found on a polytope's coordinates and reused for an exact translation of them give
+/// every bit of the penetration the frames found on the translated coordinates give.
+#[test]
+fn frames_of_an_exact_translation_give_the_same_penetration() {
+    let mut met = 0;
+    for (k, (n, m)) in [(5, 7), (8, 6), (9, 9), (12, 5), (7, 11)].into_iter().enumerate() {
+        let turn = 0.1 * k as f64;
+        let Some(a0) = snapped(&ngon_prism(n, 2.0, 0.0, DVec3::ZERO, 3.0)) else { continue };
+        let Some(b0) = snapped(&ngon_prism(m, 1.5, turn, DVec3::new(0.75, -0.5, 0.25), 2.5)) else {
+            continue;
+        };
+        let (fa, fb) = (Frames::of(&a0.positions, &a0.triangles), Frames::of(&b0.positions, &b0.triangles));
+        for by in [DVec3::new(3.0, -2.0, 1.0), DVec3::new(-1.0, 0.0, 0.0), DVec3::new(0.0, 5.0, -4.0)] {
+            let (a1, b1) = (a0.moved(by), b0.moved(by + DVec3::new(1.0, 0.0, 0.0)));
+            assert!(predicates::exact_translation(&a0.positions, &a1.positions).is_some());
+            assert!(predicates::exact_translation(&b0.positions, &b1.positions).is_some());
+            let plain = penetration(&a1.poly(), &b1.poly());
+            let framed = penetration(
+                &Polytope { frames: Some(&fa), ..a1.poly() },
+                &Polytope { frames: Some(&fb), ..b1.poly() },
+            );
+            assert_eq!(format!("{framed:?}"), format!("{plain:?}"));
+            met += usize::from(plain.is_some());
+        }
+    }
+    assert!(met >= 5, "only {met} overlapping cases");
 }
