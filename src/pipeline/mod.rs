@@ -789,7 +789,10 @@ fn run_on(req: &Request, progress: &(dyn Fn(Phase) + Sync), instanced: bool) -> 
     let result = &outcome.result;
     // Every finding's id, computed once: regions take theirs from them, an uncut list shows
     // them all, a cut one records the rest under `unlisted`, and a baseline compares them all.
-    let ids = crate::check::finding_id::finding_hashes(&result.pairs, &a.mesh, &b.mesh);
+    let ids = match &cache {
+        Some(c) => c.finding_ids(&outcome, |p| crate::check::finding_id::finding_hashes(p, &a.mesh, &b.mesh)),
+        None => crate::check::finding_id::finding_hashes(&result.pairs, &a.mesh, &b.mesh),
+    };
     let mut regions = crate::check::regions::regions_with_ids(&result.pairs, &a.mesh, &b.mesh, &ids);
     if req.penetration && !settings.first_hit {
         let opts = BuildOptions::default();
