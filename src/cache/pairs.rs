@@ -8,7 +8,10 @@
 //! pairs, closest pair, containment — instead of walking trees; the others are checked
 //! together, exactly as the check checks them, and stored. The reduction over the pairs, the
 //! tree-sharing figures and everything after the check (regions, finding ids, the baseline
-//! comparison, the report) are then those of a run without the cache.
+//! comparison, the report) are then those of a run without the cache; the finding ids of the
+//! reused pairs' triangle pairs are the stored ones ([`CheckCache::finding_ids`]), the same
+//! values (an id is a function of the two parts' names and exact world triangles, which the
+//! key holds).
 //!
 //! Exactness:
 //!
