@@ -493,11 +493,25 @@ impl PairReuse {
                 .map(|&(i, pa, pb)| {
                     let (ta, tb) = (&parts[pa].triangles, &parts[pb].triangles);
                     let local = &pending.fresh[i].1.result.pairs;
+                    // A part pair's triangle pairs come in order, near one another in the
+                    // merged list: each is searched from the last one found, by galloping.
+                    let mut from = 0usize;
                     let got: Option<Vec<u64>> = local
                         .iter()
                         .map(|p| {
                             let key = (*ta.get(p.a as usize)?, *tb.get(p.b as usize)?);
-                            let j = pairs.binary_search_by(|q| (q.a, q.b).cmp(&key)).ok()?;
+                            let at = |k: usize| (pairs[k].a, pairs[k].b);
+                            if from >= pairs.len() || at(from) > key {
+                                from = 0;
+                            }
+                            let (mut lo, mut step) = (from, 1usize);
+                            while lo + step < pairs.len() && at(lo + step) <= key {
+                                lo += step;
+                                step *= 2;
+                            }
+                            let hi = (lo + step + 1).min(pairs.len());
+                            let j = lo + pairs[lo..hi].binary_search_by(|q| (q.a, q.b).cmp(&key)).ok()?;
+                            from = j;
                             Some(ids[j])
                         })
                         .collect();
