@@ -12,7 +12,7 @@ use crate::shard::sha256::Sha256;
 /// The entry layout number: part of every [`PairKey`] and of every entry's header. Bump it when
 /// the key layouts, the entry header or the meaning of a stored value change, so that entries
 /// written before the change are never found.
-pub const FORMAT: u32 = 3;
+pub const FORMAT: u32 = 4;
 
 /// The tool version that goes into every [`PairKey`] and entry header: a cache written by
 /// another version of meshclash is never read.

@@ -31,6 +31,8 @@
 //! | 48 | the box: its lower, then its upper corner (3 × f64 bits each; finite, lower ≤ upper) |
 //! | 8 | the number of triangle pairs `t` (u64) |
 //! | t × … | each: triangle in A and in B (u32 each), kind (1 byte: 0 crossing, 1 touching, 2 clearance), contact (1 byte: 0 none, 1 point, 2 segment, 3 coplanar area, 4 coplanar boundary), distance bits (u64), 1 when a segment follows (1 byte), the segment (6 × f64 bits) |
+//! | 1 | 1 when the finding ids follow (see [`Stored::ids`]), else 0 |
+//! | t × 8 | the finding id of each triangle pair, in their order (u64) |
 //!
 //! Index payload: tag `MCLINDX` and the layout byte, the number of packs (u64), each pack's
 //! 32-byte key.
@@ -50,13 +52,13 @@ use super::key::Digest;
 
 /// The payload layout byte of packs and indexes; bump it (with [`super::FORMAT`]) when a
 /// layout below changes.
-pub const PACK_LAYOUT: u8 = 2;
+pub const PACK_LAYOUT: u8 = 3;
 
 const PACK_TAG: &[u8; 7] = b"MCLPACK";
 const INDEX_TAG: &[u8; 7] = b"MCLINDX";
 
 /// The fewest bytes one stored result takes (no reason, no closest pair, no triangle pairs).
-const MIN_RESULT: usize = 1 + 32 + 1 + 1 + 1 + 1 + 8;
+const MIN_RESULT: usize = 1 + 32 + 1 + 1 + 1 + 1 + 8 + 1;
 /// The fewest bytes one triangle pair takes.
 const MIN_FINDING: usize = 4 + 4 + 1 + 1 + 8 + 1;
 
@@ -76,6 +78,10 @@ pub struct Stored {
     /// be none (a part is open, or nothing is common), `Some(Some(box))` that box, `None` not
     /// known (a pair that is not a clash, or whose box was not computed).
     pub overlap: Option<Option<Overlap>>,
+    /// The finding id ([`crate::check::finding_id::finding_hash`]) of each of `result.pairs`,
+    /// in their order: a function of the two parts' names and exact world triangles, so of the
+    /// pair's key. `None`: not stored (computed when reused).
+    pub ids: Option<Vec<u64>>,
 }
 
 /// The least closest-pair candidate a check found over the part pairs it searched together
@@ -221,6 +227,16 @@ impl Writer {
                 }
             }
         }
+        // Ids that do not match the pairs one for one are not written (never produced).
+        match s.ids.as_ref().filter(|i| i.len() == r.pairs.len()) {
+            None => self.u8(0),
+            Some(ids) => {
+                self.u8(1);
+                for &id in ids {
+                    self.u64(id);
+                }
+            }
+        }
     }
 }
 
@@ -242,6 +258,7 @@ fn pack_len(pairs: &[(Digest, Stored)], trees: usize) -> usize {
                 + if matches!(s.overlap, Some(Some(_))) { 48 } else { 0 }
                 + r.pairs.len() * MIN_FINDING
                 + segs * 48
+                + s.ids.as_ref().filter(|i| i.len() == r.pairs.len()).map_or(0, |i| 8 * i.len())
         })
         .sum();
     8 + 8 + results + 8 + trees * 40
@@ -430,6 +447,14 @@ impl<'a> Reader<'a> {
             };
             pairs.push(PairFinding { a, b, kind, contact, distance, segment });
         }
+        let ids = match self.u8("ids flag")? {
+            0 => None,
+            1 => {
+                let b = self.take(8 * n, "ids")?;
+                Some(b.chunks_exact(8).map(|c| u64::from_le_bytes(c.try_into().expect("8 bytes"))).collect())
+            }
+            f => return Err(format!("bad ids flag {f}")),
+        };
         let result = ClashResult {
             pairs,
             counts,
@@ -440,7 +465,7 @@ impl<'a> Reader<'a> {
             trees: Default::default(),
             timings: Timings::default(),
         };
-        Ok(Stored { result, beyond, overlap })
+        Ok(Stored { result, beyond, overlap, ids })
     }
 }
 
@@ -536,7 +561,13 @@ mod tests {
                         max: DVec3::new(0.0, 1.0, 0.1),
                     })),
                 ][i % 3];
-                ([i as u8 + 1; 32], Stored { result: result(i as u32, c), beyond, overlap })
+                let result = result(i as u32, c);
+                let ids = (i % 3 != 1).then(|| {
+                    (0..result.pairs.len() as u64)
+                        .map(|k| k.wrapping_mul(0x9e37_79b9_7f4a_7c15) ^ i as u64)
+                        .collect()
+                });
+                ([i as u8 + 1; 32], Stored { result, beyond, overlap, ids })
             })
             .collect();
         Pack { pairs, trees: vec![([9; 32], 123), ([10; 32], u64::MAX)] }

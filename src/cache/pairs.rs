@@ -8,7 +8,10 @@
 //! pairs, closest pair, containment — instead of walking trees; the others are checked
 //! together, exactly as the check checks them, and stored. The reduction over the pairs, the
 //! tree-sharing figures and everything after the check (regions, finding ids, the baseline
-//! comparison, the report) are then those of a run without the cache.
+//! comparison, the report) are then those of a run without the cache; the finding ids of the
+//! reused pairs' triangle pairs are the stored ones ([`CheckCache::finding_ids`]), the same
+//! values (an id is a function of the two parts' names and exact world triangles, which the
+//! key holds).
 //!
 //! Exactness:
 //!
@@ -191,6 +194,21 @@ impl CheckCache {
         }
     }
 
+    /// The finding id ([`crate::check::finding_id::finding_hash`]) of each of `o`'s triangle
+    /// pairs, in their order: the stored ids of the reused part pairs, `compute` (the hashes of
+    /// the pairs it is given, in their order) for the others; the checked pairs' ids are stored
+    /// with their results. The same ids as `compute(&o.result.pairs)`: an id is a function of
+    /// the two parts' names and exact world triangles, which the pair's key holds.
+    pub fn finding_ids<F>(&self, o: &Outcome, compute: F) -> Vec<u64>
+    where
+        F: Fn(&[PairFinding]) -> Vec<u64>,
+    {
+        match self {
+            CheckCache::Whole(_) => compute(&o.result.pairs),
+            CheckCache::Pairs(p) => p.finding_ids(o, compute),
+        }
+    }
+
     /// The report's `cache` block for the check's outcome `o`.
     pub fn summary(&self, o: &Outcome) -> CacheSummary {
         match self {
@@ -258,6 +276,11 @@ struct Pending {
     used: Vec<Digest>,
     /// Part pair (a, b) -> the stored box of each reused clashing pair.
     boxes: HashMap<(usize, usize), Option<Overlap>>,
+    /// The stored finding ids of the reused pairs' triangle pairs: (triangle in A, in B, id),
+    /// in the input meshes' numbering.
+    known: Vec<(u32, u32, u64)>,
+    /// The part pair each run of `known` came from: (its pair key, the run's start and end).
+    known_from: Vec<(Digest, usize, usize)>,
 }
 
 /// What a run read from the cache.
@@ -388,6 +411,118 @@ impl PairReuse {
             part_pairs_checked: self.checked.load(Ordering::Relaxed),
             dir: self.store.dir().to_string_lossy().into_owned(),
         }
+    }
+
+    fn finding_ids<F>(&self, o: &Outcome, compute: F) -> Vec<u64>
+    where
+        F: Fn(&[PairFinding]) -> Vec<u64>,
+    {
+        use rayon::prelude::*;
+        let pairs = &o.result.pairs;
+        let mut guard = self.pending.lock().unwrap_or_else(|p| p.into_inner());
+        let Some(pending) = guard.as_mut() else {
+            // The check was not by pairs (delegated, or stood in for by a merge).
+            return compute(pairs);
+        };
+        let mut known = std::mem::take(&mut pending.known);
+        let from = std::mem::take(&mut pending.known_from);
+        if !from.is_empty() {
+            // Each part pair's stored ids are checked against the first of them computed again
+            // (the entry's checksum proved them as written; this proves them written for these
+            // triangles): a list that fails is not used, its ids are computed.
+            let probe = |&(a, b, _): &(u32, u32, u64)| PairFinding {
+                a,
+                b,
+                kind: crate::check::query::PairKind::Crossing,
+                contact: None,
+                distance: 0.0,
+                segment: None,
+            };
+            let firsts: Vec<PairFinding> = from.iter().map(|&(_, s, _)| probe(&known[s])).collect();
+            let mut keep = vec![true; known.len()];
+            for ((key, s, e), h) in from.iter().zip(compute(&firsts)) {
+                if known[*s].2 != h {
+                    self.store.warn(format!(
+                        "cache: ignored stored finding ids of {}: they are not these triangles'",
+                        super::key::to_hex(key)
+                    ));
+                    keep[*s..*e].iter_mut().for_each(|x| *x = false);
+                }
+            }
+            if keep.contains(&false) {
+                let mut i = 0;
+                known.retain(|_| {
+                    i += 1;
+                    keep[i - 1]
+                });
+            }
+        }
+        let ids = if known.is_empty() {
+            compute(pairs)
+        } else {
+            // Both lists sorted by (a, b) (the check's pairs are): one merge.
+            known.par_sort_unstable_by_key(|&(a, b, _)| (a, b));
+            let mut ids = vec![0u64; pairs.len()];
+            let mut missing_at = Vec::new();
+            let mut k = 0;
+            for (i, p) in pairs.iter().enumerate() {
+                while k < known.len() && (known[k].0, known[k].1) < (p.a, p.b) {
+                    k += 1;
+                }
+                match known.get(k) {
+                    Some(&(a, b, id)) if (a, b) == (p.a, p.b) => ids[i] = id,
+                    _ => missing_at.push(i),
+                }
+            }
+            if !missing_at.is_empty() {
+                let missing: Vec<PairFinding> = missing_at.iter().map(|&i| pairs[i]).collect();
+                for (&i, id) in missing_at.iter().zip(compute(&missing)) {
+                    ids[i] = id;
+                }
+            }
+            ids
+        };
+        // The checked pairs' ids, stored with their results (in their triangle pairs' order).
+        let sorted = pairs.windows(2).all(|w| (w[0].a, w[0].b) < (w[1].a, w[1].b));
+        if sorted && ids.len() == pairs.len() {
+            let parts = &o.parts;
+            let at: Vec<(usize, usize, usize)> =
+                pending.fresh_at.iter().map(|(&(a, b), &i)| (i, a, b)).collect();
+            let found: Vec<(usize, Option<Vec<u64>>)> = at
+                .par_iter()
+                .map(|&(i, pa, pb)| {
+                    let (ta, tb) = (&parts[pa].triangles, &parts[pb].triangles);
+                    let local = &pending.fresh[i].1.result.pairs;
+                    // A part pair's triangle pairs come in order, near one another in the
+                    // merged list: each is searched from the last one found, by galloping.
+                    let mut from = 0usize;
+                    let got: Option<Vec<u64>> = local
+                        .iter()
+                        .map(|p| {
+                            let key = (*ta.get(p.a as usize)?, *tb.get(p.b as usize)?);
+                            let at = |k: usize| (pairs[k].a, pairs[k].b);
+                            if from >= pairs.len() || at(from) > key {
+                                from = 0;
+                            }
+                            let (mut lo, mut step) = (from, 1usize);
+                            while lo + step < pairs.len() && at(lo + step) <= key {
+                                lo += step;
+                                step *= 2;
+                            }
+                            let hi = (lo + step + 1).min(pairs.len());
+                            let j = lo + pairs[lo..hi].binary_search_by(|q| (q.a, q.b).cmp(&key)).ok()?;
+                            from = j;
+                            Some(ids[j])
+                        })
+                        .collect();
+                    (i, got)
+                })
+                .collect();
+            for (i, got) in found {
+                pending.fresh[i].1.ids = got;
+            }
+        }
+        ids
     }
 
     fn overlaps<F>(&self, o: &Outcome, compute: F) -> Vec<Option<Overlap>>
@@ -542,6 +677,9 @@ impl PairReuse {
         // Reuse what is stored.
         let mut beyond: Vec<Option<Beyond>> = vec![None; candidates.len()];
         let mut boxes: HashMap<(usize, usize), Option<Overlap>> = HashMap::new();
+        let mut known: Vec<(u32, u32, u64)> = Vec::new();
+        let mut known_from: Vec<(Digest, usize, usize)> = Vec::new();
+        let lists = settings.detail != crate::check::query::Detail::Parts;
         let mut results: Vec<Option<ClashResult>> = candidates
             .iter()
             .zip(&pair_keys)
@@ -557,6 +695,13 @@ impl PairReuse {
                         *bound = stored.beyond;
                         if let Some(o) = overlap {
                             boxes.insert((a, b), o);
+                        }
+                        if let Some(ids) =
+                            stored.ids.as_ref().filter(|i| lists && !i.is_empty() && i.len() == r.pairs.len())
+                        {
+                            let start = known.len();
+                            known.extend(r.pairs.iter().zip(ids).map(|(p, &id)| (p.a, p.b, id)));
+                            known_from.push((*k.as_bytes(), start, known.len()));
                         }
                         Some(r)
                     }
@@ -603,8 +748,12 @@ impl PairReuse {
                 }
                 if let Some(l) = to_local(&keep, &parts[pp.a], &parts[pp.b]) {
                     // The overlap box is added when it is known (`PairReuse::overlaps`).
-                    let stored =
-                        Stored { result: l, beyond: if clear { bound } else { None }, overlap: None };
+                    let stored = Stored {
+                        result: l,
+                        beyond: if clear { bound } else { None },
+                        overlap: None,
+                        ids: None,
+                    };
                     fresh_at.insert((pp.a, pp.b), fresh.len());
                     fresh.push((*pair_keys[i].as_bytes(), stored));
                 }
@@ -679,7 +828,7 @@ impl PairReuse {
         .ok()?;
         let used: Vec<Digest> = loaded.packs.iter().filter(|(_, u)| *u).map(|(k, _)| *k).collect();
         // Stored once the overlap boxes of the clashing pairs are known.
-        let pending = Pending { fresh, fresh_at, trees: new_trees, used, boxes };
+        let pending = Pending { fresh, fresh_at, trees: new_trees, used, boxes, known, known_from };
         *self.pending.lock().unwrap_or_else(|p| p.into_inner()) = Some(pending);
         self.reused.store(reused, Ordering::Relaxed);
         self.checked.store(checked, Ordering::Relaxed);

@@ -868,3 +868,96 @@ fn overlap_boxes_are_reused_and_a_wrong_stored_box_is_recomputed() {
     assert_eq!((bits(&again), counts(&again)), (bits(&cold), (n, 0)));
     assert!(again.cache_warnings.is_empty(), "{:?}", again.cache_warnings);
 }
+
+#[test]
+fn finding_ids_are_stored_reused_and_a_wrong_list_is_recomputed() {
+    use crate::check::finding_id::finding_hash;
+    use crate::pipeline::{report, run, Request};
+    let d = tempfile::tempdir().unwrap();
+    let path = d.path().join("cubes.obj");
+    // Overlapping neighbours (each pair crosses in several triangle pairs) and one apart; a
+    // short list, so the report records the other ids under `unlisted`.
+    let mins = [[0.0, 0.0, 0.0], [0.5, 0.25, 0.0], [1.25, 0.5, 0.125], [1.75, 0.75, 0.5], [9.0, 0.0, 0.0]];
+    fs::write(&path, cubes_obj(&mins)).unwrap();
+    let mut req = Request::scene(&path);
+    req.deterministic = true;
+    req.max_pairs = 5;
+    let json = |o: &crate::pipeline::Outcome| {
+        let mut r = report::build(o);
+        r.cache = None;
+        crate::report::to_json(&r)
+    };
+    let in_pool = |threads: usize, req: &Request| {
+        let pool = rayon::ThreadPoolBuilder::new().num_threads(threads).build().unwrap();
+        pool.install(|| run(req, &|_| {}).unwrap())
+    };
+    let plain = in_pool(2, &req);
+    assert!(plain.assembly.result.pairs.len() > 10 && plain.unlisted.is_some());
+    let want = json(&plain);
+    let cache = d.path().join("c");
+    req.cache = Some(CacheConfig { dir: cache.clone(), max_bytes: DEFAULT_MAX_BYTES });
+    let cold = in_pool(2, &req);
+    assert_eq!(json(&cold), want);
+    // Every stored triangle pair carries its id: the hash of its two triangles in the mesh.
+    let mesh = &cold.inputs[0].input.mesh;
+    let parts = &cold.assembly.parts;
+    let mut stored = 0;
+    for (_, p) in packs_in(&cache) {
+        for (_, s) in &p.pairs {
+            let ids = s.ids.as_ref().expect("ids stored");
+            assert_eq!(ids.len(), s.result.pairs.len());
+            stored += ids.len();
+            // The pair's two parts: the ones whose numbering maps every pair to a finding.
+            let found = cold.assembly.part_pairs.iter().any(|pp| {
+                let (pa, pb) = (&parts[pp.a], &parts[pp.b]);
+                s.result.pairs.iter().zip(ids).all(|(q, &id)| {
+                    let (ta, tb) = (pa.triangles[q.a as usize], pb.triangles[q.b as usize]);
+                    finding_hash(mesh, ta, mesh, tb) == id
+                })
+            });
+            assert!(found || ids.is_empty(), "stored ids are no part pair's hashes");
+        }
+    }
+    assert_eq!(stored, cold.assembly.result.pairs.len());
+    // Warm, with one thread and two: the stored ids give the same report.
+    for threads in [1, 2] {
+        let warm = in_pool(threads, &req);
+        assert_eq!(warm.cache.as_ref().unwrap().part_pairs_checked, 0);
+        assert!(warm.cache_warnings.is_empty(), "{:?}", warm.cache_warnings);
+        assert_eq!(json(&warm), want, "{threads} threads");
+    }
+    // Stored ids that are not the pairs' (resealed, so the checksum holds) are refused with a
+    // warning per list and computed again.
+    let s = store(&cache);
+    let mut lists = 0;
+    for (key, mut p) in packs_in(&cache) {
+        for (_, st) in &mut p.pairs {
+            if let Some(ids) = st.ids.as_mut().filter(|i| !i.is_empty()) {
+                ids.iter_mut().for_each(|x| *x ^= 1);
+                lists += 1;
+            }
+        }
+        s.put_bytes(&key, &pack::encode_pack(&p.pairs, &p.trees));
+    }
+    assert!(lists >= 3);
+    let spoiled = in_pool(2, &req);
+    assert_eq!(json(&spoiled), want);
+    assert_eq!(spoiled.cache_warnings.len(), lists, "{:?}", spoiled.cache_warnings);
+    assert!(spoiled.cache_warnings.iter().all(|w| w.contains("finding ids")), "{:?}", spoiled.cache_warnings);
+    // A pack whose ids flag is neither 0 nor 1 does not decode: refused whole, its pairs checked.
+    let (key, p) =
+        packs_in(&cache).into_iter().find(|(_, p)| p.pairs.iter().any(|(_, s)| s.ids.is_some())).unwrap();
+    let mut bytes = pack::encode_pack(&p.pairs, &p.trees);
+    let mut none = p.clone();
+    none.pairs.iter_mut().for_each(|(_, s)| s.ids = None);
+    // The first byte where the layouts with and without ids part is the first ids flag.
+    let other = pack::encode_pack(&none.pairs, &none.trees);
+    let at = bytes.iter().zip(&other).position(|(x, y)| x != y).unwrap();
+    assert_eq!((bytes[at], other[at]), (1, 0));
+    bytes[at] = 7;
+    assert!(pack::decode_pack(&bytes).unwrap_err().contains("ids flag"));
+    s.put_bytes(&key, &bytes);
+    let refused = in_pool(2, &req);
+    assert_eq!(json(&refused), want);
+    assert!(refused.cache.as_ref().unwrap().part_pairs_checked > 0);
+}

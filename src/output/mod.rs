@@ -120,6 +120,6 @@ pub fn stdout_for(opts: &OutputOptions, rep: &Report, report_to_file: bool) -> (
 /// The report as pretty JSON with a trailing newline, streamed to `w` (the same bytes as
 /// [`crate::report::to_json`], never the whole text in memory).
 pub fn write_report_json(w: &mut dyn std::io::Write, rep: &Report) -> std::io::Result<()> {
-    serde_json::to_writer_pretty(&mut *w, rep).map_err(std::io::Error::from)?;
+    crate::report::pretty::write_pretty(&mut *w, rep)?;
     w.write_all(b"\n")
 }

@@ -833,9 +833,12 @@ fn run_on(req: &Request, progress: &(dyn Fn(Phase) + Sync), instanced: bool) -> 
     // Every finding's id, computed once: regions take theirs from them, an uncut list shows
     // them all, a cut one records the rest under `unlisted`, and a baseline compares them all.
     // The triangles of the pairs are read where they come from: an instanced scene places
-    // only those.
+    // only those. A cache supplies the ids of the pairs it reused.
     let (ta, tb) = (inputs[0].world_triangles(), inputs[1].world_triangles());
-    let ids = crate::check::finding_id::finding_hashes(&result.pairs, ta, tb);
+    let ids = match &cache {
+        Some(c) => c.finding_ids(&outcome, |p| crate::check::finding_id::finding_hashes(p, ta, tb)),
+        None => crate::check::finding_id::finding_hashes(&result.pairs, ta, tb),
+    };
     let mut regions = crate::check::regions::regions_with_ids(&result.pairs, ta, tb, &ids);
     if req.penetration && !settings.first_hit {
         let opts = BuildOptions::default();

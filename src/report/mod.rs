@@ -55,6 +55,7 @@
 
 pub mod baseline;
 pub mod clash_set;
+pub mod pretty;
 pub mod self_report;
 
 use crate::check::query::{ClashResult, Verdict};
@@ -899,7 +900,8 @@ pub fn verdict_from_name(s: &str) -> Option<Verdict> {
 
 /// The report as pretty JSON with a trailing newline.
 pub fn to_json(report: &Report) -> String {
-    let mut s = serde_json::to_string_pretty(report).expect("report serialises");
-    s.push('\n');
-    s
+    let mut s = Vec::new();
+    pretty::write_pretty(&mut s, report).expect("report serialises");
+    s.push(b'\n');
+    String::from_utf8(s).expect("JSON is UTF-8")
 }
