@@ -344,6 +344,10 @@ fn instances_past_the_expanded_vertex_limit_load_instanced_and_are_refused_expan
     // Splitting bodies reads the whole world mesh; two files are expanded as they load.
     expanded_is_refused(&["scene", f, "--split-bodies", "-o", "/dev/null"]);
     expanded_is_refused(&[f, concat!(env!("CARGO_MANIFEST_DIR"), "/meshes/fcl_rob.obj"), "-o", "/dev/null"]);
+    // An output that draws the geometry expands the scene: refused the same way, nothing written.
+    let glb = d.path().join("drawn.glb");
+    expanded_is_refused(&["scene", f, "--export-glb", glb.to_str().unwrap(), "-o", "/dev/null"]);
+    assert!(!glb.exists(), "a refused run wrote its drawing");
     // Instanced, it is checked (the instances are 2 apart: clear), its 6 GiB of expanded world
     // coordinates never made: it fits under 1 GiB of address space where that can be set.
     let report = d.path().join("r.json");

@@ -85,10 +85,17 @@ pub fn stage_files(
     staged: &mut write::Staged,
 ) -> Result<()> {
     let result = &outcome.assembly.result;
-    let [a, b] = outcome.meshes();
     if let Some(path) = &opts.junit {
         staged.stage(path, junit::from_report(rep).as_bytes())?;
     }
+    if opts.export_glb.is_none() && opts.html.is_none() && opts.bcf.is_none() {
+        return Ok(());
+    }
+    // An instanced scene is expanded only for an output that draws it, and refused, like a
+    // plain load of it, when it is too large to expand.
+    let [a, b] = outcome.meshes();
+    let (a, b) = (a.drawn_mesh()?, b.drawn_mesh()?);
+    let (a, b) = (&*a, &*b);
     if let Some(path) = &opts.export_glb {
         let z_up = opts.up.z_up(&rep.inputs.a.format);
         staged.stage(path, &glb::export(rep, result, a, b, z_up))?;

@@ -441,17 +441,6 @@ pub struct LoadedInput {
 }
 
 impl LoadedInput {
-    /// The mesh as the report reads it: the mesh in world coordinates, or for an instanced
-    /// input its objects alone (names, glTF meshes and matrices, as the expanded mesh has
-    /// them) without the geometry, made on first use. An output that draws the geometry reads
-    /// the world mesh through `Deref` ([`LoadedInput::world_mesh`]).
-    pub fn mesh(&self) -> &Mesh {
-        match &self.instanced {
-            Some(i) => i.objects.get_or_init(|| Mesh { objects: i.scene.objects(), ..Mesh::default() }),
-            None => &self.input.mesh,
-        }
-    }
-
     /// The mesh in world coordinates. An instanced input is expanded on first use (by an
     /// output that draws the geometry), exactly as the file's plain load gives it; a scene too
     /// large to expand (the expanded load's limits, which the instanced load does not apply)
@@ -473,6 +462,17 @@ impl LoadedInput {
         match &self.instanced {
             Some(i) => i.expanded.get_or_init(|| i.scene.expand().map(|l| l.mesh)).as_ref(),
             None => Ok(&self.input.mesh),
+        }
+    }
+
+    /// The world mesh for an output that draws it, or the expansion's error as the caller's
+    /// own: where the kept expansion failed, it is tried again (it refuses before it allocates).
+    pub fn drawn_mesh(&self) -> Result<std::borrow::Cow<'_, Mesh>> {
+        use std::borrow::Cow;
+        match (self.try_world_mesh(), &self.instanced) {
+            (Ok(m), _) => Ok(Cow::Borrowed(m)),
+            (Err(_), Some(i)) => i.scene.expand().map(|l| Cow::Owned(l.mesh)),
+            (Err(_), None) => Ok(Cow::Borrowed(&self.input.mesh)),
         }
     }
 
@@ -525,7 +525,6 @@ pub struct InstancedInput {
     /// place every part again for it).
     pub part_bounds: Vec<Aabb>,
     expanded: std::sync::OnceLock<Result<Mesh>>,
-    objects: std::sync::OnceLock<Mesh>,
 }
 
 impl std::fmt::Debug for InstancedInput {
@@ -574,13 +573,7 @@ fn load_scene_instanced(req: &Request, path: &Path) -> Result<LoadedInput> {
     let mut warnings = scene.warnings.clone();
     warnings.extend(range_warnings);
     let input = Input { path: path.to_path_buf(), format, mesh: Mesh::default(), warnings };
-    let instanced = InstancedInput {
-        scene,
-        info,
-        part_bounds,
-        expanded: std::sync::OnceLock::new(),
-        objects: std::sync::OnceLock::new(),
-    };
+    let instanced = InstancedInput { scene, info, part_bounds, expanded: std::sync::OnceLock::new() };
     Ok(LoadedInput {
         input,
         instanced: Some(std::sync::Arc::new(instanced)),

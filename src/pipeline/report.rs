@@ -130,8 +130,8 @@ pub fn build(o: &Outcome) -> Report {
             .zip(region_overlap)
             .enumerate()
             .map(|(i, (g, overlap))| RegionReport {
-                a_name: ia.mesh().objects[g.objects.0 as usize].name.clone(),
-                b_name: ib.mesh().objects[g.objects.1 as usize].name.clone(),
+                a_name: ia.world_triangles().object_name(g.objects.0).to_string(),
+                b_name: ib.world_triangles().object_name(g.objects.1).to_string(),
                 id: g.id.clone(),
                 a_object: g.objects.0,
                 b_object: g.objects.1,
