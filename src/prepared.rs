@@ -354,6 +354,14 @@ impl Placed {
         self.id
     }
 
+    /// Give this placement a fresh id, as placing the mesh again under the same transform
+    /// would, without redoing the work: a placement is a function of the prepared mesh and the
+    /// transform, so its world coordinates, tree and the facts found about them (ball,
+    /// convexity, topology) stay true; only answers kept under the old id stop applying.
+    pub fn renew_id(&mut self) {
+        self.id = next_id();
+    }
+
     /// The bounding ball of the world vertices ([`Ball`]), found once: the prepared mesh's own
     /// ball for the identity placement, its image ([`Ball::mapped`], no pass over the vertices)
     /// when the tree is mapped, else the ball of the world vertices.

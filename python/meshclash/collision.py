@@ -249,7 +249,8 @@ class CollisionManager:
         del self._meshes[name]
 
     def set_transform(self, name, transform):
-        """Replace the transform of object ``name``."""
+        """Replace the transform of object ``name`` (the very same transform keeps the
+        object's placement; the answers kept about it are dropped either way)."""
         if name not in self._meshes:
             raise ValueError(f"{name} not in collision manager!")
         m = _matrix(transform)

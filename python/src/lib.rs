@@ -1131,6 +1131,24 @@ impl Manager {
         self.placed(i);
     }
 
+    /// Object `i` set to the transform it already has (the same bits): its placement is
+    /// kept (placing the mesh again gives the same world coordinates; redoing it also pushed
+    /// the next query's data out of the caches), under a fresh id so that its pair answers are
+    /// dropped as after any move. False (nothing done) when the transform differs or the
+    /// placement is shared.
+    fn same_place(&mut self, i: usize, t: &DMat4) -> bool {
+        let bits = |m: &DMat4| m.to_cols_array().map(f64::to_bits);
+        if bits(&self.objs[i].transform) != bits(t) {
+            return false;
+        }
+        let old = self.objs[i].id();
+        let Some(p) = Arc::get_mut(&mut self.objs[i]) else { return false };
+        p.renew_id();
+        // Its box is the same: the sweep, the candidate pairs and the object tree stay.
+        self.memo.get_mut().unwrap().forget(old);
+        true
+    }
+
     /// Object `i` was placed anew (added or moved): its candidate pairs are found again.
     fn placed(&mut self, i: usize) {
         *self.tree.get_mut().unwrap() = None;
@@ -1222,8 +1240,12 @@ impl Manager {
 
     fn set_transform(&mut self, py: Python<'_>, name: &str, transform: Vec<Vec<f64>>) -> PyResult<()> {
         let i = self.find(name)?;
+        let t = transform_of(Some(transform))?;
+        if self.same_place(i, &t) {
+            return Ok(());
+        }
         let p = self.objs[i].prepared.clone();
-        let placed = place(py, &p, transform_of(Some(transform))?)?;
+        let placed = place(py, &p, t)?;
         self.set(i, placed);
         Ok(())
     }
