@@ -400,7 +400,9 @@ impl Sides {
 
     /// Is vertex `v` inside or on the other part? `test` is the exact point test; it is asked
     /// of `v` first and, when it cannot decide, of the other members of the class in vertex
-    /// order, so the answer is the same whichever member asks first.
+    /// order, so the answer is the same whichever member asks first. Members asking at once
+    /// wait for the first (a lock per class): `test` must not wait for other rayon tasks (the
+    /// point test and the lazy tree's cells run on the calling thread alone).
     fn inside<M: TriMesh + ?Sized>(
         &self,
         m: &M,
