@@ -294,8 +294,135 @@ where
     let mut cand = Vec::new();
     candidates(&acc, 0, a, &tb.root_box(), &mut cand);
     candidates(&acc, 1, b, &ta.root_box(), &mut cand);
-    vertices_inside(&mut acc, &cand, [&|p| inside_or_on(p, b, tb), &|p| inside_or_on(p, a, ta)])?;
+    if cand.is_empty() {
+        return acc.finish();
+    }
+    let (meet_a, meet_b) = meeting(a, ta, b, tb);
+    let (sides_a, sides_b) = rayon::join(|| Sides::new(a, &meet_a), || Sides::new(b, &meet_b));
+    let inside_a = |v: u32| sides_a.inside(a, v, |p| inside_or_on(p, b, tb));
+    let inside_b = |v: u32| sides_b.inside(b, v, |p| inside_or_on(p, a, ta));
+    vertices_inside(&mut acc, &cand, [&sides_a, &sides_b], [&inside_a, &inside_b])?;
     acc.finish()
+}
+
+/// Which triangles of A and of B may meet the other part's surface: those whose box meets the
+/// box of a triangle of the other part's tree (a superset of the crossing and touching ones).
+/// A triangle left out has no point on the other part's surface.
+fn meeting<A, TA, B, TB>(a: &A, ta: &TA, b: &B, tb: &TB) -> (Vec<bool>, Vec<bool>)
+where
+    A: TriMesh + ?Sized,
+    TA: Tree + ?Sized,
+    B: TriMesh + ?Sized,
+    TB: Tree + ?Sized,
+{
+    let found = traverse::fold_pairs(
+        ta,
+        tb,
+        |x, y| x.overlaps(y),
+        || (Vec::new(), Vec::new()),
+        |la, lb, (ma, mb): &mut (Vec<u32>, Vec<u32>)| {
+            let boxes_b: Vec<Aabb> = lb.iter().map(|&u| Aabb::of_triangle(&b.triangle(u))).collect();
+            let mut hit_b = vec![false; lb.len()];
+            for &t in la {
+                let bt = Aabb::of_triangle(&a.triangle(t));
+                let mut hit = false;
+                for (k, bu) in boxes_b.iter().enumerate() {
+                    if bt.overlaps(bu) {
+                        hit = true;
+                        hit_b[k] = true;
+                    }
+                }
+                if hit {
+                    ma.push(t);
+                }
+            }
+            mb.extend(lb.iter().zip(&hit_b).filter(|(_, &h)| h).map(|(&u, _)| u));
+        },
+        |(mut a0, mut b0), (a1, b1)| {
+            a0.extend(a1);
+            b0.extend(b1);
+            (a0, b0)
+        },
+    );
+    let mark = |n: usize, ts: Vec<u32>| {
+        let mut m = vec![false; n];
+        ts.into_iter().for_each(|t| m[t as usize] = true);
+        m
+    };
+    (mark(a.triangle_count(), found.0), mark(b.triangle_count(), found.1))
+}
+
+/// The vertices of a closed part grouped by the side of the other part's surface they lie on.
+///
+/// A triangle with no point on the other part's surface is connected, so all its points lie on
+/// one side: inside, or outside. The vertices of the triangles that do not meet the other part
+/// ([`meeting`]) are joined through those triangles into classes that share the answer of the
+/// exact point-in-solid test, asked once per class. A vertex of meeting triangles only is a
+/// class of its own (it may lie on the other part's surface) and gets its own test. The
+/// answers are the exact ones, so the box is the one every vertex tested on its own would give.
+struct Sides {
+    /// Per vertex, the representative of its class.
+    class: Vec<u32>,
+    /// Per representative, the answer once asked (None: undecided for every member).
+    answer: Vec<std::sync::OnceLock<Option<bool>>>,
+}
+
+impl Sides {
+    fn new<M: TriMesh + ?Sized>(m: &M, meets: &[bool]) -> Sides {
+        let n = m.vertex_count();
+        let mut parent: Vec<u32> = (0..n as u32).collect();
+        fn root(parent: &mut [u32], mut v: u32) -> u32 {
+            while parent[v as usize] != v {
+                let up = parent[parent[v as usize] as usize];
+                parent[v as usize] = up;
+                v = up;
+            }
+            v
+        }
+        for t in 0..m.triangle_count() as u32 {
+            if meets[t as usize] {
+                continue;
+            }
+            let [x, y, z] = m.indices(t);
+            let rx = root(&mut parent, x);
+            for w in [y, z] {
+                let rw = root(&mut parent, w);
+                let rx = root(&mut parent, rx);
+                if rw != rx {
+                    let (lo, hi) = (rw.min(rx), rw.max(rx));
+                    parent[hi as usize] = lo;
+                }
+            }
+        }
+        let class: Vec<u32> = (0..n as u32).map(|v| root(&mut parent, v)).collect();
+        Sides { class, answer: (0..n).map(|_| std::sync::OnceLock::new()).collect() }
+    }
+
+    /// Is vertex `v` inside or on the other part? `test` is the exact point test; it is asked
+    /// of `v` first and, when it cannot decide, of the other members of the class in vertex
+    /// order, so the answer is the same whichever member asks first. Members asking at once
+    /// wait for the first (a lock per class): `test` must not wait for other rayon tasks (the
+    /// point test and the lazy tree's cells run on the calling thread alone).
+    fn inside<M: TriMesh + ?Sized>(
+        &self,
+        m: &M,
+        v: u32,
+        test: impl Fn(DVec3) -> Option<bool>,
+    ) -> Option<bool> {
+        let c = self.class[v as usize];
+        *self.answer[c as usize].get_or_init(|| {
+            test(m.vertex(v)).or_else(|| {
+                (0..self.class.len() as u32)
+                    .filter(|&w| w != v && self.class[w as usize] == c)
+                    .find_map(|w| test(m.vertex(w)))
+            })
+        })
+    }
+
+    /// The answer of `v`'s class if it was asked already.
+    fn known(&self, v: u32) -> Option<Option<bool>> {
+        self.answer[self.class[v as usize] as usize].get().copied()
+    }
 }
 
 /// Triangles per run of [`edges_against`] (a cost setting only: the box is the same for any).
@@ -398,7 +525,8 @@ fn candidates<M: TriMesh + ?Sized>(
 /// when one of those cannot be decided.
 ///
 /// `cand` is from [`candidates`] (only those vertices can move the box) and `inside_other[s]`
-/// tests a point of part `s` against the other part. For each side of each axis, those beyond
+/// tests a vertex of part `s` against the other part, once per class of `sides[s]` ([`Sides`]):
+/// a vertex whose class was answered already costs no query. For each side of each axis, those beyond
 /// that side are taken from the most extreme inwards: the first one inside fixes the side
 /// (every later one lies at or inside it), and an undecided one met before it leaves no box.
 /// They are tested in batches, each batch's queries in parallel: one vertex first (a side
@@ -410,7 +538,8 @@ fn candidates<M: TriMesh + ?Sized>(
 fn vertices_inside(
     acc: &mut ExactBox,
     cand: &[(usize, u32, DVec3)],
-    inside_other: [&(dyn Fn(DVec3) -> Option<bool> + Sync); 2],
+    sides: [&Sides; 2],
+    inside_other: [&(dyn Fn(u32) -> Option<bool> + Sync); 2],
 ) -> Option<()> {
     use rayon::prelude::*;
     const UNTESTED: u8 = 0;
@@ -432,15 +561,26 @@ fn vertices_inside(
             let (mut at, mut size) = (0, 1);
             'side: while at < order.len() {
                 let batch = &order[at..(at + size).min(order.len())];
-                let todo: Vec<usize> = batch.iter().copied().filter(|&i| state[i] == UNTESTED).collect();
-                let answers: Vec<u8> = todo
-                    .par_iter()
-                    .map(|&i| match inside_other[cand[i].0](cand[i].2) {
-                        Some(true) => INSIDE,
-                        Some(false) => 2,
-                        None => UNDECIDED,
-                    })
-                    .collect();
+                let code = |a: Option<bool>| match a {
+                    Some(true) => INSIDE,
+                    Some(false) => 2,
+                    None => UNDECIDED,
+                };
+                let mut todo = Vec::new();
+                for &i in batch {
+                    if state[i] != UNTESTED {
+                        continue;
+                    }
+                    match sides[cand[i].0].known(cand[i].1) {
+                        Some(a) => state[i] = code(a),
+                        None => todo.push(i),
+                    }
+                }
+                let answers: Vec<u8> = if todo.len() > 1 {
+                    todo.par_iter().map(|&i| code(inside_other[cand[i].0](cand[i].1))).collect()
+                } else {
+                    todo.iter().map(|&i| code(inside_other[cand[i].0](cand[i].1))).collect()
+                };
                 for (&i, answer) in todo.iter().zip(answers) {
                     state[i] = answer;
                 }
@@ -624,5 +764,57 @@ mod tests {
         let want = Overlap { min: v(1.0, -2.0 / 3.0, 0.0), max: v(2.0, 2.0 / 3.0, 2.0) };
         assert_eq!(boxed(&t, &slab), Some(want));
         assert_eq!(boxed(&slab, &t), Some(want));
+    }
+
+    /// A closed solid of kind `kind` (a box cut into a grid, a torus, or a tilted tetrahedron)
+    /// scaled by `scale`, turned by `turn` about z and moved by `at`; with `snap` (boxes and
+    /// tetrahedra), every coordinate is rounded to a multiple of 1/8, so vertices land exactly
+    /// on the other part's faces, edges and vertices, and faces coincide.
+    fn solid(kind: u8, scale: f64, turn: f64, at: [f64; 3], snap: bool) -> Mesh {
+        let mut m = match kind {
+            0 => grid_box(v(-0.5, -0.5, -0.5), v(0.5, 0.5, 0.5), 2),
+            1 => crate::testing::gen::torus(96),
+            _ => Mesh {
+                positions: vec![
+                    v(-0.5, -0.5, -0.5),
+                    v(0.75, -0.25, -0.5),
+                    v(-0.25, 0.75, -0.4),
+                    v(-0.3, -0.2, 0.6),
+                ],
+                triangles: vec![[0, 2, 1], [0, 1, 3], [0, 3, 2], [1, 2, 3]],
+                tri_object: vec![0; 4],
+                objects: vec![Object::default()],
+            },
+        };
+        let (s, c) = turn.sin_cos();
+        for p in &mut m.positions {
+            let q = *p * scale;
+            *p = v(c * q.x - s * q.y + at[0], s * q.x + c * q.y + at[1], q.z + at[2]);
+            if snap && kind != 1 {
+                *p = (*p * 8.0).round() / 8.0;
+            }
+        }
+        m
+    }
+
+    proptest::proptest! {
+        #![proptest_config(proptest::prelude::ProptestConfig::with_cases(256))]
+
+        /// Deciding vertices a class at a time gives the box of every edge against every face
+        /// and every vertex tested on its own, bit for bit, in both part orders.
+        #[test]
+        fn random_closed_parts_give_the_brute_force_box(
+            kinds in (0u8..3, 0u8..3),
+            scales in (0.5f64..2.0, 0.5f64..2.0),
+            turns in (0.0f64..3.2, 0.0f64..3.2),
+            at in [-1.0f64..1.0, -1.0f64..1.0, -0.6f64..0.6],
+            snap in proptest::bool::ANY,
+        ) {
+            let a = solid(kinds.0, scales.0, turns.0, [0.0; 3], snap);
+            let b = solid(kinds.1, scales.1, turns.1, at, snap);
+            let want = brute(&a, &b);
+            proptest::prop_assert_eq!(boxed(&a, &b), want);
+            proptest::prop_assert_eq!(boxed(&b, &a), want);
+        }
     }
 }
