@@ -817,16 +817,22 @@ fn packs_in(dir: &Path) -> Vec<(PairKey, pack::Pack)> {
     out
 }
 
-#[test]
-fn overlap_boxes_are_reused_and_a_wrong_stored_box_is_recomputed() {
-    use crate::pipeline::{run, Request};
-    let d = tempfile::tempdir().unwrap();
-    let path = d.path().join("cubes.obj");
-    // A chain of overlapping cubes (each pair of neighbours has an overlap box) and one apart.
+/// A scene request for a chain of overlapping cubes written into `dir`: each pair of neighbours
+/// crosses in several triangle pairs and has an overlap box; one more cube lies apart.
+fn chain_of_cubes(dir: &Path) -> crate::pipeline::Request {
+    let path = dir.join("cubes.obj");
     let mins = [[0.0, 0.0, 0.0], [0.5, 0.25, 0.0], [1.25, 0.5, 0.125], [1.75, 0.75, 0.5], [9.0, 0.0, 0.0]];
     fs::write(&path, cubes_obj(&mins)).unwrap();
-    let mut req = Request::scene(&path);
+    let mut req = crate::pipeline::Request::scene(&path);
     req.deterministic = true;
+    req
+}
+
+#[test]
+fn overlap_boxes_are_reused_and_a_wrong_stored_box_is_recomputed() {
+    use crate::pipeline::run;
+    let d = tempfile::tempdir().unwrap();
+    let mut req = chain_of_cubes(d.path());
     let bits = |o: &crate::pipeline::Outcome| format!("{:?}", o.overlaps);
     let cold = run(&req, &|_| {}).unwrap();
     let boxes = cold.overlaps.iter().flatten().count();
@@ -874,13 +880,8 @@ fn finding_ids_are_stored_reused_and_a_wrong_list_is_recomputed() {
     use crate::check::finding_id::finding_hash;
     use crate::pipeline::{report, run, Request};
     let d = tempfile::tempdir().unwrap();
-    let path = d.path().join("cubes.obj");
-    // Overlapping neighbours (each pair crosses in several triangle pairs) and one apart; a
-    // short list, so the report records the other ids under `unlisted`.
-    let mins = [[0.0, 0.0, 0.0], [0.5, 0.25, 0.0], [1.25, 0.5, 0.125], [1.75, 0.75, 0.5], [9.0, 0.0, 0.0]];
-    fs::write(&path, cubes_obj(&mins)).unwrap();
-    let mut req = Request::scene(&path);
-    req.deterministic = true;
+    let mut req = chain_of_cubes(d.path());
+    // A short list, so the report records the other ids under `unlisted`.
     req.max_pairs = 5;
     let json = |o: &crate::pipeline::Outcome| {
         let mut r = report::build(o);
