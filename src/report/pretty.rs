@@ -71,23 +71,15 @@ impl Out<'_> {
         self.raw(bracket);
     }
 
+    // Strings and integers are formatted by serde_json itself (the same bytes as its
+    // serializer writes); appending to a `Vec` cannot fail.
     fn string(&mut self, s: &str) {
-        escape_into(&mut self.buf, s);
+        let _appended = serde_json::to_writer(&mut self.buf, s).is_ok();
     }
 
     fn u64(&mut self, x: u64) {
-        let mut digits = [0u8; 20];
-        let mut i = digits.len();
-        let mut x = x;
-        loop {
-            i -= 1;
-            digits[i] = b'0' + (x % 10) as u8;
-            x /= 10;
-            if x == 0 {
-                break;
-            }
-        }
-        self.buf.extend_from_slice(&digits[i..]);
+        use serde_json::ser::Formatter;
+        let _appended = serde_json::ser::CompactFormatter.write_u64(&mut self.buf, x).is_ok();
     }
 
     fn bool(&mut self, b: bool) {
@@ -122,40 +114,6 @@ impl Out<'_> {
         self.key(first, level, key);
         self.serde(level, v)
     }
-}
-
-/// `s` as a JSON string, escaped as serde_json escapes it: `"` and `\` with a backslash, the
-/// control characters below 0x20 as `\b`, `\t`, `\n`, `\f`, `\r` or `\u00xx` (lowercase hex),
-/// everything else as it is.
-pub(crate) fn escape_into(buf: &mut Vec<u8>, s: &str) {
-    const HEX: &[u8; 16] = b"0123456789abcdef";
-    buf.push(b'"');
-    let bytes = s.as_bytes();
-    let mut start = 0;
-    for (i, &c) in bytes.iter().enumerate() {
-        let short = match c {
-            b'"' => b'"',
-            b'\\' => b'\\',
-            0x08 => b'b',
-            0x09 => b't',
-            0x0A => b'n',
-            0x0C => b'f',
-            0x0D => b'r',
-            0x00..=0x1F => b'u',
-            _ => continue,
-        };
-        buf.extend_from_slice(&bytes[start..i]);
-        start = i + 1;
-        buf.push(b'\\');
-        buf.push(short);
-        if short == b'u' {
-            buf.extend_from_slice(b"00");
-            buf.push(HEX[(c >> 4) as usize]);
-            buf.push(HEX[(c & 0xf) as usize]);
-        }
-    }
-    buf.extend_from_slice(&bytes[start..]);
-    buf.push(b'"');
 }
 
 /// `rep` as serde_json's pretty JSON (no trailing newline), written to `w`.
@@ -540,9 +498,10 @@ mod tests {
         let mut all: String = (0u8..0x80).map(char::from).collect();
         all.push_str("é\u{2028}😀");
         for s in std::iter::once(all).chain((0..500).map(|_| r.string())) {
-            let mut got = Vec::new();
-            escape_into(&mut got, &s);
-            assert_eq!(got, serde_json::to_vec(&s).unwrap(), "{s:?}");
+            let mut sink = Vec::new();
+            let mut out = Out { buf: Vec::new(), w: &mut sink, scratch: Vec::new() };
+            out.string(&s);
+            assert_eq!(out.buf, serde_json::to_vec(&s).unwrap(), "{s:?}");
         }
     }
 }
