@@ -493,16 +493,6 @@ impl LoadedInput {
             None => std::borrow::Cow::Owned(query::MeshInfo::of(&self.input.mesh)),
         }
     }
-
-    /// The object triangle `t` belongs to; `parts` are the check's parts of this input.
-    pub fn object_of(&self, parts: &[assembly::Part], t: u32) -> u32 {
-        if self.instanced.is_none() {
-            return self.input.mesh.tri_object[t as usize];
-        }
-        // An instanced scene's parts hold consecutive runs of its triangles, in object order.
-        let k = parts.partition_point(|p| p.triangles.first().is_some_and(|&f| f <= t));
-        parts[k.saturating_sub(1)].object
-    }
 }
 
 /// A loaded input reads as its world mesh ([`LoadedInput::world_mesh`]: an instanced scene is

@@ -70,8 +70,8 @@ pub fn build(o: &Outcome) -> Report {
         rayon::join(|| ia.info().into_owned(), || ib.info().into_owned())
     };
     // The object of a triangle of A, of B.
-    let parts = &o.assembly.parts;
-    let (oa, ob) = (|t| ia.object_of(parts, t), |t| ib.object_of(parts, t));
+    let (ta, tb) = (ia.world_triangles(), ib.world_triangles());
+    let (oa, ob) = (|t| ta.object_of(t), |t| tb.object_of(t));
     let (assembly, parts, mut part_pairs) = assembly_view(&o.assembly, o.settings.max_pairs);
     for (pp, ov) in part_pairs.iter_mut().zip(&o.overlaps) {
         pp.overlap = ov.as_ref().map(OverlapReport::of);
