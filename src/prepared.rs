@@ -46,6 +46,8 @@ pub struct Prepared {
     /// The vertex pairs and triangles whose coincidence or collinearity rounding under a
     /// placement could change ([`Fragile`]).
     fragile: OnceLock<Option<Fragile>>,
+    /// The exact box of every vertex in the mesh's own coordinates (used or not).
+    root: Aabb,
 }
 
 impl Prepared {
@@ -53,6 +55,7 @@ impl Prepared {
     pub fn new(label: &Path, mesh: Mesh, opts: BuildOptions) -> Result<Prepared> {
         query::check_range(&mesh, label)?;
         let tree = Bvh::build(&mesh, opts);
+        let root = Aabb::of_points(&mesh.positions);
         Ok(Prepared {
             mesh,
             tree,
@@ -63,6 +66,7 @@ impl Prepared {
             topology: OnceLock::new(),
             ball: OnceLock::new(),
             fragile: OnceLock::new(),
+            root,
         })
     }
 
@@ -82,9 +86,8 @@ impl Prepared {
 
     fn own_ball(&self) -> &(Ball, bool) {
         self.ball.get_or_init(|| {
-            let pos = &self.mesh.positions;
-            let root = Aabb::of_points(pos);
-            (Ball::of_points(pos, &root), self.tree.bounds().contains(&root))
+            let root = &self.root;
+            (Ball::of_points(&self.mesh.positions, root), self.tree.bounds().contains(root))
         })
     }
 
@@ -106,25 +109,43 @@ impl Prepared {
         self.topology.get_or_init(|| Arc::new(containment::topology(&self.mesh)))
     }
 
-    /// Place the mesh: every vertex transformed in f64 (as `--transform` does; identity keeps
-    /// the coordinates as they are), the tree mapped onto the result conservatively.
+    /// Place the mesh under `m`. Nothing is computed on the vertices yet: the placement keeps
+    /// the transform and a box that holds every world vertex ([`reach`]), enough for a broad
+    /// phase; the world coordinates (every vertex transformed in f64, as `--transform` does;
+    /// identity keeps the coordinates as they are), the tree mapped onto them and their exact
+    /// box are computed when a query first reads them ([`Placed::positions`]). The errors of
+    /// the world coordinates (a vertex not finite or beyond the exact range) are raised here:
+    /// when the box does not show every vertex clear of them, the vertices are placed now.
     pub fn place(self: &Arc<Self>, m: DMat4) -> Result<Placed> {
-        let local = &self.mesh.positions;
+        let placed = |reach: Aabb, laid: OnceLock<Laid>| Placed {
+            prepared: self.clone(),
+            transform: m,
+            reach,
+            laid,
+            topology: OnceLock::new(),
+            convex: OnceLock::new(),
+            translated: OnceLock::new(),
+            ball: OnceLock::new(),
+            id: next_id(),
+        };
         if m == DMat4::IDENTITY {
-            let root = Aabb::of_points(local);
-            return Ok(Placed {
-                prepared: self.clone(),
-                transform: m,
-                world: None,
-                tree: Mapping::Own,
-                root,
-                topology: OnceLock::new(),
-                convex: OnceLock::new(),
-                translated: OnceLock::new(),
-                ball: OnceLock::new(),
-                id: next_id(),
-            });
+            let laid = Laid { world: None, tree: Mapping::Own, root: self.root };
+            return Ok(placed(self.root, OnceLock::from(laid)));
         }
+        if let Some(reach) = reach(&rows_of(&m), &self.root).filter(|r| {
+            let bound = r.min.abs().max(r.max.abs()).max_element();
+            bound.is_finite() && bound <= predicates::MAX_EXACT_MAGNITUDE
+        }) {
+            return Ok(placed(reach, OnceLock::new()));
+        }
+        self.place_now(m)
+    }
+
+    /// Place the mesh under `m` (not the identity) with its world coordinates computed at once:
+    /// the first vertex that is not finite or beyond the exact range after the transform is the
+    /// error.
+    fn place_now(self: &Arc<Self>, m: DMat4) -> Result<Placed> {
+        let local = &self.mesh.positions;
         let mut world = Vec::with_capacity(local.len());
         for (i, p) in local.iter().enumerate() {
             let w = m.transform_point3(*p);
@@ -137,19 +158,12 @@ impl Prepared {
             }
             world.push(w);
         }
-        let rows = [0, 1, 2].map(|k| [m.x_axis[k], m.y_axis[k], m.z_axis[k], m.w_axis[k]]);
-        let tree =
-            match BoxMap::fit(rows, &self.tree.bounds(), local.iter().copied().zip(world.iter().copied())) {
-                Some(map) => Mapping::Mapped(map),
-                None => Mapping::Refit(refit(&self.tree, &world, &self.mesh.triangles)),
-            };
-        let root = Aabb::of_points(&world);
+        let laid = self.lay(&m, world);
         Ok(Placed {
             prepared: self.clone(),
             transform: m,
-            world: Some(world),
-            tree,
-            root,
+            reach: laid.root,
+            laid: OnceLock::from(laid),
             topology: OnceLock::new(),
             convex: OnceLock::new(),
             translated: OnceLock::new(),
@@ -157,6 +171,46 @@ impl Prepared {
             id: next_id(),
         })
     }
+
+    /// The tree mapped onto the world coordinates `world` (placed by `m`, not the identity) and
+    /// their exact box.
+    fn lay(&self, m: &DMat4, world: Vec<DVec3>) -> Laid {
+        let local = &self.mesh.positions;
+        let pairs = local.iter().copied().zip(world.iter().copied());
+        let tree = match BoxMap::fit(rows_of(m), &self.tree.bounds(), pairs) {
+            Some(map) => Mapping::Mapped(map),
+            None => Mapping::Refit(refit(&self.tree, &world, &self.mesh.triangles)),
+        };
+        let root = Aabb::of_points(&world);
+        Laid { world: Some(world), tree, root }
+    }
+}
+
+/// The rows `[r_i0, r_i1, r_i2, t_i]` of the affine part of `m`.
+fn rows_of(m: &DMat4) -> [[f64; 4]; 3] {
+    [0, 1, 2].map(|k| [m.x_axis[k], m.y_axis[k], m.z_axis[k], m.w_axis[k]])
+}
+
+/// A box that holds the f64 image (`DMat4::transform_point3`, whatever the order of its
+/// products and sums) of every point of `root` under the affine map `rows`, found from `root`
+/// alone; `None` when the map is not finite. The box is the map's image of `root` with no
+/// measured deviation ([`BoxMap::fit`] over no vertex pair: it holds every point whose f64
+/// image is `fl(R x + t)` evaluated in the map's order), widened by the search margin of the
+/// map's scale `S = max_i (|t_i| + Σ_j |r_ij| max(|root.min_j|, |root.max_j|))`
+/// ([`predicates::distance_rounding_slack`], 128 units of rounding of `S`). That covers the
+/// rest: an image computed in another order is, like `fl(R x + t)`, within `γ_4 S` of the exact
+/// image (Higham, §3.1; `γ_4 ≈ 4u`), so within `8.1u S` of `fl(R x + t)`, and the widening
+/// itself rounds by at most `u (|box| + margin)`, about `u S`.
+pub fn reach(rows: &[[f64; 4]; 3], root: &Aabb) -> Option<Aabb> {
+    let map = BoxMap::fit(*rows, root, std::iter::empty())?;
+    let big = root.min.abs().max(root.max.abs()).to_array();
+    let scale = rows
+        .iter()
+        .map(|r| r[3].abs() + (0..3).map(|j| r[j].abs() * big[j]).sum::<f64>())
+        .fold(0.0f64, f64::max);
+    let margin = DVec3::splat(predicates::distance_rounding_slack(scale));
+    let b = map.map_box(root);
+    Some(Aabb { min: b.min - margin, max: b.max + margin })
 }
 
 /// A fresh placement id (never reused in the process).
@@ -191,16 +245,27 @@ fn refit(template: &Bvh, world: &[DVec3], tris: &[[u32; 3]]) -> Bvh {
     Bvh { nodes, prims: template.prims.clone() }
 }
 
-/// A prepared mesh under one placement: its world coordinates and a view of the prepared tree.
+/// What a placement computes on the vertices: the world coordinates (`None`: the prepared
+/// mesh's own), the view of the prepared tree, the exact world box.
+#[derive(Debug)]
+struct Laid {
+    world: Option<Vec<DVec3>>,
+    tree: Mapping,
+    root: Aabb,
+}
+
+/// A prepared mesh under one placement: its world coordinates and a view of the prepared tree,
+/// computed when first read.
 #[derive(Debug)]
 pub struct Placed {
     /// The prepared mesh.
     pub prepared: Arc<Prepared>,
     /// The placement.
     pub transform: DMat4,
-    world: Option<Vec<DVec3>>,
-    tree: Mapping,
-    root: Aabb,
+    /// A box holding every world vertex, known without them ([`reach`]; the exact box when
+    /// they were computed at once).
+    reach: Aabb,
+    laid: OnceLock<Laid>,
     topology: OnceLock<Arc<Topology>>,
     convex: OnceLock<bool>,
     translated: OnceLock<bool>,
@@ -292,9 +357,40 @@ impl TriMesh for PlacedMesh<'_> {
 }
 
 impl Placed {
+    /// The world coordinates, tree view and exact box, computed on first use (every vertex
+    /// transformed as [`Prepared::place`] would have at once: `place` checked them already).
+    fn laid(&self) -> &Laid {
+        self.laid.get_or_init(|| {
+            let m = &self.transform;
+            let world: Vec<DVec3> = self.prepared.mesh.positions.iter().map(|p| m.transform_point3(*p)).collect();
+            debug_assert!(world.iter().all(|w| w.abs().max_element() <= predicates::MAX_EXACT_MAGNITUDE));
+            self.prepared.lay(m, world)
+        })
+    }
+
     /// The world coordinates.
     pub fn positions(&self) -> &[DVec3] {
-        self.world.as_deref().unwrap_or(&self.prepared.mesh.positions)
+        self.laid().world.as_deref().unwrap_or(&self.prepared.mesh.positions)
+    }
+
+    /// The world coordinates of vertex `v`: the very value [`Placed::positions`] holds, found
+    /// alone (when the world coordinates are not computed yet, by transforming that vertex
+    /// as they would be).
+    pub fn vertex(&self, v: u32) -> DVec3 {
+        match self.laid.get() {
+            Some(l) => l.world.as_ref().map_or(self.prepared.mesh.positions[v as usize], |w| w[v as usize]),
+            None => self.transform.transform_point3(self.prepared.mesh.positions[v as usize]),
+        }
+    }
+
+    /// The world corners of triangle `t` ([`Placed::vertex`]).
+    pub fn triangle(&self, t: u32) -> [DVec3; 3] {
+        self.prepared.mesh.triangles[t as usize].map(|v| self.vertex(v))
+    }
+
+    /// Are the world coordinates computed (a query has read them)?
+    pub fn is_laid(&self) -> bool {
+        self.laid.get().is_some()
     }
 
     /// The mesh view.
@@ -304,17 +400,24 @@ impl Placed {
 
     /// The tree view.
     pub fn tree(&self) -> MappedTree<'_> {
-        let (bvh, map) = match &self.tree {
+        let laid = self.laid();
+        let (bvh, map) = match &laid.tree {
             Mapping::Own => (&self.prepared.tree, None),
             Mapping::Mapped(m) => (&self.prepared.tree, Some(*m)),
             Mapping::Refit(t) => (t, None),
         };
-        MappedTree { bvh, map, root: self.root }
+        MappedTree { bvh, map, root: laid.root }
     }
 
     /// The exact world box.
     pub fn bounds(&self) -> Aabb {
-        self.root
+        self.laid().root
+    }
+
+    /// A box holding every world vertex, known from the placement alone ([`reach`]); the exact
+    /// box when the placement computed the world coordinates at once. It never changes.
+    pub fn reach(&self) -> Aabb {
+        self.reach
     }
 
     /// Exact: are the world coordinates a convex polytope facing out? The prepared mesh's
@@ -327,7 +430,7 @@ impl Placed {
             if !p.is_convex() {
                 return false;
             }
-            match &self.world {
+            match &self.laid().world {
                 _ if self.translated() => true,
                 None => true,
                 Some(w) => p.surface().is_some_and(|s| convex::is_convex(w, &p.mesh.triangles, s)),
@@ -343,7 +446,7 @@ impl Placed {
         let p = &self.prepared;
         let surface = p.surface()?;
         // Own coordinates or an exact translation of them: the prepared mesh's face frames.
-        let frames = (self.world.is_none() || self.translated())
+        let frames = (self.laid().world.is_none() || self.translated())
             .then(|| p.frames.get_or_init(|| convex::Frames::of(&p.mesh.positions, &p.mesh.triangles)));
         Some(Polytope { positions: self.positions(), triangles: &p.mesh.triangles, surface, frames })
     }
@@ -366,19 +469,37 @@ impl Placed {
     /// ball for the identity placement, its image ([`Ball::mapped`], no pass over the vertices)
     /// when the tree is mapped, else the ball of the world vertices.
     pub fn ball(&self) -> Ball {
-        *self.ball.get_or_init(|| match &self.tree {
-            Mapping::Own => self.prepared.ball(),
-            Mapping::Mapped(map) if self.prepared.own_ball().1 => {
-                self.prepared.ball().mapped(map, &self.root)
+        *self.ball.get_or_init(|| {
+            let laid = self.laid();
+            match &laid.tree {
+                Mapping::Own => self.prepared.ball(),
+                Mapping::Mapped(map) if self.prepared.own_ball().1 => {
+                    self.prepared.ball().mapped(map, &laid.root)
+                }
+                Mapping::Mapped(_) | Mapping::Refit(_) => Ball::of_points(self.positions(), &laid.root),
             }
-            Mapping::Mapped(_) | Mapping::Refit(_) => Ball::of_points(self.positions(), &self.root),
         })
     }
 
     /// Certainly apart (by their boxes or their balls): the two can neither collide nor be
-    /// nearer than [`Placed::gap`].
+    /// nearer than [`Placed::gap`]. Boxes that hold them ([`Placed::reach`]) and miss settle
+    /// it without the world coordinates.
     pub fn apart(&self, o: &Placed) -> bool {
-        !self.bounds().overlaps(&o.bounds()) || self.ball().apart(&o.ball())
+        !self.reach.overlaps(&o.reach) || !self.bounds().overlaps(&o.bounds()) || self.ball().apart(&o.ball())
+    }
+
+    /// A lower bound of [`Placed::gap`] (so of the distance between the two meshes) from the
+    /// boxes that hold them ([`Placed::reach`]) alone: their distance less the search margin
+    /// of their coordinates' scale (0 when they overlap). The boxes hold the exact ones, and
+    /// their scale is at least theirs: the f64 box distance only shrinks and the margin grows.
+    pub fn reach_gap(&self, o: &Placed) -> f64 {
+        (self.reach.distance_sq(&o.reach).sqrt() - self.reach_margin().max(o.reach_margin())).max(0.0)
+    }
+
+    /// The search margin of the scale of [`Placed::reach`]: at least the margin of the world
+    /// coordinates' scale ([`Ball::slack`]).
+    pub fn reach_margin(&self) -> f64 {
+        predicates::distance_rounding_slack(self.reach.max_abs())
     }
 
     /// A lower bound of the distance between the two meshes: the larger of their boxes' and
@@ -394,7 +515,7 @@ impl Placed {
     /// coincident vertex pair and every degenerate triangle is the same as in the prepared
     /// mesh, so its placement-free answers (convexity, topology) hold here. Decided once.
     fn translated(&self) -> bool {
-        *self.translated.get_or_init(|| match &self.world {
+        *self.translated.get_or_init(|| match &self.laid().world {
             None => true,
             Some(w) => predicates::exact_translation(&self.prepared.mesh.positions, w).is_some(),
         })
@@ -407,7 +528,8 @@ impl Placed {
     fn topology(&self) -> &Topology {
         self.topology.get_or_init(|| {
             let p = &self.prepared;
-            let from_prepared = match (&self.tree, &self.world) {
+            let laid = self.laid();
+            let from_prepared = match (&laid.tree, &laid.world) {
                 (Mapping::Own, _) | (_, None) => Some(p.topology().clone()),
                 (Mapping::Mapped(map), Some(world)) if p.own_ball().1 => p.fragile().and_then(|f| {
                     f.placed(p.topology(), world, &p.mesh.triangles, &PlacementRounding::of(map))
@@ -601,7 +723,7 @@ fn shared_surface(x: &Aabb, y: &Aabb) -> f64 {
 /// when no vertex of either mesh lies in the other's box: nothing can be contained then).
 pub fn collide(a: &Placed, b: &Placed, all: bool) -> Collision {
     let none = Collision { contacts: Vec::new(), containment: Containment::None };
-    if !a.bounds().overlaps(&b.bounds()) {
+    if !a.reach().overlaps(&b.reach()) || !a.bounds().overlaps(&b.bounds()) {
         return none;
     }
     let (ma, mb, ta, tb) = (a.mesh(), b.mesh(), a.tree(), b.tree());
@@ -847,6 +969,150 @@ mod tests {
             }
         }
         assert!(met > 10 && missed > 5, "{met} met, {missed} missed");
+    }
+
+    /// Random affine maps: rotations, uneven scales, reflections, shears, large translations,
+    /// zeros of either sign, from `seed`.
+    fn random_transforms(seed: u64, n: usize) -> Vec<DMat4> {
+        let mut next = crate::load::test_rng(seed);
+        let mut unit = move || next(1 << 30) as f64 / (1u64 << 30) as f64;
+        (0..n)
+            .map(|k| {
+                let axis = DVec3::new(unit() - 0.5, unit() - 0.5, unit() - 0.5).normalize_or(DVec3::Z);
+                let rot = DMat4::from_axis_angle(axis, unit() * 6.3);
+                let scale = DVec3::new(0.1 + unit() * 3.0, 0.1 + unit() * 3.0, 0.1 + unit() * 3.0);
+                let shift = DVec3::new(unit() - 0.5, unit() - 0.5, unit() - 0.5) * [8.0, 1.0e6, 0.5][k % 3];
+                let mut m = match k % 5 {
+                    0 => DMat4::from_translation(shift),
+                    1 => DMat4::from_translation(shift) * rot,
+                    2 => DMat4::from_translation(shift) * rot * DMat4::from_scale(scale),
+                    3 => DMat4::from_translation(shift) * DMat4::from_scale(scale * -1.0),
+                    _ => {
+                        let mut m = DMat4::from_translation(shift) * rot;
+                        m.y_axis.x += unit();
+                        m
+                    }
+                };
+                if k % 2 == 1 {
+                    let flip = |x: f64| if x == 0.0 { -x } else { x };
+                    m = DMat4::from_cols_array(&m.to_cols_array().map(flip));
+                }
+                m
+            })
+            .collect()
+    }
+
+    /// A placement's world coordinates computed when first read are bit for bit those computed
+    /// at once, and so are its exact box, tree boxes, ball and every answer about it; its box
+    /// from the transform alone holds every world vertex, and reading single vertices or a pair
+    /// lower bound computes nothing.
+    #[test]
+    fn lazy_placements_answer_as_eager_ones() {
+        let mut compared = 0;
+        for seed in 0..6u64 {
+            let a = prepared(soup(60 + 10 * seed as usize, 2 * seed + 11));
+            let b = prepared(if seed % 2 == 0 { cube(DVec3::splat(2.0)) } else { soup(50, 2 * seed + 12) });
+            let ms = random_transforms(seed + 1, 10);
+            for (k, &ma) in ms.iter().enumerate() {
+                let mb = ms[(k + 3) % ms.len()] * DMat4::from_translation(DVec3::splat(k as f64 * 0.3));
+                let (la, lb) = (a.place(ma).unwrap(), b.place(mb).unwrap());
+                let (ea, eb) = (a.place_now(ma).unwrap(), b.place_now(mb).unwrap());
+                assert!(!la.is_laid() && !lb.is_laid(), "placing computes nothing");
+                // Single vertices and the box bound, before the world coordinates exist.
+                let singles: Vec<DVec3> = (0..a.mesh.positions.len() as u32).map(|v| la.vertex(v)).collect();
+                assert_eq!(la.triangle(1), ea.triangle(1));
+                assert!(la.reach_gap(&lb) <= ea.gap(&eb));
+                if !la.reach().overlaps(&lb.reach()) {
+                    assert!(la.apart(&lb) && !la.is_laid() && !lb.is_laid());
+                    assert!(!collide(&la, &lb, false).collides() && !la.is_laid());
+                }
+                let bits = |p: &[DVec3]| p.iter().flat_map(|v| v.to_array().map(f64::to_bits)).collect::<Vec<_>>();
+                assert_eq!(bits(&singles), bits(ea.positions()));
+                for (l, e) in [(&la, &ea), (&lb, &eb)] {
+                    assert_eq!(bits(l.positions()), bits(e.positions()));
+                    assert_eq!(l.bounds(), e.bounds());
+                    assert!(l.reach().contains(&l.bounds()), "{:?} {:?}", l.reach(), l.bounds());
+                    assert!(e.reach() == e.bounds());
+                    let (tl, te) = (l.tree(), e.tree());
+                    for n in 0..l.prepared.tree.nodes.len() as u32 {
+                        assert_eq!(tl.node_box(n), te.node_box(n));
+                    }
+                    assert_eq!(l.ball(), e.ball());
+                    assert_eq!(l.is_convex(), e.is_convex());
+                }
+                assert_eq!(la.apart(&lb), ea.apart(&eb));
+                assert_eq!(la.gap(&lb), ea.gap(&eb));
+                assert_eq!(collide(&la, &lb, true), collide(&ea, &eb, true));
+                assert_eq!(distance(&la, &lb, f64::INFINITY), distance(&ea, &eb, f64::INFINITY));
+                // Fresh lazy placements (nothing computed yet) for the signed distance.
+                let (la, lb) = (a.place(ma).unwrap(), b.place(mb).unwrap());
+                assert_eq!(signed_distance(&la, &lb, f64::INFINITY), signed_distance(&ea, &eb, f64::INFINITY));
+                compared += 1;
+            }
+        }
+        assert_eq!(compared, 60);
+    }
+
+    /// A transform that takes some vertex out of the finite or exact range fails at placing,
+    /// with the error placing every vertex at once gives; one whose box bound leaves the range
+    /// while every vertex stays in it places (at once).
+    #[test]
+    fn placing_out_of_range_fails_at_place() {
+        let a = prepared(cube(DVec3::ZERO));
+        let big = predicates::MAX_EXACT_MAGNITUDE;
+        let cases = [
+            (DMat4::from_scale(DVec3::splat(big * 2.0)), false),
+            (DMat4::from_translation(DVec3::new(0.0, big * 1.5, 0.0)), false),
+            (DMat4::from_scale(DVec3::new(1.0, f64::INFINITY, 1.0)), false),
+            (DMat4::from_scale(DVec3::new(1.0, 1.0, f64::NAN)), false),
+            (DMat4::from_translation(DVec3::new(f64::MAX, 0.0, 0.0)) * DMat4::from_scale(DVec3::splat(2.0)), false),
+            // The corner (1, 1, 1) lands exactly on the range's end: fine, placed at once.
+            (DMat4::from_scale(DVec3::splat(big)), true),
+            (DMat4::from_translation(DVec3::splat(big - 1.0e60)), true),
+        ];
+        for (m, fine) in cases {
+            let (lazy, eager) = (a.place(m), a.place_now(m));
+            match (lazy, eager) {
+                (Ok(l), Ok(e)) => {
+                    assert!(fine, "{m}");
+                    assert!(l.is_laid());
+                    assert_eq!(l.positions(), e.positions());
+                }
+                (Err(l), Err(e)) => {
+                    assert!(!fine, "{m}");
+                    assert_eq!(l.to_string(), e.to_string());
+                }
+                (l, e) => panic!("{m}: {:?} / {:?}", l.map(|_| ()), e.map(|_| ())),
+            }
+        }
+    }
+
+    /// The box from the transform alone holds the f64 image of every point of the source box,
+    /// at scales from 2^-200 to 2^200 and with translations that cancel the linear part.
+    #[test]
+    fn reach_holds_every_image() {
+        let mut next = crate::load::test_rng(0x5DEE_CE66_D1CE_4E5B);
+        let mut unit = move || next(1 << 40) as f64 / (1u64 << 40) as f64 - 0.5;
+        for k in 0..4000 {
+            let scale = 2f64.powi((k % 41) * 10 - 200);
+            let pts: Vec<DVec3> = (0..6).map(|_| DVec3::new(unit(), unit(), unit()) * scale + scale).collect();
+            let mut pts = pts;
+            let root = Aabb::of_points(&pts);
+            pts.extend((0..8).map(|c| {
+                DVec3::select(glam::BVec3::new(c & 1 != 0, c & 2 != 0, c & 4 != 0), root.max, root.min)
+            }));
+            let mut m = DMat4::from_cols_array(&std::array::from_fn(|_| unit() * 4.0));
+            // Half the time the translation nearly cancels the image of the first point.
+            if k % 2 == 0 {
+                let w = m.transform_point3(pts[0]) - m.w_axis.truncate();
+                m.w_axis = (-w).extend(1.0);
+            }
+            let r = reach(&rows_of(&m), &root).unwrap();
+            for p in &pts {
+                let w = m.transform_point3(*p);
+                assert!(r.contains(&Aabb { min: w, max: w }), "{k}: {w} outside {r:?}");
+            }
+        }
     }
 
     /// Balls hold every vertex, their gap is a lower bound of the true distance, and apart

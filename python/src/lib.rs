@@ -853,10 +853,11 @@ fn hint_key(a: &[Arc<Placed>], b: &[Arc<Placed>], (i, j): (usize, usize)) -> Hin
 /// Exact: does triangle pair `hint` (of `x`, of `y`; ignored when out of range) meet?
 fn hint_meets(x: &Placed, y: &Placed, hint: Option<(u32, u32)>) -> bool {
     let Some((s, t)) = hint else { return false };
-    let (mx, my) = (x.mesh(), y.mesh());
-    (s as usize) < mx.triangle_count()
-        && (t as usize) < my.triangle_count()
-        && tri_tri::classify(&mx.triangle(s), &my.triangle(t)).is_some()
+    // The two triangles' world corners alone (the meshes' world coordinates are not computed
+    // for them).
+    (s as usize) < x.prepared.mesh.triangles.len()
+        && (t as usize) < y.prepared.mesh.triangles.len()
+        && tri_tri::classify(&x.triangle(s), &y.triangle(t)).is_some()
 }
 
 /// Up to this many candidate object pairs, a query runs them on the calling thread (waking the
@@ -977,8 +978,8 @@ fn nearest(
     // of all pairs gives. A node pair's bound (its boxes' distance less the largest search
     // margin of all objects) is at most the bound of every object pair below it: boxes of
     // nodes hold their objects' boxes, and each step of the box distance is monotone.
-    let margin = a.iter().chain(b).map(|p| p.ball().slack).fold(0.0f64, f64::max);
-    let boxes = |l: &[Arc<Placed>]| l.iter().map(|p| p.bounds()).collect::<Vec<Aabb>>();
+    let margin = a.iter().chain(b).map(|p| p.reach_margin()).fold(0.0f64, f64::max);
+    let boxes = |l: &[Arc<Placed>]| l.iter().map(|p| p.reach()).collect::<Vec<Aabb>>();
     let kept = tree();
     let own_b;
     let tb = match &kept {
@@ -1011,8 +1012,10 @@ fn nearest(
             if matches!(among, Among::Named(k) if j == k) {
                 return best.0;
             }
-            let lb = a[i].gap(&b[j]);
-            if key3(&(lb, i, j), &best).is_gt() {
+            // The bound from the boxes that hold the two first (it needs no world
+            // coordinates), then the finer one: each at most the pair's distance.
+            let far = |lb: f64| key3(&(lb, i, j), &best).is_gt();
+            if far(a[i].reach_gap(&b[j])) || far(a[i].gap(&b[j])) {
                 return best.0;
             }
             if let Some(c) = signed(i, j, best.0) {
@@ -1063,12 +1066,12 @@ impl Sweep {
     fn pairs(&self, objs: &[Arc<Placed>]) -> Vec<(usize, usize)> {
         let mut out = Vec::new();
         for (k, &(_, i)) in self.order.iter().enumerate() {
-            let bi = objs[i].bounds();
+            let bi = objs[i].reach();
             for &(min_x, j) in &self.order[k + 1..] {
                 if min_x > bi.max.x {
                     break;
                 }
-                if bi.overlaps(&objs[j].bounds()) {
+                if bi.overlaps(&objs[j].reach()) {
                     out.push((i.min(j), i.max(j)));
                 }
             }
@@ -1086,7 +1089,7 @@ impl Sweep {
         let mut out: Vec<usize> = self.order[start..end.max(start)]
             .iter()
             .map(|x| x.1)
-            .filter(|&i| objs[i].bounds().overlaps(q))
+            .filter(|&i| objs[i].reach().overlaps(q))
             .collect();
         out.sort_unstable();
         out
@@ -1124,8 +1127,8 @@ impl Manager {
     }
 
     fn set(&mut self, i: usize, placed: Arc<Placed>) {
-        self.sweep.remove(i, &self.objs[i].bounds());
-        self.sweep.insert(i, &placed.bounds());
+        self.sweep.remove(i, &self.objs[i].reach());
+        self.sweep.insert(i, &placed.reach());
         self.memo.get_mut().unwrap().forget(self.objs[i].id());
         self.objs[i] = placed;
         self.placed(i);
@@ -1155,7 +1158,7 @@ impl Manager {
         let Some(pairs) = self.pairs.get_mut().unwrap().as_mut() else { return };
         let pairs = Arc::make_mut(pairs);
         pairs.retain(|&(x, y)| x != i && y != i);
-        let with = self.sweep.against(&self.objs, &self.objs[i].bounds());
+        let with = self.sweep.against(&self.objs, &self.objs[i].reach());
         pairs.extend(with.into_iter().filter(|&j| j != i).map(|j| (i.min(j), i.max(j))));
         pairs.sort_unstable();
     }
@@ -1171,7 +1174,7 @@ impl Manager {
         let mut out: Vec<(usize, usize)> = other
             .iter()
             .enumerate()
-            .flat_map(|(j, o)| self.sweep.against(&self.objs, &o.bounds()).into_iter().map(move |i| (i, j)))
+            .flat_map(|(j, o)| self.sweep.against(&self.objs, &o.reach()).into_iter().map(move |i| (i, j)))
             .collect();
         out.sort_unstable();
         out
@@ -1183,7 +1186,7 @@ impl Manager {
 fn object_tree(objs: &[Arc<Placed>], kept: &Mutex<Option<Arc<ObjectTree>>>) -> Arc<ObjectTree> {
     let mut kept = kept.lock().unwrap();
     kept.get_or_insert_with(|| {
-        let boxes: Vec<Aabb> = objs.iter().map(|p| p.bounds()).collect();
+        let boxes: Vec<Aabb> = objs.iter().map(|p| p.reach()).collect();
         Arc::new(ObjectTree::build(&boxes, (0..boxes.len()).collect()))
     })
     .clone()
@@ -1215,7 +1218,7 @@ impl Manager {
             Some(&i) => self.set(i, placed),
             None => {
                 let i = self.objs.len();
-                self.sweep.insert(i, &placed.bounds());
+                self.sweep.insert(i, &placed.reach());
                 self.index.insert(name.clone(), i);
                 self.names.push(name);
                 self.objs.push(placed);
@@ -1227,7 +1230,7 @@ impl Manager {
 
     fn remove(&mut self, name: &str) -> PyResult<()> {
         let i = self.find(name)?;
-        self.sweep.remove(i, &self.objs[i].bounds());
+        self.sweep.remove(i, &self.objs[i].reach());
         self.sweep.renumber_after(i);
         self.memo.get_mut().unwrap().forget(self.objs[i].id());
         *self.pairs.get_mut().unwrap() = None;

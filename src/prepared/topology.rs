@@ -447,8 +447,8 @@ mod tests {
             let p = prepared.place(m).unwrap();
             let fresh = containment::topology(&p.mesh());
             assert_eq!(*p.topology(), fresh, "placement {k}");
-            let Mapping::Mapped(map) = &p.tree else { continue };
-            let world = p.world.as_deref().unwrap();
+            let Mapping::Mapped(map) = &p.laid().tree else { continue };
+            let world = p.positions();
             let t = fragile
                 .placed(&own, world, &prepared.mesh.triangles, &PlacementRounding::of(map))
                 .expect("the rounding of these placements is within the bounds");
