@@ -48,6 +48,8 @@ pub struct Prepared {
     fragile: OnceLock<Option<Fragile>>,
     /// The exact box of every vertex in the mesh's own coordinates (used or not).
     root: Aabb,
+    /// Does every vertex belong to some triangle?
+    all_used: bool,
 }
 
 impl Prepared {
@@ -56,6 +58,9 @@ impl Prepared {
         query::check_range(&mesh, label)?;
         let tree = Bvh::build(&mesh, opts);
         let root = Aabb::of_points(&mesh.positions);
+        let mut used = vec![false; mesh.positions.len()];
+        mesh.triangles.iter().flatten().for_each(|&v| used[v as usize] = true);
+        let all_used = used.iter().all(|&u| u);
         Ok(Prepared {
             mesh,
             tree,
@@ -67,6 +72,7 @@ impl Prepared {
             ball: OnceLock::new(),
             fragile: OnceLock::new(),
             root,
+            all_used,
         })
     }
 
@@ -110,7 +116,7 @@ impl Prepared {
     }
 
     /// Place the mesh under `m`. Nothing is computed on the vertices yet: the placement keeps
-    /// the transform and a box that holds every world vertex ([`reach`]), enough for a broad
+    /// the transform and a box that holds every world vertex ([`Coarse`]), enough for a broad
     /// phase; the world coordinates (every vertex transformed in f64, as `--transform` does;
     /// identity keeps the coordinates as they are), the tree mapped onto them and their exact
     /// box are computed when a query first reads them ([`Placed::positions`]). The errors of
@@ -121,6 +127,8 @@ impl Prepared {
             prepared: self.clone(),
             transform: m,
             reach,
+            coarse: None,
+            outline: OnceLock::new(),
             laid,
             topology: OnceLock::new(),
             convex: OnceLock::new(),
@@ -132,11 +140,22 @@ impl Prepared {
             let laid = Laid { world: None, tree: Mapping::Own, root: self.root };
             return Ok(placed(self.root, OnceLock::from(laid)));
         }
-        if let Some(reach) = reach(&rows_of(&m), &self.root).filter(|r| {
-            let bound = r.min.abs().max(r.max.abs()).max_element();
-            bound.is_finite() && bound <= predicates::MAX_EXACT_MAGNITUDE
-        }) {
-            return Ok(placed(reach, OnceLock::new()));
+        let rows = rows_of(&m);
+        if let Some((coarse, map)) = Coarse::of(&rows, &self.root).zip(BoxMap::fit(rows, &self.tree.bounds(), std::iter::empty())) {
+            let reach = coarse.map_box(&self.root);
+            let bound = reach.min.abs().max(reach.max.abs()).max_element();
+            if bound.is_finite() && bound <= predicates::MAX_EXACT_MAGNITUDE {
+                let mut p = placed(reach, OnceLock::new());
+                p.coarse = Some((coarse, map));
+                // When every vertex is a triangle's, the outline's boxes hold them all: their
+                // union is a tighter box for a rotated mesh.
+                let outline = p.outline();
+                if self.all_used && !outline.is_empty() {
+                    let u = outline.iter().fold(Aabb::EMPTY, |b, x| b.union(*x));
+                    p.reach = Aabb { min: u.min.max(reach.min), max: u.max.min(reach.max) };
+                }
+                return Ok(p);
+            }
         }
         self.place_now(m)
     }
@@ -163,6 +182,8 @@ impl Prepared {
             prepared: self.clone(),
             transform: m,
             reach: laid.root,
+            coarse: None,
+            outline: OnceLock::new(),
             laid: OnceLock::from(laid),
             topology: OnceLock::new(),
             convex: OnceLock::new(),
@@ -191,27 +212,46 @@ fn rows_of(m: &DMat4) -> [[f64; 4]; 3] {
     [0, 1, 2].map(|k| [m.x_axis[k], m.y_axis[k], m.z_axis[k], m.w_axis[k]])
 }
 
-/// A box that holds the f64 image (`DMat4::transform_point3`, whatever the order of its
-/// products and sums) of every point of `root` under the affine map `rows`, found from `root`
-/// alone; `None` when the map is not finite. The box is the map's image of `root` with no
-/// measured deviation ([`BoxMap::fit`] over no vertex pair: it holds every point whose f64
-/// image is `fl(R x + t)` evaluated in the map's order), widened by the search margin of the
-/// map's scale `S = max_i (|t_i| + Σ_j |r_ij| max(|root.min_j|, |root.max_j|))`
+/// A conservative map of boxes under a placement, found from the transform alone: the box it
+/// gives for a box of the prepared mesh's own coordinates holds the f64 image
+/// (`DMat4::transform_point3`, whatever the order of its products and sums) of every point of
+/// that box. It is the affine map with no measured deviation ([`BoxMap::fit`] over no vertex
+/// pair, the source root the mesh's own box: it holds every point whose image is `fl(R x + t)`
+/// evaluated in the map's order), its boxes widened by the search margin of the map's scale
+/// `S = max_i (|t_i| + Σ_j |r_ij| max(|root.min_j|, |root.max_j|))`
 /// ([`predicates::distance_rounding_slack`], 128 units of rounding of `S`). That covers the
 /// rest: an image computed in another order is, like `fl(R x + t)`, within `γ_4 S` of the exact
-/// image (Higham, §3.1; `γ_4 ≈ 4u`), so within `8.1u S` of `fl(R x + t)`, and the widening
-/// itself rounds by at most `u (|box| + margin)`, about `u S`.
-pub fn reach(rows: &[[f64; 4]; 3], root: &Aabb) -> Option<Aabb> {
-    let map = BoxMap::fit(*rows, root, std::iter::empty())?;
-    let big = root.min.abs().max(root.max.abs()).to_array();
-    let scale = rows
-        .iter()
-        .map(|r| r[3].abs() + (0..3).map(|j| r[j].abs() * big[j]).sum::<f64>())
-        .fold(0.0f64, f64::max);
-    let margin = DVec3::splat(predicates::distance_rounding_slack(scale));
-    let b = map.map_box(root);
-    Some(Aabb { min: b.min - margin, max: b.max + margin })
+/// image (Higham, §3.1; `γ_4 ≈ 4u`), so within `8.1u S` of `fl(R x + t)`, and the widening itself
+/// rounds by at most `u (|box| + margin)`, about `u S`.
+#[derive(Debug, Clone, Copy)]
+pub struct Coarse {
+    map: BoxMap,
+    margin: f64,
 }
+
+impl Coarse {
+    /// The coarse map of `rows` for boxes inside `root`; `None` when the map is not finite.
+    pub fn of(rows: &[[f64; 4]; 3], root: &Aabb) -> Option<Coarse> {
+        let map = BoxMap::fit(*rows, root, std::iter::empty())?;
+        let big = root.min.abs().max(root.max.abs()).to_array();
+        let scale = rows
+            .iter()
+            .map(|r| r[3].abs() + (0..3).map(|j| r[j].abs() * big[j]).sum::<f64>())
+            .fold(0.0f64, f64::max);
+        Some(Coarse { map, margin: predicates::distance_rounding_slack(scale) })
+    }
+
+    /// A box holding the image of every point of `b` (inside the root given to [`Coarse::of`]).
+    pub fn map_box(&self, b: &Aabb) -> Aabb {
+        let m = DVec3::splat(self.margin);
+        let b = self.map.map_box(b);
+        Aabb { min: b.min - m, max: b.max + m }
+    }
+}
+
+/// Down to this depth, the nodes of a placed mesh's tree give its outline
+/// ([`Placed::outline`]): at most 2^6 boxes (a speed threshold, no answer depends on it).
+const OUTLINE_DEPTH: u32 = 6;
 
 /// A fresh placement id (never reused in the process).
 fn next_id() -> u64 {
@@ -262,9 +302,13 @@ pub struct Placed {
     pub prepared: Arc<Prepared>,
     /// The placement.
     pub transform: DMat4,
-    /// A box holding every world vertex, known without them ([`reach`]; the exact box when
-    /// they were computed at once).
+    /// A box holding every world vertex of the triangles, known without them
+    /// ([`Placed::reach`]).
     reach: Aabb,
+    /// When the world coordinates were not computed at once: the map of boxes known without
+    /// them, and the tree's box map, by whose evaluation ([`BoxMap::image`]) they are computed.
+    coarse: Option<(Coarse, BoxMap)>,
+    outline: OnceLock<Vec<Aabb>>,
     laid: OnceLock<Laid>,
     topology: OnceLock<Arc<Topology>>,
     convex: OnceLock<bool>,
@@ -357,14 +401,27 @@ impl TriMesh for PlacedMesh<'_> {
 }
 
 impl Placed {
-    /// The world coordinates, tree view and exact box, computed on first use (every vertex
-    /// transformed as [`Prepared::place`] would have at once: `place` checked them already).
+    /// The world coordinates, tree view and exact box, computed on first use (`place` checked
+    /// the range already). Each vertex is the tree's box map's image of it ([`BoxMap::image`]:
+    /// the products and sums of `DMat4::transform_point3`, in its order, so the same bits as
+    /// placing at once), so that map, fitted over no vertex, is the map a fit over every vertex
+    /// gives (each deviation is zero), with no pass to measure it.
     fn laid(&self) -> &Laid {
         self.laid.get_or_init(|| {
-            let m = &self.transform;
-            let world: Vec<DVec3> = self.prepared.mesh.positions.iter().map(|p| m.transform_point3(*p)).collect();
-            debug_assert!(world.iter().all(|w| w.abs().max_element() <= predicates::MAX_EXACT_MAGNITUDE));
-            self.prepared.lay(m, world)
+            let Some((_, map)) = &self.coarse else { unreachable!("placed at once") };
+            let mut root = Aabb::EMPTY;
+            let world: Vec<DVec3> = self
+                .prepared
+                .mesh
+                .positions
+                .iter()
+                .map(|p| {
+                    let w = map.image(*p);
+                    root = root.grow(w);
+                    w
+                })
+                .collect();
+            Laid { world: Some(world), tree: Mapping::Mapped(*map), root }
         })
     }
 
@@ -379,7 +436,10 @@ impl Placed {
     pub fn vertex(&self, v: u32) -> DVec3 {
         match self.laid.get() {
             Some(l) => l.world.as_ref().map_or(self.prepared.mesh.positions[v as usize], |w| w[v as usize]),
-            None => self.transform.transform_point3(self.prepared.mesh.positions[v as usize]),
+            None => match &self.coarse {
+                Some((_, map)) => map.image(self.prepared.mesh.positions[v as usize]),
+                None => self.transform.transform_point3(self.prepared.mesh.positions[v as usize]),
+            },
         }
     }
 
@@ -414,8 +474,10 @@ impl Placed {
         self.laid().root
     }
 
-    /// A box holding every world vertex, known from the placement alone ([`reach`]); the exact
-    /// box when the placement computed the world coordinates at once. It never changes.
+    /// A box holding every world vertex of the mesh's triangles (every world vertex when some
+    /// vertex is in no triangle), known from the placement alone ([`Coarse`], and the union of
+    /// [`Placed::outline`]); the exact box when the placement computed the world coordinates at
+    /// once. It never changes.
     pub fn reach(&self) -> Aabb {
         self.reach
     }
@@ -486,6 +548,32 @@ impl Placed {
     /// it without the world coordinates.
     pub fn apart(&self, o: &Placed) -> bool {
         !self.reach.overlaps(&o.reach) || !self.bounds().overlaps(&o.bounds()) || self.ball().apart(&o.ball())
+    }
+
+    /// Boxes that together hold every triangle of the placed mesh: the boxes of the prepared
+    /// tree's nodes at depth [`OUTLINE_DEPTH`] (and of leaves above it), mapped by the
+    /// placement's [`Coarse`] map when the world coordinates were not computed at once (none
+    /// are read), else the tree view's boxes. Found once.
+    pub fn outline(&self) -> &[Aabb] {
+        self.outline.get_or_init(|| {
+            let own = &self.prepared.tree;
+            if own.is_empty() {
+                return Vec::new();
+            }
+            let mut out = Vec::new();
+            let mut stack = vec![(0u32, 0u32)];
+            while let Some((n, depth)) = stack.pop() {
+                if depth < OUTLINE_DEPTH && !own.is_leaf(n) {
+                    stack.extend(own.children(n).map(|c| (c, depth + 1)));
+                    continue;
+                }
+                out.push(match &self.coarse {
+                    Some((c, _)) => c.map_box(&own.node_box(n)),
+                    None => self.tree().node_box(n),
+                });
+            }
+            out
+        })
     }
 
     /// A lower bound of [`Placed::gap`] (so of the distance between the two meshes) from the
@@ -559,6 +647,33 @@ impl Collision {
     pub fn collides(&self) -> bool {
         !self.contacts.is_empty() || self.containment.is_clash()
     }
+}
+
+/// Certainly no triangle of `a` meets one of `b`, from their outlines ([`Placed::outline`]) and
+/// boxes ([`Placed::reach`]) alone: no box of one's outline may meet one of the other's (a
+/// point shared by two triangles lies in a box of each). True says what a tree walk for
+/// meeting triangles would find (none) without the world coordinates.
+pub fn no_meeting_triangles(a: &Placed, b: &Placed) -> bool {
+    let tol = Tolerances::default();
+    if !tol.boxes_may_meet(&a.reach(), &b.reach()) {
+        return true;
+    }
+    let (ra, rb) = (a.reach(), b.reach());
+    let near = |o: &[Aabb], r: &Aabb| o.iter().filter(|x| tol.boxes_may_meet(x, r)).copied().collect::<Vec<_>>();
+    let (oa, ob) = (near(a.outline(), &rb), near(b.outline(), &ra));
+    !oa.iter().any(|x| ob.iter().any(|y| tol.boxes_may_meet(x, y)))
+}
+
+/// Certainly the two do not collide, from their outlines and boxes alone: no triangles meet
+/// ([`no_meeting_triangles`]) and no box of either's outline meets the other's box (so no
+/// vertex of either's triangles lies in the other's box: nothing is contained). [`collide`]
+/// finds no collision then.
+pub fn surely_clear(a: &Placed, b: &Placed) -> bool {
+    let (ra, rb) = (a.reach(), b.reach());
+    !ra.overlaps(&rb)
+        || (no_meeting_triangles(a, b)
+            && !a.outline().iter().any(|x| x.overlaps(&rb))
+            && !b.outline().iter().any(|y| y.overlaps(&ra)))
 }
 
 /// Every triangle pair of `a` and `b` that meets exactly (crossing or touching), sorted; with
@@ -723,11 +838,12 @@ fn shared_surface(x: &Aabb, y: &Aabb) -> f64 {
 /// when no vertex of either mesh lies in the other's box: nothing can be contained then).
 pub fn collide(a: &Placed, b: &Placed, all: bool) -> Collision {
     let none = Collision { contacts: Vec::new(), containment: Containment::None };
-    if !a.reach().overlaps(&b.reach()) || !a.bounds().overlaps(&b.bounds()) {
+    if surely_clear(a, b) || !a.bounds().overlaps(&b.bounds()) {
         return none;
     }
     let (ma, mb, ta, tb) = (a.mesh(), b.mesh(), a.tree(), b.tree());
-    let contacts = meeting_pairs(&ma, &ta, &mb, &tb, !all);
+    let contacts =
+        if no_meeting_triangles(a, b) { Vec::new() } else { meeting_pairs(&ma, &ta, &mb, &tb, !all) };
     if !contacts.is_empty() {
         return Collision { contacts, containment: Containment::None };
     }
@@ -1009,6 +1125,7 @@ mod tests {
     #[test]
     fn lazy_placements_answer_as_eager_ones() {
         let mut compared = 0;
+        let mut outcomes = [0; 3];
         for seed in 0..6u64 {
             let a = prepared(soup(60 + 10 * seed as usize, 2 * seed + 11));
             let b = prepared(if seed % 2 == 0 { cube(DVec3::splat(2.0)) } else { soup(50, 2 * seed + 12) });
@@ -1026,6 +1143,14 @@ mod tests {
                     assert!(la.apart(&lb) && !la.is_laid() && !lb.is_laid());
                     assert!(!collide(&la, &lb, false).collides() && !la.is_laid());
                 }
+                // The outlines' verdicts, read without the world coordinates, against the
+                // exact ones.
+                let (quiet, clear) = (no_meeting_triangles(&la, &lb), surely_clear(&la, &lb));
+                assert!(!la.is_laid() && !lb.is_laid());
+                let full = collide(&ea, &eb, true);
+                assert!(!quiet || full.contacts.is_empty());
+                assert!(!clear || !full.collides());
+                outcomes[quiet as usize + clear as usize] += 1;
                 let bits = |p: &[DVec3]| p.iter().flat_map(|v| v.to_array().map(f64::to_bits)).collect::<Vec<_>>();
                 assert_eq!(bits(&singles), bits(ea.positions()));
                 for (l, e) in [(&la, &ea), (&lb, &eb)] {
@@ -1051,6 +1176,7 @@ mod tests {
             }
         }
         assert_eq!(compared, 60);
+        assert!(outcomes.iter().all(|&n| n >= 3), "{outcomes:?}");
     }
 
     /// A transform that takes some vertex out of the finite or exact range fails at placing,
@@ -1107,7 +1233,7 @@ mod tests {
                 let w = m.transform_point3(pts[0]) - m.w_axis.truncate();
                 m.w_axis = (-w).extend(1.0);
             }
-            let r = reach(&rows_of(&m), &root).unwrap();
+            let r = Coarse::of(&rows_of(&m), &root).unwrap().map_box(&root);
             for p in &pts {
                 let w = m.transform_point3(*p);
                 assert!(r.contains(&Aabb { min: w, max: w }), "{k}: {w} outside {r:?}");

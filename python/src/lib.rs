@@ -777,7 +777,7 @@ fn collide_pairs(
     memo: Memory<'_>,
 ) -> Vec<Hit> {
     let key = |&(i, j): &(usize, usize)| (a[i].id(), b[j].id());
-    let apart = |&(i, j): &(usize, usize)| a[i].apart(&b[j]);
+    let apart = |&(i, j): &(usize, usize)| prepared::surely_clear(&a[i], &b[j]) || a[i].apart(&b[j]);
     let meets = Verdict { collides: true, containment: None };
     // The triangle pair that met last time, when it still meets (exact test): then the pair
     // collides with no containment, the verdict the full test gives.
@@ -825,6 +825,9 @@ fn collide_pairs(
         open.retain(|p| !apart(p));
         let meet = |p: &(usize, usize)| {
             let (x, y) = (&a[p.0], &b[p.1]);
+            if prepared::no_meeting_triangles(x, y) {
+                return None;
+            }
             let m = api::meeting_pairs(&x.mesh(), &x.tree(), &y.mesh(), &y.tree(), true);
             let first = m.first()?;
             memo.keep_hint(hint_key(a, b, *p), (first.a, first.b));
@@ -933,7 +936,13 @@ fn nearest(
         None if memo.no_meeting(key(i, j)) => None,
         None => {
             let (x, y) = (&a[i], &b[j]);
-            let m = api::meeting_pairs(&x.mesh(), &x.tree(), &y.mesh(), &y.tree(), true);
+            // The outlines settle most pairs with no meeting triangles without the world
+            // coordinates.
+            let m = if prepared::no_meeting_triangles(x, y) {
+                Vec::new()
+            } else {
+                api::meeting_pairs(&x.mesh(), &x.tree(), &y.mesh(), &y.tree(), true)
+            };
             let Some(first) = m.into_iter().next() else {
                 memo.keep_no_meeting(key(i, j));
                 return None;
@@ -946,7 +955,7 @@ fn nearest(
     let contained = |&(i, j): &(usize, usize)| {
         let v = match memo.verdict(key(i, j)) {
             Some(v) => v,
-            None if a[i].apart(&b[j]) => return None,
+            None if prepared::surely_clear(&a[i], &b[j]) || a[i].apart(&b[j]) => return None,
             None => {
                 let c = api::collide(&a[i], &b[j], false);
                 let v = Verdict { collides: c.collides(), containment: c.containment.name() };
