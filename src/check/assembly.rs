@@ -148,7 +148,7 @@ impl Layout {
 
 /// The vertex-index offset that makes `inst` read like `leader` (same triangle count, and each
 /// corner of each triangle the leader's corner plus one common offset), if there is one.
-fn shift_of(mesh: &Mesh, leader: &Part, inst: &Part) -> Option<i64> {
+pub(crate) fn shift_of(mesh: &Mesh, leader: &Part, inst: &Part) -> Option<i64> {
     if leader.triangles.len() != inst.triangles.len() || leader.triangles.is_empty() {
         return None;
     }
