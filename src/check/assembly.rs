@@ -1136,7 +1136,9 @@ impl PartPairReduction {
     /// The merged result (findings sorted by triangle pair, verdict the worst part pair's) and
     /// the part pairs that are not clear.
     pub fn finish(mut self, timings: crate::check::query::Timings) -> (ClashResult, Vec<PartPairSummary>) {
-        self.merged.sort_unstable_by_key(|p| (p.a, p.b));
+        // Each triangle pair is found in one part pair only, so the keys are distinct and any
+        // sort gives one order: sorted in parallel.
+        self.merged.par_sort_unstable_by_key(|p| (p.a, p.b));
         let verdict = self.part_pairs.iter().map(|p| p.verdict).max().unwrap_or(Verdict::Clear);
         let result = ClashResult {
             pairs: self.merged,
