@@ -12,7 +12,7 @@ use crate::shard::sha256::Sha256;
 /// The entry layout number: part of every [`PairKey`] and of every entry's header. Bump it when
 /// the key layouts, the entry header or the meaning of a stored value change, so that entries
 /// written before the change are never found.
-pub const FORMAT: u32 = 4;
+pub const FORMAT: u32 = 5;
 
 /// The tool version that goes into every [`PairKey`] and entry header: a cache written by
 /// another version of meshclash is never read.
@@ -22,7 +22,8 @@ const PART_TAG: &[u8] = b"meshclash.cache.part\0";
 const SETTINGS_TAG: &[u8] = b"meshclash.cache.settings\0";
 const PAIR_TAG: &[u8] = b"meshclash.cache.pair\0";
 const MESH_TAG: &[u8] = b"meshclash.cache.mesh\0";
-const LAYOUT_TAG: &[u8] = b"meshclash.cache.part-layout\0";
+const SHAPE_TAG: &[u8] = b"meshclash.cache.part-shape\0";
+const VERTICES_TAG: &[u8] = b"meshclash.cache.part-vertices\0";
 
 /// A SHA-256 digest, the 32 bytes of every key.
 pub type Digest = [u8; 32];
@@ -154,63 +155,62 @@ impl PartKey {
         PartKey(finish(sha))
     }
 
-    /// The key of a part as a part-pair check sees it: its name, its world-space vertices and
-    /// how its triangles share them (closedness, winding and containment read the sharing),
-    /// independent of where its vertices sit in the file's vertex list, so a part keeps its
-    /// key when other parts change.
+    /// The key of a part as a part-pair check sees it: its name, how its triangles share its
+    /// vertices (closedness, winding and containment read the sharing) and its world-space
+    /// vertices, independent of where its vertices sit in the file's vertex list, so a part
+    /// keeps its key when other parts change.
     ///
     /// The part's vertices are numbered in order of first use by its triangles (as the check
-    /// numbers them). The SHA-256 input, every integer little-endian, every f64 as `to_bits`:
-    /// the tag `meshclash.cache.part-layout` and a zero byte; the name's length (u64) and the
-    /// name; then for each triangle of `triangles` (indices into `mesh.triangles`, in order)
-    /// and each of its three corners, the corner's part-local vertex number (u32), followed,
-    /// when that number is used for the first time, by the vertex's x, y, z; finally the
-    /// triangle count (u64). `mesh` must be in world space (placed, in the run's units).
+    /// numbers them). Its *shape* digest is the SHA-256 of the tag
+    /// `meshclash.cache.part-shape` and a zero byte, the triangle count (u64), then each
+    /// triangle's three part-local vertex numbers (u32); the key is the SHA-256 of the tag
+    /// `meshclash.cache.part-vertices` and a zero byte, the name's length (u64) and the name,
+    /// the shape digest's 32 bytes, the vertex count (u64), then each vertex's x, y, z in that
+    /// numbering. Every integer little-endian, every f64 as `to_bits`. `mesh` must be in world
+    /// space (placed, in the run's units).
+    ///
+    /// The instances of one glTF mesh share their shape (their triangles index the mesh's
+    /// vertices alike, one offset apart): [`PartKey::of_part_layouts`] hashes it once for all of
+    /// them, and then only each instance's vertices.
     pub fn of_part_layout(name: &str, mesh: &Mesh, triangles: &[u32]) -> PartKey {
-        let mut sha = Sha256::default();
-        sha.update(LAYOUT_TAG);
-        put_len(&mut sha, name.len());
-        sha.update(name.as_bytes());
-        let corners = || triangles.iter().flat_map(|&t| mesh.triangles[t as usize]);
-        let (lo, hi) = corners().fold((u32::MAX, 0u32), |(lo, hi), v| (lo.min(v), hi.max(v)));
-        // Local numbers by a dense table over the part's index range (parts are nearly always
-        // one run of the file's vertices); a map when the range is sparse.
-        let span = if triangles.is_empty() { 0 } else { (hi - lo) as usize + 1 };
-        let dense = span <= 3 * triangles.len() + 64;
-        let mut table: Vec<u32> = if dense { vec![u32::MAX; span] } else { Vec::new() };
-        let mut map: std::collections::HashMap<u32, u32> = std::collections::HashMap::new();
-        let mut next = 0u32;
-        let mut buf: Vec<u8> = Vec::with_capacity(1 << 16);
-        for v in corners() {
-            let slot = if dense { &mut table[(v - lo) as usize] } else { map.entry(v).or_insert(u32::MAX) };
-            let fresh = *slot == u32::MAX;
-            if fresh {
-                *slot = next;
-                next += 1;
-            }
-            buf.extend(slot.to_le_bytes());
-            if fresh {
-                for c in mesh.positions[v as usize].to_array() {
-                    buf.extend(c.to_bits().to_le_bytes());
-                }
-            }
-            if buf.len() >= 1 << 16 {
-                sha.update(&buf);
-                buf.clear();
-            }
-        }
-        sha.update(&buf);
-        put_len(&mut sha, triangles.len());
-        PartKey(finish(sha))
+        let shape = Shape::of(mesh, triangles);
+        shape.key(name, mesh, 0)
     }
 
     /// The keys of `parts` (see [`PartKey::of_part_layout`]), computed in parallel, in the
-    /// order of `parts`; `meshes[p.input]` holds part `p`.
+    /// order of `parts`; `meshes[p.input]` holds part `p`. The parts that instance one glTF mesh
+    /// alike (the same triangles, their vertex numbers one offset apart) share one shape,
+    /// numbered and hashed once; the keys are those [`PartKey::of_part_layout`] gives.
     pub fn of_part_layouts(meshes: [&Mesh; 2], parts: &[&Part]) -> Vec<PartKey> {
         use rayon::prelude::*;
-        parts
+        use std::collections::HashMap;
+        let mut leader_of: HashMap<(u8, u32), usize> = HashMap::new();
+        let leader: Vec<Option<usize>> = parts
+            .iter()
+            .enumerate()
+            .map(|(j, p)| p.gltf_mesh.map(|m| *leader_of.entry((p.input, m)).or_insert(j)))
+            .collect();
+        // Each part's shape: its leader's, one vertex offset apart, when its triangles read
+        // like the leader's; else its own.
+        let shift: Vec<Option<(usize, i64)>> = (0..parts.len())
+            .into_par_iter()
+            .map(|j| {
+                let l = leader[j].filter(|&l| l != j)?;
+                let mesh = meshes[parts[j].input as usize];
+                crate::check::assembly::shift_of(mesh, parts[l], parts[j]).map(|s| (l, s))
+            })
+            .collect();
+        let own: Vec<usize> = (0..parts.len()).filter(|&j| shift[j].is_none()).collect();
+        let shapes: HashMap<usize, Shape> = own
             .par_iter()
-            .map(|p| PartKey::of_part_layout(&p.name, meshes[p.input as usize], &p.triangles))
+            .map(|&j| (j, Shape::of(meshes[parts[j].input as usize], &parts[j].triangles)))
+            .collect();
+        (0..parts.len())
+            .into_par_iter()
+            .map(|j| {
+                let (l, s) = shift[j].unwrap_or((j, 0));
+                shapes[&l].key(&parts[j].name, meshes[parts[j].input as usize], s)
+            })
             .collect()
     }
 
@@ -457,5 +457,69 @@ impl PairKey {
     /// The digest as 64 lowercase hex digits.
     pub fn hex(&self) -> String {
         to_hex(&self.0)
+    }
+}
+
+/// A part's triangles as the check reads them: its vertices numbered in order of first use
+/// (`vmap[v]`, the mesh vertex of part-local vertex `v`) and the digest of its triangles in
+/// that numbering (see [`PartKey::of_part_layout`]).
+struct Shape {
+    vmap: Vec<u32>,
+    digest: Digest,
+}
+
+impl Shape {
+    fn of(mesh: &Mesh, triangles: &[u32]) -> Shape {
+        let mut sha = Sha256::default();
+        sha.update(SHAPE_TAG);
+        put_len(&mut sha, triangles.len());
+        let corners = || triangles.iter().flat_map(|&t| mesh.triangles[t as usize]);
+        let (lo, hi) = corners().fold((u32::MAX, 0u32), |(lo, hi), v| (lo.min(v), hi.max(v)));
+        // Local numbers by a dense table over the part's index range (parts are nearly always
+        // one run of the file's vertices); a map when the range is sparse.
+        let span = if triangles.is_empty() { 0 } else { (hi - lo) as usize + 1 };
+        let dense = span <= 3 * triangles.len() + 64;
+        let mut table: Vec<u32> = if dense { vec![u32::MAX; span] } else { Vec::new() };
+        let mut map: std::collections::HashMap<u32, u32> = std::collections::HashMap::new();
+        let mut vmap: Vec<u32> = Vec::new();
+        let mut buf: Vec<u8> = Vec::with_capacity(1 << 16);
+        for v in corners() {
+            let slot = if dense { &mut table[(v - lo) as usize] } else { map.entry(v).or_insert(u32::MAX) };
+            if *slot == u32::MAX {
+                *slot = vmap.len() as u32;
+                vmap.push(v);
+            }
+            buf.extend(slot.to_le_bytes());
+            if buf.len() >= 1 << 16 {
+                sha.update(&buf);
+                buf.clear();
+            }
+        }
+        sha.update(&buf);
+        Shape { vmap, digest: finish(sha) }
+    }
+
+    /// The key of the part named `name` of this shape whose vertex `v` is mesh vertex
+    /// `vmap[v] + shift`.
+    fn key(&self, name: &str, mesh: &Mesh, shift: i64) -> PartKey {
+        let mut sha = Sha256::default();
+        sha.update(VERTICES_TAG);
+        put_len(&mut sha, name.len());
+        sha.update(name.as_bytes());
+        sha.update(&self.digest);
+        put_len(&mut sha, self.vmap.len());
+        let mut buf: Vec<u8> = Vec::with_capacity(1 << 16);
+        for &v in &self.vmap {
+            let p = mesh.positions[(v as i64 + shift) as usize];
+            for c in [p.x, p.y, p.z] {
+                buf.extend(c.to_bits().to_le_bytes());
+            }
+            if buf.len() >= 1 << 16 {
+                sha.update(&buf);
+                buf.clear();
+            }
+        }
+        sha.update(&buf);
+        PartKey(finish(sha))
     }
 }

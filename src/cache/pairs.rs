@@ -283,6 +283,23 @@ struct Pending {
     known_from: Vec<(Digest, usize, usize)>,
 }
 
+/// A candidate pair's stored answer, as the reuse found it.
+enum Reused {
+    /// Nothing stored under its key.
+    Missing,
+    /// Stored but not for these parts (the reason): checked again.
+    Refused(String),
+    /// Reused: from pack `pack`, its result in the file's triangle numbers, its bound, its
+    /// overlap box (for a clash) and its finding ids (when stored and wanted).
+    Fits {
+        pack: usize,
+        r: ClashResult,
+        bound: Option<Beyond>,
+        overlap: Option<Option<Overlap>>,
+        ids: Option<Vec<u64>>,
+    },
+}
+
 /// What a run read from the cache.
 #[derive(Default)]
 struct Loaded {
@@ -380,11 +397,16 @@ fn listed(r: &ClashResult) -> bool {
 /// clashing pair (`b` None: known to have none). A clashing pair without a known box, or whose
 /// box does not lie within both parts' boxes (where A ∩ B lies, and its bounds correctly
 /// rounded too), is an error: the pair is not reused.
-fn stored_box(s: &Stored, pa: &Part, pb: &Part) -> Result<Option<Option<Overlap>>, String> {
-    if s.result.verdict != Verdict::Clash {
+fn stored_box(
+    verdict: Verdict,
+    overlap: Option<Option<Overlap>>,
+    pa: &Part,
+    pb: &Part,
+) -> Result<Option<Option<Overlap>>, String> {
+    if verdict != Verdict::Clash {
         return Ok(None);
     }
-    match s.overlap {
+    match overlap {
         None => Err("a clash stored without its overlap box".into()),
         Some(None) => Ok(Some(None)),
         Some(Some(o)) => {
@@ -680,38 +702,63 @@ impl PairReuse {
         let mut known: Vec<(u32, u32, u64)> = Vec::new();
         let mut known_from: Vec<(Digest, usize, usize)> = Vec::new();
         let lists = settings.detail != crate::check::query::Detail::Parts;
-        let mut results: Vec<Option<ClashResult>> = candidates
+        // Each stored answer is taken out of what was read (copied only for a key that two
+        // candidates share), then mapped back to the file's triangle numbers in parallel.
+        let mut uses: HashMap<Digest, u32> = HashMap::with_capacity(pair_keys.len());
+        for k in &pair_keys {
+            *uses.entry(*k.as_bytes()).or_insert(0) += 1;
+        }
+        let taken: Vec<Option<(usize, Stored)>> = pair_keys
             .iter()
-            .zip(&pair_keys)
-            .zip(&mut beyond)
-            .map(|((&(a, b), k), bound)| {
-                let (pack, stored) = loaded.pairs.get(k.as_bytes())?;
-                let mut r = stored.result.clone();
-                let fits = to_global(&mut r, &parts[a], &parts[b])
-                    .and_then(|()| stored_box(stored, &parts[a], &parts[b]));
-                match fits {
-                    Ok(overlap) => {
-                        loaded.packs[*pack].1 = true;
-                        *bound = stored.beyond;
-                        if let Some(o) = overlap {
-                            boxes.insert((a, b), o);
-                        }
-                        if let Some(ids) =
-                            stored.ids.as_ref().filter(|i| lists && !i.is_empty() && i.len() == r.pairs.len())
-                        {
-                            let start = known.len();
-                            known.extend(r.pairs.iter().zip(ids).map(|(p, &id)| (p.a, p.b, id)));
-                            known_from.push((*k.as_bytes(), start, known.len()));
-                        }
-                        Some(r)
-                    }
-                    Err(e) => {
-                        self.store.warn(format!("cache: ignored stored result of {}: {e}", k.hex()));
-                        None
-                    }
-                }
+            .map(|k| match uses[k.as_bytes()] {
+                1 => loaded.pairs.remove(k.as_bytes()),
+                _ => loaded.pairs.get(k.as_bytes()).cloned(),
             })
             .collect();
+        let reuse: Vec<Reused> = {
+            use rayon::prelude::*;
+            candidates
+                .par_iter()
+                .zip(taken.into_par_iter())
+                .map(|(&(a, b), found)| {
+                    let Some((pack, stored)) = found else { return Reused::Missing };
+                    let Stored { result: mut r, beyond: bound, overlap, ids } = stored;
+                    let verdict = r.verdict;
+                    let fits = to_global(&mut r, &parts[a], &parts[b])
+                        .and_then(|()| stored_box(verdict, overlap, &parts[a], &parts[b]));
+                    match fits {
+                        Ok(overlap) => {
+                            let ids = ids.filter(|i| lists && !i.is_empty() && i.len() == r.pairs.len());
+                            Reused::Fits { pack, r, bound, overlap, ids }
+                        }
+                        Err(e) => Reused::Refused(e),
+                    }
+                })
+                .collect()
+        };
+        let mut results: Vec<Option<ClashResult>> = Vec::with_capacity(candidates.len());
+        for (((&(a, b), k), bound), reused) in candidates.iter().zip(&pair_keys).zip(&mut beyond).zip(reuse) {
+            results.push(match reused {
+                Reused::Missing => None,
+                Reused::Refused(e) => {
+                    self.store.warn(format!("cache: ignored stored result of {}: {e}", k.hex()));
+                    None
+                }
+                Reused::Fits { pack, r, bound: stored_bound, overlap, ids } => {
+                    loaded.packs[pack].1 = true;
+                    *bound = stored_bound;
+                    if let Some(o) = overlap {
+                        boxes.insert((a, b), o);
+                    }
+                    if let Some(ids) = ids {
+                        let start = known.len();
+                        known.extend(r.pairs.iter().zip(ids).map(|(p, id)| (p.a, p.b, id)));
+                        known_from.push((*k.as_bytes(), start, known.len()));
+                    }
+                    Some(r)
+                }
+            });
+        }
         let numbering = std::cell::OnceCell::new();
         let numbering = || *numbering.get_or_init(|| numbering_digest(parts));
         let mut fresh: Vec<(Digest, Stored)> = Vec::new();
@@ -803,6 +850,9 @@ impl PairReuse {
         let reused = candidates.len() as u64 - checked;
         // The reduction of the check over its part pairs, as the check itself reduces them.
         let mut reduction = PartPairReduction::new(settings.detail);
+        if lists {
+            reduction.merged.reserve_exact(results.iter().flatten().map(|r| r.pairs.len()).sum());
+        }
         for (&(a, b), r) in candidates.iter().zip(results) {
             reduction.add(a, b, r.expect("every candidate reused or checked"));
         }

@@ -962,3 +962,77 @@ fn finding_ids_are_stored_reused_and_a_wrong_list_is_recomputed() {
     assert_eq!(json(&refused), want);
     assert!(refused.cache.as_ref().unwrap().part_pairs_checked > 0);
 }
+
+// Computed independently with Python's hashlib over the layout of `PartKey::of_part_layout`:
+// a part whose vertices sit after another vertex of the file, numbered from 0 by first use.
+#[test]
+fn part_layout_key_test_vector() {
+    let mesh = Mesh {
+        positions: vec![DVec3::splat(9.0), DVec3::ZERO, DVec3::X, DVec3::Y, DVec3::new(1.0, 1.0, 0.0)],
+        triangles: vec![[1, 2, 3], [2, 4, 3]],
+        tri_object: vec![0, 0],
+        objects: vec![crate::scene::mesh::Object { name: "p".into(), ..Default::default() }],
+    };
+    assert_eq!(
+        PartKey::of_part_layout("p", &mesh, &[0, 1]).hex(),
+        "8961bfddf00d3a01a1b09f771cb6c01509d77f2ec646b2fe9aa273e9ba214529"
+    );
+}
+
+/// Four instances of one glTF mesh (two triangles over four vertices each, one after another
+/// in the file): the third with one vertex nudged, the fourth with its triangles' corners in
+/// another order (it does not read like the others), the fifth a part of its own.
+fn instances() -> Mesh {
+    use crate::scene::mesh::Object;
+    let quad = [DVec3::ZERO, DVec3::X, DVec3::Y, DVec3::new(1.0, 1.0, 0.0)];
+    let mut positions = Vec::new();
+    let mut triangles = Vec::new();
+    let mut tri_object = Vec::new();
+    let mut objects = Vec::new();
+    for k in 0..5u32 {
+        let base = positions.len() as u32;
+        let offset = DVec3::new(f64::from(k) * 2.0, 0.0, 0.0);
+        positions.extend(quad.iter().map(|&p| p + offset));
+        if k == 2 {
+            positions[base as usize + 3].z = 1e-300;
+        }
+        let t = if k == 3 { [[1, 3, 2], [0, 1, 2]] } else { [[0, 1, 2], [1, 3, 2]] };
+        triangles.extend(t.map(|c| c.map(|i| i + base)));
+        tri_object.extend([k, k]);
+        let gltf_mesh = (k < 4).then_some(0);
+        objects.push(Object { name: format!("i{k}"), gltf_mesh, ..Default::default() });
+    }
+    Mesh { positions, triangles, tri_object, objects }
+}
+
+#[test]
+fn part_layout_keys_of_instances_are_each_parts_own() {
+    let mesh = instances();
+    let parts = crate::check::assembly::parts_of(&mesh, 0);
+    let refs: Vec<&crate::check::assembly::Part> = parts.iter().collect();
+    let keys = PartKey::of_part_layouts([&mesh, &mesh], &refs);
+    let one_by_one: Vec<PartKey> =
+        parts.iter().map(|p| PartKey::of_part_layout(&p.name, &mesh, &p.triangles)).collect();
+    assert_eq!(keys, one_by_one);
+    // Any order of the parts: the same key for each.
+    let reversed: Vec<&crate::check::assembly::Part> = parts.iter().rev().collect();
+    let mut back = PartKey::of_part_layouts([&mesh, &mesh], &reversed);
+    back.reverse();
+    assert_eq!(back, keys);
+    let distinct: std::collections::HashSet<PartKey> = keys.iter().copied().collect();
+    assert_eq!(distinct.len(), keys.len());
+    // The same part under another name, moved, or with its corners in another order: a new key.
+    let p = &parts[0];
+    let k = PartKey::of_part_layout(&p.name, &mesh, &p.triangles);
+    assert_ne!(PartKey::of_part_layout("other", &mesh, &p.triangles), k);
+    let mut moved = mesh.clone();
+    moved.positions[0].x = -0.0;
+    assert_ne!(PartKey::of_part_layout(&p.name, &moved, &p.triangles), k);
+    // An instance at the other end of the file, the same coordinates and sharing: the same key.
+    let mut copy = mesh.clone();
+    let base = copy.positions.len() as u32;
+    copy.positions.extend(mesh.positions[..4].iter().copied());
+    copy.triangles.extend([[0, 1, 2], [1, 3, 2]].map(|c| c.map(|i| i + base)));
+    let at = copy.triangles.len() as u32;
+    assert_eq!(PartKey::of_part_layout(&p.name, &copy, &[at - 2, at - 1]), k);
+}

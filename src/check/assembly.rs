@@ -148,7 +148,7 @@ impl Layout {
 
 /// The vertex-index offset that makes `inst` read like `leader` (same triangle count, and each
 /// corner of each triangle the leader's corner plus one common offset), if there is one.
-fn shift_of(mesh: &Mesh, leader: &Part, inst: &Part) -> Option<i64> {
+pub(crate) fn shift_of(mesh: &Mesh, leader: &Part, inst: &Part) -> Option<i64> {
     if leader.triangles.len() != inst.triangles.len() || leader.triangles.is_empty() {
         return None;
     }
@@ -1136,7 +1136,9 @@ impl PartPairReduction {
     /// The merged result (findings sorted by triangle pair, verdict the worst part pair's) and
     /// the part pairs that are not clear.
     pub fn finish(mut self, timings: crate::check::query::Timings) -> (ClashResult, Vec<PartPairSummary>) {
-        self.merged.sort_unstable_by_key(|p| (p.a, p.b));
+        // Each triangle pair is found in one part pair only, so the keys are distinct and any
+        // sort gives one order: sorted in parallel.
+        self.merged.par_sort_unstable_by_key(|p| (p.a, p.b));
         let verdict = self.part_pairs.iter().map(|p| p.verdict).max().unwrap_or(Verdict::Clear);
         let result = ClashResult {
             pairs: self.merged,
