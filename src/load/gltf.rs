@@ -808,19 +808,35 @@ fn decode_mesh(r: &Reader, doc: &Document, m: usize, warnings: &mut Vec<String>)
         }
         let positions = r.positions(&acc, m, prim.index())?;
         let nv = positions.len();
-        let indices: Cow<[u32]> = match prim.indices() {
-            Some(ia) => Cow::Owned(r.indices(&ia, m, prim.index())?),
-            None => Cow::Owned((0..nv as u32).collect()),
-        };
-        if let Some((k, &v)) = indices.iter().enumerate().find(|(_, &v)| v as usize >= nv) {
+        let out_of_range = |k: usize, v: u32| {
             let at = Location::Index { mesh: m, primitive: prim.index(), index: k };
-            return Err(Error::at(r.path, at, InputProblem::IndexOutOfRange { index: v.into(), len: nv }));
-        }
-        let triangles = triangulate(mode, &indices);
-        let leftover = match mode {
-            Mode::Triangles => indices.len() % 3,
-            _ if indices.len() < 3 => indices.len(),
-            _ => 0,
+            Error::at(r.path, at, InputProblem::IndexOutOfRange { index: v.into(), len: nv })
+        };
+        let (triangles, leftover) = match (mode, prim.indices()) {
+            // A triangle list read straight into its triangles.
+            (Mode::Triangles, Some(ia)) => {
+                let (triangles, rest) = r.triangle_indices(&ia, m, prim.index())?;
+                let all = triangles.iter().flatten().chain(&rest);
+                if let Some((k, &v)) = all.enumerate().find(|(_, &v)| v as usize >= nv) {
+                    return Err(out_of_range(k, v));
+                }
+                (triangles, rest.len())
+            }
+            (_, ia) => {
+                let indices: Cow<[u32]> = match ia {
+                    Some(ia) => Cow::Owned(r.indices(&ia, m, prim.index())?),
+                    None => Cow::Owned((0..nv as u32).collect()),
+                };
+                if let Some((k, &v)) = indices.iter().enumerate().find(|(_, &v)| v as usize >= nv) {
+                    return Err(out_of_range(k, v));
+                }
+                let leftover = match mode {
+                    Mode::Triangles => indices.len() % 3,
+                    _ if indices.len() < 3 => indices.len(),
+                    _ => 0,
+                };
+                (triangulate(mode, &indices), leftover)
+            }
         };
         if leftover > 0 {
             warnings

@@ -586,6 +586,11 @@ impl Reader<'_, '_> {
         let t = acc.data_type();
         let size = t.size();
         let norm = acc.normalized();
+        if t == DataType::F32 {
+            // `component` of a FLOAT, without choosing the type per component.
+            let f = |b: &[u8]| f64::from(f32::from_le_bytes([b[0], b[1], b[2], b[3]]));
+            return self.read(acc, user, N * 4, |b| std::array::from_fn(|k| f(&b[k * 4..])));
+        }
         self.read(acc, user, N * size, |b| std::array::from_fn(|k| component(t, norm, &b[k * size..])))
     }
 
@@ -629,6 +634,47 @@ impl Reader<'_, '_> {
             DataType::U32 => self.read(acc, user, 4, |b| u32::from_le_bytes([b[0], b[1], b[2], b[3]])),
             t => Err(self.err(acc, user, GltfProblem::ComponentType { role, found: type_name(t) })),
         }
+    }
+
+    /// The index accessor of a TRIANGLES primitive as its triangles (each three indices in
+    /// order) and the trailing indices that make no triangle: what [`Self::indices`] gives,
+    /// grouped, with its checks and errors. A tightly packed accessor without sparse values is
+    /// decoded straight into triangles (no flat list).
+    pub(crate) fn triangle_indices(
+        &self,
+        acc: &Accessor,
+        mesh: usize,
+        primitive: usize,
+    ) -> Result<(Vec<[u32; 3]>, Vec<u32>)> {
+        let t = acc.data_type();
+        let elem = t.size();
+        let packed = acc.dimensions() == Dimensions::Scalar
+            && matches!(t, DataType::U8 | DataType::U16 | DataType::U32)
+            && acc.sparse().is_none()
+            && acc.view().is_some_and(|v| v.stride().is_none_or(|s| s == elem));
+        let Some(view) = acc.view().filter(|_| packed) else {
+            let flat = self.indices(acc, mesh, primitive)?;
+            let whole = flat.len() / 3 * 3;
+            let triangles = flat[..whole].chunks_exact(3).map(|c| [c[0], c[1], c[2]]).collect();
+            return Ok((triangles, flat[whole..].to_vec()));
+        };
+        let user = AccessorUser::Primitive { mesh, primitive };
+        let data = self.view_bytes(&view)?;
+        let count = acc.count();
+        self.fits((acc, user, AccessorPart::Elements), count, elem, elem, acc.offset(), data.len())?;
+        let data = &data[acc.offset().min(data.len())..];
+        let data = &data[..count * elem];
+        fn group<const E: usize>(data: &[u8], one: fn([u8; E]) -> u32) -> (Vec<[u32; 3]>, Vec<u32>) {
+            let at = |c: &[u8], k: usize| one(c[k * E..(k + 1) * E].try_into().expect("E bytes"));
+            let triples = data.chunks_exact(3 * E);
+            let rest = triples.remainder().chunks_exact(E).map(|c| at(c, 0)).collect();
+            (triples.map(|c| [at(c, 0), at(c, 1), at(c, 2)]).collect(), rest)
+        }
+        Ok(match elem {
+            1 => group::<1>(data, |b| b[0] as u32),
+            2 => group::<2>(data, |b| u16::from_le_bytes(b) as u32),
+            _ => group::<4>(data, u32::from_le_bytes),
+        })
     }
 
     /// The bytes of buffer view `view`, checked against its buffer.

@@ -286,6 +286,64 @@ fn non_finite_positions() {
     assert!(e.contains("glTF node 8: world transform is not finite"), "{e}");
 }
 
+/// Triangle lists of every index type, tightly packed (read straight into triangles) or with
+/// sparse values (read as a flat list): the same triangles, trailing index warning and
+/// out-of-range errors (numbered in the flat list) either way.
+#[test]
+fn triangle_lists_of_every_index_type_packed_or_sparse() {
+    let pad = |b: &mut Vec<u8>| b.resize(b.len().div_ceil(4) * 4, 0);
+    for (ct, size) in [(5121, 1usize), (5123, 2), (5125, 4)] {
+        let enc = |v: u32| v.to_le_bytes()[..size].to_vec();
+        for sparse in [false, true] {
+            for (bad_at, bad) in [(None, 0), (Some(4), 9), (Some(6), 9)] {
+                let mut idx = [0u32, 1, 2, 2, 1, 3, 3];
+                if let Some(k) = bad_at {
+                    idx[k] = bad;
+                }
+                let mut bin = f32s(&[0., 0., 0., 1., 0., 0., 0., 1., 0., 1., 1., 0.]);
+                idx.iter().for_each(|&v| bin.extend(enc(v)));
+                pad(&mut bin);
+                let sparse_at = bin.len();
+                bin.push(4);
+                pad(&mut bin);
+                let value_at = bin.len();
+                bin.extend(enc(0));
+                pad(&mut bin);
+                let sparse_member = if sparse {
+                    r#","sparse":{"count":1,"indices":{"bufferView":2,"componentType":5121},"values":{"bufferView":3}}"#
+                } else {
+                    ""
+                };
+                let body = format!(
+                    r#""bufferViews":[{{"buffer":0,"byteLength":48}},{{"buffer":0,"byteOffset":48,"byteLength":{}}},
+                        {{"buffer":0,"byteOffset":{sparse_at},"byteLength":1}},{{"buffer":0,"byteOffset":{value_at},"byteLength":{size}}}],
+                      "accessors":[{{"bufferView":0,"componentType":5126,"count":4,"type":"VEC3","min":[0,0,0],"max":[1,1,0]}},
+                        {{"bufferView":1,"componentType":{ct},"count":7,"type":"SCALAR"{sparse_member}}}],
+                      "meshes":[{{"primitives":[{{"attributes":{{"POSITION":0}},"indices":1}}]}}],
+                      "nodes":[{{"mesh":0}}]"#,
+                    7 * size
+                );
+                let doc = gltf(&bin, &body);
+                let case = format!("component type {ct}, sparse {sparse}, {bad_at:?}");
+                match bad_at {
+                    Some(k) if !(sparse && k == 4) => {
+                        let e = err(&doc);
+                        let want = format!("index {k} refers to vertex 9 but there are 4 vertices");
+                        assert!(e.contains(&want), "{case}: {e}");
+                    }
+                    _ => {
+                        let l = ok(&doc);
+                        let second = if sparse { [2, 0, 3] } else { [2, 1, 3] };
+                        assert_eq!(l.mesh.triangles, [[0, 1, 2], second], "{case}");
+                        assert_eq!(l.warnings.len(), 1, "{case}: {:?}", l.warnings);
+                        assert!(l.warnings[0].contains("1 trailing indices"), "{case}: {:?}", l.warnings);
+                    }
+                }
+            }
+        }
+    }
+}
+
 #[test]
 fn index_out_of_range() {
     let mut bin = tri_bin();

@@ -140,10 +140,33 @@ impl Format {
 /// it is opened, so a FIFO cannot block the run and a device cannot stream without end
 ///. Symlinks are followed: the link's target must be a regular file.
 pub fn load_path(path: &Path) -> Result<(Loaded, Format)> {
+    let obj = path.extension().is_some_and(|e| e.eq_ignore_ascii_case("obj"));
+    if obj {
+        if let Some(loaded) = load_obj_streamed(path)? {
+            return Ok((loaded, Format::Obj));
+        }
+    }
     let bytes = read_regular_file(path, Reading::File, u64::MAX)?;
     let format = detect_format(path, &bytes)?;
     let loaded = load_bytes(path, &bytes, format)?;
     Ok((loaded, format))
+}
+
+/// An OBJ file parsed as it is read, a chunk at a time ([`obj::load_file`]), with the checks
+/// and errors of [`load_path`]: its head is checked as [`detect_format`] checks it, the mesh
+/// validated. `None` when the fast path declines or the file cannot be read so: [`load_path`]
+/// then reads it whole, and reports what it finds.
+fn load_obj_streamed(path: &Path) -> Result<Option<Loaded>> {
+    use std::os::unix::fs::FileExt;
+    let (f, size) = open_regular(path, Reading::File)?;
+    let mut head = vec![0u8; size.min(4096) as usize];
+    if f.read_exact_at(&mut head, 0).is_err() {
+        return Ok(None);
+    }
+    detect_format(path, &head)?;
+    let Some(loaded) = obj::load_file(&f, size) else { return Ok(None) };
+    validate(path, &loaded)?;
+    Ok(Some(loaded))
 }
 
 /// The most bytes a plan, shard report, baseline or clash-set file may have (1 GiB): read

@@ -91,6 +91,13 @@ pub(crate) fn load(path: &Path, bytes: &[u8]) -> Result<Loaded> {
     Parser::new(path, MAX_TRIANGLES).run(bytes)
 }
 
+/// Parses the OBJ file `file` of `size` bytes on the parallel fast path, reading it a chunk at a
+/// time (never whole); `None` when the fast path declines (the caller then reads the file whole
+/// and calls [`load`], which reports the problem) or the file cannot be read as it was.
+pub(crate) fn load_file(file: &std::fs::File, size: u64) -> Option<Loaded> {
+    chunked::parse_file(file, size, MAX_TRIANGLES, chunked::CHUNK_BYTES)
+}
+
 struct Parser<'p> {
     path: &'p Path,
     mesh: Mesh,
@@ -394,7 +401,6 @@ mod chunked {
     use super::{decimal, plain_index, trim_end, Tokens, IGNORED, MAX_FACE_VERTICES};
     use crate::scene::mesh::{Loaded, Mesh, Object};
     use glam::DVec3;
-    use rayon::prelude::*;
 
     /// Nominal chunk size (a chunk ends at the first line end after it). A cost knob only.
     pub(super) const CHUNK_BYTES: usize = 1 << 18;
@@ -435,22 +441,272 @@ mod chunked {
 
     /// Parses `bytes` if the fast path can (see the module doc); `None` otherwise.
     pub(super) fn parse(bytes: &[u8], max_triangles: usize, chunk_bytes: usize) -> Option<Loaded> {
-        let chunks: Vec<Chunk> =
-            cut(bytes, chunk_bytes).into_par_iter().map(|r| chunk(&bytes[r])).collect::<Option<_>>()?;
-        join(chunks, max_triangles)
+        run(&InMemory { bytes, ranges: cut(bytes, chunk_bytes) }, max_triangles)
     }
 
-    fn chunk(bytes: &[u8]) -> Option<Chunk> {
+    /// Parses the regular file `file` of `size` bytes if the fast path can, reading it a chunk
+    /// at a time into each worker's own buffer (the whole file is never held in memory, and
+    /// the bytes are parsed while they are still in the cache they were read into); `None`
+    /// otherwise, or when the file cannot be read as it was when `size` was taken (it failed,
+    /// shrank or grew): the caller then reads it whole.
+    pub(super) fn parse_file(
+        file: &std::fs::File,
+        size: u64,
+        max_triangles: usize,
+        chunk_bytes: usize,
+    ) -> Option<Loaded> {
+        let loaded = run(&InFile { file, size, chunk: chunk_bytes.max(1) as u64 }, max_triangles)?;
+        (file.metadata().ok()?.len() == size).then_some(loaded)
+    }
+
+    /// Where the chunks' bytes come from: a slice in memory or a file read chunk by chunk.
+    trait Source: Sync {
+        /// How many chunks.
+        fn count(&self) -> usize;
+        /// The bytes of chunk `k` (whole lines), read into `buf` when they are not in memory;
+        /// `None` when they cannot be read.
+        fn bytes<'s>(&'s self, k: usize, buf: &'s mut Vec<u8>) -> Option<&'s [u8]>;
+    }
+
+    /// A file in memory, cut at line ends ([`cut`]).
+    struct InMemory<'a> {
+        bytes: &'a [u8],
+        ranges: Vec<std::ops::Range<usize>>,
+    }
+
+    impl Source for InMemory<'_> {
+        fn count(&self) -> usize {
+            self.ranges.len()
+        }
+        fn bytes<'s>(&'s self, k: usize, _: &'s mut Vec<u8>) -> Option<&'s [u8]> {
+            Some(&self.bytes[self.ranges[k].clone()])
+        }
+    }
+
+    /// A file on disk in chunks of `chunk` bytes: chunk `k` holds the lines that start in
+    /// `[k·chunk, (k+1)·chunk)` (a line starts at 0 or after a `\n`), so the chunks are found
+    /// each on its own, reading around their nominal range only, and they cover the file once.
+    struct InFile<'f> {
+        file: &'f std::fs::File,
+        size: u64,
+        chunk: u64,
+    }
+
+    /// Bytes read past a chunk's nominal end at first, for its last line.
+    const MARGIN: u64 = 4096;
+
+    /// The bytes of the file from `base` on read so far into `buf[..filled]`.
+    struct Window<'f, 'b> {
+        file: &'f std::fs::File,
+        size: u64,
+        base: u64,
+        filled: usize,
+        buf: &'b mut Vec<u8>,
+    }
+
+    impl Window<'_, '_> {
+        /// Reads on up to file position `upto` (at most the file's size); false when the read
+        /// fails or comes short.
+        fn fill(&mut self, upto: u64) -> bool {
+            use std::os::unix::fs::FileExt;
+            let upto = upto.min(self.size);
+            let have = self.base + self.filled as u64;
+            if upto <= have {
+                return true;
+            }
+            let need = (upto - self.base) as usize;
+            if self.buf.len() < need {
+                // The buffer only grows, and is reused from chunk to chunk: zeroed once.
+                self.buf.resize(need, 0);
+            }
+            if self.file.read_exact_at(&mut self.buf[self.filled..need], have).is_err() {
+                return false;
+            }
+            self.filled = need;
+            true
+        }
+
+        /// The start of the first line that starts after position `from` and at most at
+        /// `limit` (the position after the first `\n` at or after `from`), reading on as far as
+        /// needed; `Some(None)` when there is none up to `limit`, `None` when a read fails.
+        fn line_start_after(&mut self, from: u64, limit: u64) -> Option<Option<u64>> {
+            let mut at = from;
+            loop {
+                let end = self.base + self.filled as u64;
+                let window = &self.buf[(at - self.base) as usize..self.filled];
+                if let Some(i) = memchr::memchr(b'\n', window) {
+                    let start = at + i as u64 + 1;
+                    return Some((start <= limit).then_some(start));
+                }
+                if end >= limit.min(self.size) {
+                    return Some(None);
+                }
+                at = end;
+                let more = (self.filled as u64).max(1 << 16);
+                if !self.fill(end.saturating_add(more)) {
+                    return None;
+                }
+            }
+        }
+    }
+
+    impl Source for InFile<'_> {
+        fn count(&self) -> usize {
+            self.size.div_ceil(self.chunk) as usize
+        }
+        fn bytes<'s>(&'s self, k: usize, buf: &'s mut Vec<u8>) -> Option<&'s [u8]> {
+            let (size, lo) = (self.size, k as u64 * self.chunk);
+            let hi = lo.saturating_add(self.chunk).min(size);
+            let base = lo.saturating_sub(1);
+            let mut w = Window { file: self.file, size, base, filled: 0, buf };
+            if !w.fill(hi.saturating_add(MARGIN)) {
+                return None;
+            }
+            // The chunk's first line: the file's first, or the first starting in [lo, hi)
+            // (none: a line that started before spans the chunk, which is then empty).
+            let start = if k == 0 {
+                0
+            } else {
+                match w.line_start_after(lo - 1, hi - 1)? {
+                    Some(s) => s,
+                    None => return Some(&[]),
+                }
+            };
+            // Its end: where the next chunk's first line starts (the first line start at or
+            // after `hi`), or the file's end.
+            let end = if hi == size { size } else { w.line_start_after(hi - 1, size)?.unwrap_or(size) };
+            if !w.fill(end) {
+                return None;
+            }
+            let Window { base, buf, .. } = w;
+            let buf: &'s Vec<u8> = buf;
+            Some(&buf[(start - base) as usize..(end - base) as usize])
+        }
+    }
+
+    /// What has been joined so far, in file order.
+    struct Joined {
+        /// The next chunk to join.
+        turn: usize,
+        /// A chunk declined (or a worker stopped): the fast path gives up.
+        failed: bool,
+        mesh: Mesh,
+        max_index: u64,
+    }
+
+    /// Marks the join failed when a worker unwinds, so that no other waits for its chunk.
+    struct FailOnUnwind<'a>(&'a std::sync::Mutex<Joined>, &'a std::sync::Condvar);
+
+    impl Drop for FailOnUnwind<'_> {
+        fn drop(&mut self) {
+            if std::thread::panicking() {
+                self.0.lock().unwrap_or_else(std::sync::PoisonError::into_inner).failed = true;
+                self.1.notify_all();
+            }
+        }
+    }
+
+    /// Parses the chunks of `source` on every core: each worker takes the next chunk, parses it
+    /// into its own vectors (reused from chunk to chunk) and, when the chunks before it are
+    /// joined, appends it to the mesh; so the mesh is built in file order once, without a
+    /// vector per chunk nor a second copy.
+    fn run(source: &impl Source, max_triangles: usize) -> Option<Loaded> {
+        use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
+        use std::sync::{Condvar, Mutex, PoisonError};
+        let n = source.count();
+        let next = AtomicUsize::new(0);
+        let stop = AtomicBool::new(false);
+        let joined = Mutex::new(Joined {
+            turn: 0,
+            failed: false,
+            mesh: Mesh { objects: vec![Object::default()], ..Default::default() },
+            max_index: 0,
+        });
+        let cv = Condvar::new();
+        let work = || {
+            let _guard = FailOnUnwind(&joined, &cv);
+            let mut buf = Vec::new();
+            let mut c = Chunk::default();
+            loop {
+                let k = next.fetch_add(1, Ordering::Relaxed);
+                if k >= n || stop.load(Ordering::Relaxed) {
+                    return;
+                }
+                let parsed = source.bytes(k, &mut buf).is_some_and(|b| chunk_into(b, &mut c).is_some());
+                let mut j = joined.lock().unwrap_or_else(PoisonError::into_inner);
+                while j.turn != k && !j.failed {
+                    j = cv.wait(j).unwrap_or_else(PoisonError::into_inner);
+                }
+                if j.failed {
+                    return;
+                }
+                if parsed && append(&mut j, &mut c, max_triangles) {
+                    j.turn += 1;
+                } else {
+                    j.failed = true;
+                    stop.store(true, Ordering::Relaxed);
+                }
+                drop(j);
+                cv.notify_all();
+            }
+        };
+        let workers = rayon::current_num_threads().min(n).max(1);
+        rayon::scope(|s| {
+            let work = &work;
+            for _ in 1..workers {
+                s.spawn(move |_| work());
+            }
+            work();
+        });
+        let Joined { turn, failed, mut mesh, max_index } =
+            joined.into_inner().unwrap_or_else(PoisonError::into_inner);
+        if failed || turn != n || max_index > mesh.positions.len() as u64 {
+            return None; // a chunk declined, or a face refers beyond the file's vertices
+        }
+        super::drop_empty_objects(&mut mesh);
+        for (i, o) in mesh.objects.iter_mut().enumerate() {
+            if o.name.is_empty() {
+                o.name = format!("object{i}");
+            }
+        }
+        Some(Loaded { mesh, warnings: Vec::new() })
+    }
+
+    /// Appends the next chunk `c` to `j`, resolving its relative indices and its objects;
+    /// false when the file would exceed the triangle or vertex bound.
+    fn append(j: &mut Joined, c: &mut Chunk, max_triangles: usize) -> bool {
+        let mesh = &mut j.mesh;
+        let (v0, t0, o0) = (mesh.positions.len(), mesh.triangles.len(), mesh.objects.len() as u32 - 1);
+        if t0 + c.triangles.len() > max_triangles || v0 + c.positions.len() > u32::MAX as usize + 1 {
+            return false;
+        }
+        mesh.positions.extend_from_slice(&c.positions);
+        mesh.triangles.extend_from_slice(&c.triangles);
+        for &(slot, r) in &c.relative {
+            let Ok(v) = u32::try_from(v0 as i64 + r) else { return false };
+            mesh.triangles[t0 + slot / 3][slot % 3] = v;
+        }
+        mesh.tri_object.extend(c.names_before.iter().map(|&k| o0 + k));
+        mesh.objects.extend(c.names.drain(..).map(|name| Object { name, ..Default::default() }));
+        j.max_index = j.max_index.max(c.max_index);
+        true
+    }
+
+    /// Parses one chunk into `c` (emptied first; its vectors keep their capacity).
+    fn chunk_into(bytes: &[u8], c: &mut Chunk) -> Option<()> {
         // Capacity for the most vertices and plain triangles the chunk can hold (a statement
         // takes at least 8 bytes), so the vectors never move while growing: reserved but
         // untouched pages cost nothing.
         let most = bytes.len() / 8 + 1;
-        let mut c = Chunk {
-            positions: Vec::with_capacity(most),
-            triangles: Vec::with_capacity(most),
-            names_before: Vec::with_capacity(most),
-            ..Chunk::default()
-        };
+        c.positions.clear();
+        c.triangles.clear();
+        c.names_before.clear();
+        c.names.clear();
+        c.relative.clear();
+        c.max_index = 0;
+        c.positions.reserve(most);
+        c.triangles.reserve(most);
+        c.names_before.reserve(most);
         let mut face: Vec<i64> = Vec::new();
         let mut start = 0;
         let ends = memchr::memchr_iter(b'\n', bytes).chain(std::iter::once(bytes.len()));
@@ -533,7 +789,7 @@ mod chunked {
                     for i in 1..face.len() - 1 {
                         let base = slot0 + (i - 1) * 3;
                         for (corner, k) in [0, i, i + 1].into_iter().enumerate() {
-                            resolved[corner] = at(k, base + corner, &mut c)?;
+                            resolved[corner] = at(k, base + corner, c)?;
                         }
                         c.triangles.push(resolved);
                         c.names_before.push(names);
@@ -546,7 +802,7 @@ mod chunked {
                 _ => return None, // `p`/`l` and unrecognised lines warn: the sequential parser
             }
         }
-        Some(c)
+        Some(())
     }
 
     /// A blank between the fields of a plain statement (the general path splits at any ASCII
@@ -628,42 +884,6 @@ mod chunked {
         rest[i..].iter().all(|b| blank(Some(b))).then_some(v)
     }
 
-    fn join(chunks: Vec<Chunk>, max_triangles: usize) -> Option<Loaded> {
-        let vertices: usize = chunks.iter().map(|c| c.positions.len()).sum();
-        let triangles: usize = chunks.iter().map(|c| c.triangles.len()).sum();
-        if triangles > max_triangles || vertices > u32::MAX as usize + 1 {
-            return None;
-        }
-        if chunks.iter().any(|c| c.max_index > vertices as u64) {
-            return None; // a face refers beyond the file's vertices
-        }
-        let mut mesh = Mesh {
-            positions: Vec::with_capacity(vertices),
-            triangles: Vec::with_capacity(triangles),
-            tri_object: Vec::with_capacity(triangles),
-            objects: vec![Object::default()],
-        };
-        for c in chunks {
-            let (v0, t0, o0) =
-                (mesh.positions.len() as i64, mesh.triangles.len(), mesh.objects.len() as u32 - 1);
-            mesh.positions.extend_from_slice(&c.positions);
-            mesh.triangles.extend_from_slice(&c.triangles);
-            for (slot, r) in c.relative {
-                let v = u32::try_from(v0 + r).ok()?;
-                mesh.triangles[t0 + slot / 3][slot % 3] = v;
-            }
-            mesh.tri_object.extend(c.names_before.iter().map(|&k| o0 + k));
-            mesh.objects.extend(c.names.into_iter().map(|name| Object { name, ..Default::default() }));
-        }
-        super::drop_empty_objects(&mut mesh);
-        for (i, o) in mesh.objects.iter_mut().enumerate() {
-            if o.name.is_empty() {
-                o.name = format!("object{i}");
-            }
-        }
-        Some(Loaded { mesh, warnings: Vec::new() })
-    }
-
     #[cfg(test)]
     mod tests {
         use super::super::Parser;
@@ -673,9 +893,17 @@ mod chunked {
         /// for every chunk size (1 byte: a chunk per line).
         fn agree(src: &[u8]) -> bool {
             let want = Parser::new(Path::new("t.obj"), 1 << 20).run(src);
+            let file = in_file(src);
             let mut took = false;
             for size in [1, 7, 64, 1 << 20] {
-                if let Some(got) = super::parse(src, 1 << 20, size) {
+                let got = super::parse(src, 1 << 20, size);
+                let read = super::parse_file(file.as_file(), src.len() as u64, 1 << 20, size);
+                assert_eq!(
+                    format!("{:?}", read.as_ref().map(|l| &l.mesh)),
+                    format!("{:?}", got.as_ref().map(|l| &l.mesh)),
+                    "read from a file in chunks of {size} bytes"
+                );
+                if let Some(got) = got {
                     let want = want.as_ref().expect("the fast path accepted a file the parser refuses");
                     assert!(want.warnings.is_empty());
                     assert_eq!(format!("{:?}", got.mesh), format!("{:?}", want.mesh), "chunk size {size}");
@@ -683,6 +911,65 @@ mod chunked {
                 }
             }
             took
+        }
+
+        /// `src` in a temporary file.
+        fn in_file(src: &[u8]) -> tempfile::NamedTempFile {
+            use std::io::Write;
+            let mut f = tempfile::NamedTempFile::new().unwrap();
+            f.write_all(src).unwrap();
+            f
+        }
+
+        /// Lines longer than a chunk and than what is read past a chunk's end at first, a file
+        /// without a final line end, blank and `\r\n` lines: read from the file in chunks of
+        /// every size, the mesh is the one parsed in memory.
+        #[test]
+        fn file_read_in_chunks_equals_the_file_in_memory() {
+            let long = |n: usize| [b"# ".as_slice(), &vec![b'x'; n], b"\n"].concat();
+            let mut src = b"v 0 0 0\nv 1 0 0\r\n\n".to_vec();
+            src.extend(long(10_000));
+            src.extend(b"v 0 1 0\no ");
+            src.extend(vec![b'n'; 9000]);
+            src.extend(b"\nf 1 2 3\n");
+            src.extend(long(3));
+            src.extend(long(70_000));
+            src.extend(b"f 3 2 1");
+            let want = Parser::new(Path::new("t.obj"), 1 << 20).run(&src).unwrap();
+            let file = in_file(&src);
+            for size in [1, 2, 3, 7, 64, 4095, 4096, 4097, 10_000, 1 << 16, 1 << 20] {
+                let got = super::parse_file(file.as_file(), src.len() as u64, 1 << 20, size)
+                    .unwrap_or_else(|| panic!("declined with chunks of {size} bytes"));
+                assert_eq!(format!("{:?}", got.mesh), format!("{:?}", want.mesh), "chunks of {size} bytes");
+            }
+            assert_eq!(want.mesh.triangles.len(), 2);
+            assert_eq!(want.mesh.objects[0].name.len(), 9000);
+            // A file that is not the size it was taken to be (it changed): declined.
+            let n = src.len() as u64;
+            assert!(super::parse_file(file.as_file(), n - 1, 1 << 20, 64).is_none());
+            assert!(super::parse_file(file.as_file(), n + 1, 1 << 20, 64).is_none());
+        }
+
+        /// One line of a megabyte in chunks of 64 bytes: only the chunk where it starts reads
+        /// it (the others find no line of their own), so reading stays linear.
+        #[test]
+        fn a_line_spanning_many_chunks_is_read_once() {
+            let mut src = b"v 0 0 0\nv 1 0 0\nv 0 1 0\n#".to_vec();
+            src.extend(vec![b'c'; 1 << 20]);
+            src.extend(b"\nf 1 2 3\n");
+            let file = in_file(&src);
+            let source = super::InFile { file: file.as_file(), size: src.len() as u64, chunk: 64 };
+            let mut buf = Vec::new();
+            let mut lines = Vec::new();
+            for k in 0..super::Source::count(&source) {
+                let bytes = super::Source::bytes(&source, k, &mut buf).unwrap().to_vec();
+                assert!(buf.len() < 70_000 || bytes.len() > 1 << 20, "chunk {k} read {} bytes", buf.len());
+                if !bytes.is_empty() {
+                    lines.push(bytes);
+                }
+                buf = Vec::new();
+            }
+            assert_eq!(lines.concat(), src);
         }
 
         #[test]
