@@ -80,11 +80,22 @@ impl ExactBox {
         }
     }
 
-    fn add(&mut self, p: Point) {
-        for k in 0..3 {
-            let r = Ratio::new(p.num[k].clone(), p.den.clone());
-            self.extend(k, &r, &r);
+    /// Add point `p` on the axes of `axes` (an axis left out must be one the point cannot
+    /// move: see [`ExactBox::may_move`]; its coordinate is not read).
+    fn add(&mut self, p: Point, axes: [bool; 3]) {
+        let Point { num, den } = p;
+        for (k, n) in num.into_iter().enumerate() {
+            if axes[k] {
+                let r = Ratio::new(n, den.clone());
+                self.extend(k, &r, &r);
+            }
         }
+    }
+
+    /// Per axis, whether a point known to lie in `b` may move that axis's bounds: false when
+    /// `b` lies strictly inside the box along it (the point then cannot move it).
+    fn may_move(&self, b: &Aabb) -> [bool; 3] {
+        [0, 1, 2].map(|k| !(self.inner[k].0 <= b.min[k] && b.max[k] <= self.inner[k].1))
     }
 
     /// Widen axis `k` to take in `[lo, hi]`.
@@ -118,7 +129,7 @@ impl ExactBox {
 
     fn add_vertex(&mut self, v: DVec3) {
         let num = self.frame.point(v);
-        self.add(Point { num, den: Int::from_i64(1) });
+        self.add(Point { num, den: Int::from_i64(1) }, [true; 3]);
     }
 
     /// True if `v` is strictly inside the box (so it cannot move it).
@@ -153,24 +164,39 @@ fn proper<M: TriMesh + ?Sized>(m: &M, t: u32) -> bool {
     !Shape::of(&m.triangle(t)).is_degenerate()
 }
 
-/// The point `p + t (q - p)` for `t = n / d` (`d != 0`).
-fn along(f: &Frame, p: DVec3, q: DVec3, n: &Int, d: &Int) -> Point {
-    let (ip, iq) = (f.point(p), f.point(q));
-    let num = [0, 1, 2].map(|k| ip[k].mul(d).add(&n.mul(&iq[k].sub(&ip[k]))));
+/// The point `p + t (q - p)` for `t = n / d` (`d != 0`), its coordinates on the axes of `axes`
+/// (the others are left zero: see [`ExactBox::add`]).
+fn along(f: &Frame, p: DVec3, q: DVec3, n: &Int, d: &Int, axes: [bool; 3]) -> Point {
+    let num = [0, 1, 2].map(|k| {
+        if !axes[k] {
+            return Int::default();
+        }
+        let (ip, iq) = (f.int(p[k]), f.int(q[k]));
+        ip.mul(d).add(&n.mul(&iq.sub(&ip)))
+    });
     Point { num, den: d.clone() }
+}
+
+/// The vertex `v` as a point, its coordinates on the axes of `axes` (see [`along`]).
+fn vertex_point(f: &Frame, v: DVec3, axes: [bool; 3]) -> Point {
+    let num = [0, 1, 2].map(|k| if axes[k] { f.int(v[k]) } else { Int::default() });
+    Point { num, den: Int::from_i64(1) }
 }
 
 /// Add to `acc` the points of segment `p q` ∩ closed triangle `tri` that can be vertices of
 /// the intersection: the crossing point, or the ends of the piece inside a coplanar triangle.
-fn edge_face(acc: &mut ExactBox, p: DVec3, q: DVec3, tri: [DVec3; 3]) {
+/// `within` encloses segment ∩ triangle (exact f64 bounds): only the axes along which it is
+/// not strictly inside the box found so far are computed and compared.
+fn edge_face(acc: &mut ExactBox, p: DVec3, q: DVec3, tri: [DVec3; 3], within: &Aabb) {
     let [a, b, c] = tri;
     let (sp, sq) = (pr::orient3d(a, b, c, p), pr::orient3d(a, b, c, q));
     if sp * sq > 0 {
         return;
     }
     let f = acc.frame;
+    let axes = acc.may_move(within);
     if sp == 0 && sq == 0 {
-        coplanar(acc, p, q, tri);
+        coplanar(acc, p, q, tri, axes);
         return;
     }
     // The line crosses the plane once: inside the closed triangle iff the three orientations
@@ -180,21 +206,21 @@ fn edge_face(acc: &mut ExactBox, p: DVec3, q: DVec3, tri: [DVec3; 3]) {
         return;
     }
     let point = match (sp, sq) {
-        (0, _) => Point { num: f.point(p), den: Int::from_i64(1) },
-        (_, 0) => Point { num: f.point(q), den: Int::from_i64(1) },
+        (0, _) => vertex_point(&f, p, axes),
+        (_, 0) => vertex_point(&f, q, axes),
         _ => {
-            let vp = exact::orient3d(&f, a, b, c, p);
-            let vq = exact::orient3d(&f, a, b, c, q);
+            let (vp, vq) = exact::orient3d_two(&f, a, b, c, p, q);
             let d = vp.sub(&vq);
-            along(&f, p, q, &vp, &d)
+            along(&f, p, q, &vp, &d, axes)
         }
     };
-    acc.add(point);
+    acc.add(point, axes);
 }
 
 /// Segment `p q` in the plane of the proper triangle `tri`: clip it to the triangle in the
 /// projection that drops an axis the triangle is not parallel to, and add the ends.
-fn coplanar(acc: &mut ExactBox, p: DVec3, q: DVec3, tri: [DVec3; 3]) {
+/// Only the axes of `axes` are computed (see [`ExactBox::add`]).
+fn coplanar(acc: &mut ExactBox, p: DVec3, q: DVec3, tri: [DVec3; 3], axes: [bool; 3]) {
     let f = acc.frame;
     let Some(axis) = (0..3).find(|&k| pr::orient2d(tri[0], tri[1], tri[2], k) != 0) else {
         return;
@@ -236,7 +262,7 @@ fn coplanar(acc: &mut ExactBox, p: DVec3, q: DVec3, tri: [DVec3; 3]) {
         return;
     }
     for t in [lo, hi] {
-        acc.add(along(&f, p, q, &t.num, &t.den));
+        acc.add(along(&f, p, q, &t.num, &t.den, axes), axes);
     }
 }
 
@@ -472,7 +498,7 @@ where
                     let tb = Aabb::of_triangle(&tri);
                     let common = Aabb { min: seg.min.max(tb.min), max: seg.max.min(tb.max) };
                     if !acc.strictly_contains(&common) && proper(other, t) {
-                        edge_face(&mut acc, p, q, tri);
+                        edge_face(&mut acc, p, q, tri, &common);
                     }
                     false
                 });
@@ -675,7 +701,8 @@ mod tests {
                 let v = m.indices(t);
                 for k in 0..3 {
                     for u in 0..o.triangles.len() as u32 {
-                        edge_face(&mut acc, m.vertex(v[k]), m.vertex(v[(k + 1) % 3]), o.triangle(u));
+                        let all = Aabb { min: DVec3::NEG_INFINITY, max: DVec3::INFINITY };
+                        edge_face(&mut acc, m.vertex(v[k]), m.vertex(v[(k + 1) % 3]), o.triangle(u), &all);
                     }
                 }
             }

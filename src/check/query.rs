@@ -525,14 +525,23 @@ where
         ta,
         tb,
         |x, y| !stop.load(Ordering::Relaxed) && tol.boxes_may_meet(x, y),
-        |la, lb, out| leaf_pairs(a, la, b, lb, settings, &stop, |f| out.push(f)),
+        |la, lb, out| leaf_pairs(a, la, b, lb, settings, &stop, true, |f, _| out.push(f)),
     );
     pairs.par_sort_unstable_by_key(|p| (p.a, p.b));
     (pairs, stop.load(Ordering::Relaxed))
 }
 
+/// Triangles of a leaf prepared at a time ([`leaf_pairs`]; the default leaves hold 4).
+const LEAF_CHUNK: usize = 8;
+
 /// Classify every pair of triangles of two leaves whose boxes may meet, handing each finding
 /// to `found`; with `first_hit`, the first crossing raises `stop` and the rest are skipped.
+///
+/// Each triangle is read, boxed and prepared ([`tri_tri::Prepared`]) once per leaf pair, not
+/// once per candidate. Without `segments`, an exact contact of two proper triangles comes
+/// without its f64 segment; `found` gets, with each finding, a way to classify that pair again
+/// with everything (for the few findings it keeps).
+#[allow(clippy::too_many_arguments)]
 fn leaf_pairs<A, B>(
     a: &A,
     la: &[u32],
@@ -540,28 +549,39 @@ fn leaf_pairs<A, B>(
     lb: &[u32],
     settings: &Settings,
     stop: &AtomicBool,
-    mut found: impl FnMut(PairFinding),
+    segments: bool,
+    mut found: impl FnMut(PairFinding, &dyn Fn() -> PairFinding),
 ) where
     A: TriMesh + ?Sized,
     B: TriMesh + ?Sized,
 {
     let tol = settings.tolerances;
-    for &i in la {
-        let ti = a.triangle(i);
-        let bi = Aabb::of_triangle(&ti);
-        for &j in lb {
-            let tj = b.triangle(j);
-            if !tol.boxes_may_meet(&bi, &Aabb::of_triangle(&tj)) {
-                continue;
-            }
-            if stop.load(Ordering::Relaxed) {
-                return;
-            }
-            if let Some(f) = classify_pair(i, &ti, j, &tj, &tol, settings.mode) {
-                if settings.first_hit && f.kind == PairKind::Crossing {
-                    stop.store(true, Ordering::Relaxed);
+    for chunk in lb.chunks(LEAF_CHUNK) {
+        let side_b: [Option<(Aabb, tri_tri::Prepared)>; LEAF_CHUNK] = std::array::from_fn(|k| {
+            chunk.get(k).map(|&j| {
+                let t = b.triangle(j);
+                (Aabb::of_triangle(&t), tri_tri::Prepared::new(t))
+            })
+        });
+        for &i in la {
+            let ti = a.triangle(i);
+            let bi = Aabb::of_triangle(&ti);
+            let mut pi: Option<tri_tri::Prepared> = None;
+            for (&j, (bj, pj)) in chunk.iter().zip(side_b.iter().flatten()) {
+                if !tol.boxes_may_meet(&bi, bj) {
+                    continue;
                 }
-                found(f);
+                if stop.load(Ordering::Relaxed) {
+                    return;
+                }
+                let pi = &*pi.get_or_insert_with(|| tri_tri::Prepared::new(ti));
+                if let Some(f) = classify_pair(i, pi, j, pj, &tol, settings.mode, segments) {
+                    if settings.first_hit && f.kind == PairKind::Crossing {
+                        stop.store(true, Ordering::Relaxed);
+                    }
+                    let full = || classify_pair(i, pi, j, pj, &tol, settings.mode, true).unwrap_or(f);
+                    found(f, &full);
+                }
             }
         }
     }
@@ -596,6 +616,13 @@ impl Tally {
             self.best = Some(p);
         }
         self.coplanar_area |= p.contact == Some(Contact::CoplanarArea);
+    }
+
+    /// Would [`Tally::add`] keep `p` (as the first contact or as the closest pair)? Reads
+    /// neither its segment nor anything but its indices, distance and contact.
+    pub fn keeps(&self, p: &PairFinding) -> bool {
+        (p.contact.is_some() && self.first_contact.is_none_or(|f| (p.a, p.b) < (f.a, f.b)))
+            || self.best.is_none_or(|f| closer(p, &f))
     }
 
     /// The tally of both sets of pairs.
@@ -655,7 +682,11 @@ where
         |x, y| !stop.load(Ordering::Relaxed) && tol.boxes_may_meet(x, y),
         BTreeMap::<K, Tally>::new,
         |la, lb, out| {
-            leaf_pairs(a, la, b, lb, settings, &stop, |f| out.entry(group(f.a, f.b)).or_default().add(f))
+            leaf_pairs(a, la, b, lb, settings, &stop, false, |f, full| {
+                let t = out.entry(group(f.a, f.b)).or_default();
+                // A finding the tally keeps carries its segment; the others need none.
+                t.add(if f.segment.is_none() && t.keeps(&f) { full() } else { f })
+            })
         },
         |mut x, y| {
             for (k, t) in y {
@@ -935,17 +966,20 @@ fn ms(t: Instant) -> f64 {
     t.elapsed().as_secs_f64() * 1e3
 }
 
-/// Exact classification, then the tolerance bands for pairs that do not meet.
+/// Exact classification, then the tolerance bands for pairs that do not meet. Without
+/// `segment`, see [`tri_tri::classify_prepared`].
 fn classify_pair(
     i: u32,
-    ti: &[DVec3; 3],
+    pi: &tri_tri::Prepared,
     j: u32,
-    tj: &[DVec3; 3],
+    pj: &tri_tri::Prepared,
     tol: &Tolerances,
     mode: Mode,
+    segment: bool,
 ) -> Option<PairFinding> {
+    let (ti, tj) = (pi.triangle(), pj.triangle());
     let hit = match mode {
-        Mode::Exact => tri_tri::classify(ti, tj),
+        Mode::Exact => tri_tri::classify_prepared(pi, pj, segment),
         Mode::Fast => tri_tri::classify_with::<tri_tri::Float>(ti, tj),
     };
     if let Some(h) = hit {

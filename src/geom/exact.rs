@@ -251,6 +251,14 @@ pub fn orient3d(f: &Frame, a: DVec3, b: DVec3, c: DVec3, d: DVec3) -> Int {
     dot(&cross(&u, &v), &w)
 }
 
+/// [`orient3d`] of two points `d` and `e` against one plane `(a, b, c)`: the same two values,
+/// the plane's normal computed once.
+pub fn orient3d_two(f: &Frame, a: DVec3, b: DVec3, c: DVec3, d: DVec3, e: DVec3) -> (Int, Int) {
+    let pa = f.point(a);
+    let n = cross(&diff(&f.point(b), &pa), &diff(&f.point(c), &pa));
+    (dot(&n, &diff(&f.point(d), &pa)), dot(&n, &diff(&f.point(e), &pa)))
+}
+
 /// The exact value of component `axis` of `(b - a) × (c - a)` at the frame's scale (times
 /// `2^(-2·base)`); its sign is [`crate::geom::predicates::orient2d`]'s.
 pub fn orient2d(f: &Frame, a: DVec3, b: DVec3, c: DVec3, axis: usize) -> Int {
@@ -429,6 +437,9 @@ mod tests {
             let p: Vec<DVec3> = (0..4).map(|_| DVec3::new(rnd(), rnd(), rnd())).collect();
             let f = Frame::of_points(&p);
             assert_eq!(orient3d(&f, p[0], p[1], p[2], p[3]).signum(), pr::orient3d(p[0], p[1], p[2], p[3]));
+            let (x, y) = orient3d_two(&f, p[0], p[1], p[2], p[3], p[1] + p[3]);
+            assert_eq!(x, orient3d(&f, p[0], p[1], p[2], p[3]));
+            assert_eq!(y, orient3d(&f, p[0], p[1], p[2], p[1] + p[3]));
             for k in 0..3 {
                 assert_eq!(orient2d(&f, p[0], p[1], p[2], k).signum(), pr::orient2d(p[0], p[1], p[2], k));
             }

@@ -110,7 +110,85 @@ impl Shape {
 /// exactly. Every sign used is exact, so the answer is the one of [`classify_unfiltered`], bit
 /// for bit (points included).
 pub fn classify(a: &[DVec3; 3], b: &[DVec3; 3]) -> Option<Hit> {
-    let fb = PlaneFilter::new(b);
+    classify_facts(a, b, true)
+}
+
+/// A triangle with the facts the classifier reads from it alone: its float plane filter, and
+/// its exact [`Shape`] once some pair needs it. A triangle met by several candidates (the
+/// triangles of two leaves of a walk, tried against each other) is prepared once for all of
+/// them; [`classify_prepared`] then answers exactly as [`classify`] does.
+pub struct Prepared {
+    tri: [DVec3; 3],
+    filter: PlaneFilter,
+    shape: std::cell::OnceCell<Shape>,
+}
+
+impl Prepared {
+    /// The facts of triangle `t` (its shape is classified on first use).
+    #[inline]
+    pub fn new(t: [DVec3; 3]) -> Prepared {
+        Prepared { tri: t, filter: PlaneFilter::new(&t), shape: std::cell::OnceCell::new() }
+    }
+
+    /// The triangle.
+    #[inline]
+    pub fn triangle(&self) -> &[DVec3; 3] {
+        &self.tri
+    }
+}
+
+/// [`classify`] of two prepared triangles: the same answer, bit for bit. Without `segment`,
+/// the f64 placement of the shared segment of two proper non-coplanar triangles is skipped (a
+/// caller that keeps only counts asks again, with it, for the few pairs whose point it keeps):
+/// [`Hit::segment`] is then `None` for them, and every other field is as [`classify`] gives.
+pub fn classify_prepared(a: &Prepared, b: &Prepared, segment: bool) -> Option<Hit> {
+    classify_facts(a, b, segment)
+}
+
+/// What [`classify_facts`] reads of a triangle: a bare triangle computes each fact when asked,
+/// a [`Prepared`] one keeps them.
+trait Facts {
+    fn tri(&self) -> &[DVec3; 3];
+    fn filter(&self) -> PlaneFilter;
+    fn shape(&self) -> Shape;
+}
+
+impl Facts for [DVec3; 3] {
+    #[inline]
+    fn tri(&self) -> &[DVec3; 3] {
+        self
+    }
+    #[inline]
+    fn filter(&self) -> PlaneFilter {
+        PlaneFilter::new(self)
+    }
+    #[inline]
+    fn shape(&self) -> Shape {
+        Shape::of(self)
+    }
+}
+
+impl Facts for Prepared {
+    #[inline]
+    fn tri(&self) -> &[DVec3; 3] {
+        &self.tri
+    }
+    #[inline]
+    fn filter(&self) -> PlaneFilter {
+        self.filter
+    }
+    #[inline]
+    fn shape(&self) -> Shape {
+        *self.shape.get_or_init(|| Shape::of(&self.tri))
+    }
+}
+
+/// The filtered classification of [`classify`], reading each triangle's own facts through
+/// [`Facts`].
+#[inline]
+fn classify_facts<X: Facts + ?Sized, Y: Facts + ?Sized>(x: &X, y: &Y, segment: bool) -> Option<Hit> {
+    let (a, b) = (x.tri(), y.tri());
+    let fb = y.filter();
     if fb.proper() {
         // The filter's sides of `a`'s vertices against `b`'s plane, computed once: all strictly
         // on one side means apart, whatever shape `a` has (a segment or point of `a` is then
@@ -119,14 +197,14 @@ pub fn classify(a: &[DVec3; 3], b: &[DVec3; 3]) -> Option<Hit> {
         if s == [Some(1); 3] || s == [Some(-1); 3] {
             return None;
         }
-        let fa = PlaneFilter::new(a);
+        let fa = x.filter();
         if fa.proper() {
             // Both proven non-collinear: `Shape::of` would return `Tri` for both.
             let sa = Classifier::<Exact>::settle(s, b, a);
-            return Classifier::<Exact>::tri_tri_from(a, b, sa, || Classifier::<Exact>::sides_all(&fa, a, b));
+            return Classifier::<Exact>::tri_tri_from(a, b, sa, || Classifier::<Exact>::sides_all(&fa, a, b), segment);
         }
     }
-    Classifier::<Exact>::classify_shapes(&Shape::of(a), &Shape::of(b))
+    Classifier::<Exact>::classify_shapes(&x.shape(), &y.shape())
 }
 
 /// As [`classify`], for already classified shapes.
@@ -230,14 +308,14 @@ impl<K: Kernel> Classifier<K> {
 
     fn tri_tri(a: &[DVec3; 3], b: &[DVec3; 3]) -> Option<Hit> {
         let sa = a.map(|p| K::orient3d(b[0], b[1], b[2], p));
-        Self::tri_tri_from(a, b, sa, || b.map(|p| K::orient3d(a[0], a[1], a[2], p)))
+        Self::tri_tri_from(a, b, sa, || b.map(|p| K::orient3d(a[0], a[1], a[2], p)), true)
     }
 
     /// [`Self::tri_tri`] with the plane sides from the float filters of both triangles: the
     /// filter's sign where it proves one, the exact stages where it cannot.
     fn tri_tri_filtered(a: &[DVec3; 3], fa: &PlaneFilter, b: &[DVec3; 3], fb: &PlaneFilter) -> Option<Hit> {
         let sa = Self::sides(fb, b, a)?;
-        Self::tri_tri_from(a, b, sa, || Self::sides_all(fa, a, b))
+        Self::tri_tri_from(a, b, sa, || Self::sides_all(fa, a, b), true)
     }
 
     /// Exact signs of `pts` against the plane of `t` (filter `f`), or `None` when all three are
@@ -265,12 +343,14 @@ impl<K: Kernel> Classifier<K> {
     }
 
     /// The classification from `sa` (the exact sides of `a`'s vertices against `b`'s plane) and
-    /// `sb` (those of `b` against `a`'s plane, asked for only when needed).
+    /// `sb` (those of `b` against `a`'s plane, asked for only when needed); the shared segment
+    /// placed only with `segment` (else `None`).
     fn tri_tri_from(
         a: &[DVec3; 3],
         b: &[DVec3; 3],
         sa: [Sign; 3],
         sb: impl FnOnce() -> [Sign; 3],
+        segment: bool,
     ) -> Option<Hit> {
         if sa.iter().all(|&s| s > 0) || sa.iter().all(|&s| s < 0) {
             return None;
@@ -291,6 +371,11 @@ impl<K: Kernel> Classifier<K> {
             return None;
         }
         let positive = lo_a_hi_b < 0 && hi_a_lo_b > 0 && !ia.single && !ib.single;
+        let crossing = positive && ia.split && ib.split;
+        let contact = if positive { Contact::Segment } else { Contact::Point };
+        if !segment {
+            return Some(Hit { crossing, contact, segment: None });
+        }
         // The shared interval: max of the lows, min of the highs. The determinant values (for
         // placing the ends) only of the vertices used, with their exact signs already known.
         // Each value at most once: both ends of one section share its apex.
@@ -306,11 +391,7 @@ impl<K: Kernel> Classifier<K> {
         } else {
             [lo, lo]
         });
-        Some(Hit {
-            crossing: positive && ia.split && ib.split,
-            contact: if positive { Contact::Segment } else { Contact::Point },
-            segment,
-        })
+        Some(Hit { crossing, contact, segment })
     }
 
     /// Counter-clockwise (in projection `k`) copy of a proper triangle.
