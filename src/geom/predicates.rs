@@ -404,6 +404,11 @@ pub fn collinear(a: DVec3, b: DVec3, c: DVec3) -> bool {
             return false;
         }
     }
+    // Two equal vertices make any triangle collinear: no exact stage needed (zero-area
+    // triangles of tessellated input are mostly of this kind).
+    if a == b || b == c || a == c {
+        return true;
+    }
     (0..3).all(|k| orient2d(a, b, c, k) == 0)
 }
 
@@ -892,6 +897,34 @@ impl BoxMap {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// Collinearity with repeated vertices (the shortcut) and without agrees with the exact
+    /// components of the normal, signed zeros included.
+    #[test]
+    fn collinear_agrees_with_the_exact_normal() {
+        let exact = |a: DVec3, b: DVec3, c: DVec3| (0..3).all(|k| orient2d(a, b, c, k) == 0);
+        let (p, q) = (DVec3::new(0.1, 0.2, 0.3), DVec3::new(-1.5, 2.25, 1e-9));
+        let z = DVec3::ZERO;
+        let nz = DVec3::new(-0.0, 0.0, -0.0);
+        let line = |t: f64| DVec3::new(1.0 + t, 2.0 + 2.0 * t, 3.0 - t);
+        let cases = [
+            (p, p, q),
+            (p, q, p),
+            (q, p, p),
+            (p, p, p),
+            (z, nz, q),
+            (line(0.0), line(0.5), line(2.0)),
+            (line(0.0), line(0.5), line(2.0) + DVec3::new(0.0, 0.0, 1e-15)),
+            (p, q, p + DVec3::new(f64::EPSILON, 0.0, 0.0)),
+        ];
+        for (a, b, c) in cases {
+            for (x, y, w) in [(a, b, c), (b, c, a), (c, a, b), (b, a, c)] {
+                assert_eq!(collinear(x, y, w), exact(x, y, w), "{x:?} {y:?} {w:?}");
+            }
+        }
+        assert!(collinear(p, p, q) && collinear(z, nz, q));
+        assert!(!collinear(p, q, p + DVec3::new(f64::EPSILON, 0.0, 0.0)));
+    }
 
     #[test]
     fn orient3d_value_is_accurate_near_coplanarity() {

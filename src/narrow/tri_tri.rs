@@ -201,7 +201,13 @@ fn classify_facts<X: Facts + ?Sized, Y: Facts + ?Sized>(x: &X, y: &Y, segment: b
         if fa.proper() {
             // Both proven non-collinear: `Shape::of` would return `Tri` for both.
             let sa = Classifier::<Exact>::settle(s, b, a);
-            return Classifier::<Exact>::tri_tri_from(a, b, sa, || Classifier::<Exact>::sides_all(&fa, a, b), segment);
+            return Classifier::<Exact>::tri_tri_from(
+                a,
+                b,
+                sa,
+                || Classifier::<Exact>::sides_all(&fa, a, b),
+                segment,
+            );
         }
     }
     Classifier::<Exact>::classify_shapes(&x.shape(), &y.shape())

@@ -215,6 +215,17 @@ mod filtered_vs_unfiltered {
             prop_assert_eq!(f, u, "a = {:?}, b = {:?}", x, y);
             let shapes = bits(classify_shapes(&Shape::of(x), &Shape::of(y)));
             prop_assert_eq!(shapes, u);
+            // Prepared triangles: the same hit; without the segment, the same but for the segment
+            // of two proper triangles (absent then, as documented).
+            let (px, py) = (Prepared::new(*x), Prepared::new(*y));
+            prop_assert_eq!(bits(classify_prepared(&px, &py, true)), u);
+            let bare = classify_prepared(&px, &py, false);
+            let full = classify(x, y);
+            prop_assert_eq!(bare.map(|h| (h.crossing, h.contact)), full.map(|h| (h.crossing, h.contact)));
+            let proper = !Shape::of(x).is_degenerate() && !Shape::of(y).is_degenerate();
+            if !proper {
+                prop_assert_eq!(bits(bare), bits(full));
+            }
             for p in y {
                 let (s, r) =
                     (pr::orient3d(x[0], x[1], x[2], *p), pr::orient3d_adaptive(x[0], x[1], x[2], *p));
