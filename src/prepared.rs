@@ -141,7 +141,9 @@ impl Prepared {
             return Ok(placed(self.root, OnceLock::from(laid)));
         }
         let rows = rows_of(&m);
-        if let Some((coarse, map)) = Coarse::of(&rows, &self.root).zip(BoxMap::fit(rows, &self.tree.bounds(), std::iter::empty())) {
+        if let Some((coarse, map)) =
+            Coarse::of(&rows, &self.root).zip(BoxMap::fit(rows, &self.tree.bounds(), std::iter::empty()))
+        {
             let reach = coarse.map_box(&self.root);
             let bound = reach.min.abs().max(reach.max.abs()).max_element();
             if bound.is_finite() && bound <= predicates::MAX_EXACT_MAGNITUDE {
@@ -659,7 +661,8 @@ pub fn no_meeting_triangles(a: &Placed, b: &Placed) -> bool {
         return true;
     }
     let (ra, rb) = (a.reach(), b.reach());
-    let near = |o: &[Aabb], r: &Aabb| o.iter().filter(|x| tol.boxes_may_meet(x, r)).copied().collect::<Vec<_>>();
+    let near =
+        |o: &[Aabb], r: &Aabb| o.iter().filter(|x| tol.boxes_may_meet(x, r)).copied().collect::<Vec<_>>();
     let (oa, ob) = (near(a.outline(), &rb), near(b.outline(), &ra));
     !oa.iter().any(|x| ob.iter().any(|y| tol.boxes_may_meet(x, y)))
 }
@@ -1151,7 +1154,8 @@ mod tests {
                 assert!(!quiet || full.contacts.is_empty());
                 assert!(!clear || !full.collides());
                 outcomes[quiet as usize + clear as usize] += 1;
-                let bits = |p: &[DVec3]| p.iter().flat_map(|v| v.to_array().map(f64::to_bits)).collect::<Vec<_>>();
+                let bits =
+                    |p: &[DVec3]| p.iter().flat_map(|v| v.to_array().map(f64::to_bits)).collect::<Vec<_>>();
                 assert_eq!(bits(&singles), bits(ea.positions()));
                 for (l, e) in [(&la, &ea), (&lb, &eb)] {
                     assert_eq!(bits(l.positions()), bits(e.positions()));
@@ -1171,7 +1175,10 @@ mod tests {
                 assert_eq!(distance(&la, &lb, f64::INFINITY), distance(&ea, &eb, f64::INFINITY));
                 // Fresh lazy placements (nothing computed yet) for the signed distance.
                 let (la, lb) = (a.place(ma).unwrap(), b.place(mb).unwrap());
-                assert_eq!(signed_distance(&la, &lb, f64::INFINITY), signed_distance(&ea, &eb, f64::INFINITY));
+                assert_eq!(
+                    signed_distance(&la, &lb, f64::INFINITY),
+                    signed_distance(&ea, &eb, f64::INFINITY)
+                );
                 compared += 1;
             }
         }
@@ -1191,7 +1198,11 @@ mod tests {
             (DMat4::from_translation(DVec3::new(0.0, big * 1.5, 0.0)), false),
             (DMat4::from_scale(DVec3::new(1.0, f64::INFINITY, 1.0)), false),
             (DMat4::from_scale(DVec3::new(1.0, 1.0, f64::NAN)), false),
-            (DMat4::from_translation(DVec3::new(f64::MAX, 0.0, 0.0)) * DMat4::from_scale(DVec3::splat(2.0)), false),
+            (
+                DMat4::from_translation(DVec3::new(f64::MAX, 0.0, 0.0))
+                    * DMat4::from_scale(DVec3::splat(2.0)),
+                false,
+            ),
             // The corner (1, 1, 1) lands exactly on the range's end: fine, placed at once.
             (DMat4::from_scale(DVec3::splat(big)), true),
             (DMat4::from_translation(DVec3::splat(big - 1.0e60)), true),
@@ -1221,7 +1232,8 @@ mod tests {
         let mut unit = move || next(1 << 40) as f64 / (1u64 << 40) as f64 - 0.5;
         for k in 0..4000 {
             let scale = 2f64.powi((k % 41) * 10 - 200);
-            let pts: Vec<DVec3> = (0..6).map(|_| DVec3::new(unit(), unit(), unit()) * scale + scale).collect();
+            let pts: Vec<DVec3> =
+                (0..6).map(|_| DVec3::new(unit(), unit(), unit()) * scale + scale).collect();
             let mut pts = pts;
             let root = Aabb::of_points(&pts);
             pts.extend((0..8).map(|c| {

@@ -16,7 +16,6 @@ use meshclash::pipeline::{Gate, Unit};
 use meshclash::prepared;
 use meshclash::prepared::broad::{self, ObjectTree};
 use meshclash::report::self_report::SelfFailOn;
-use meshclash::scene::mesh::TriMesh;
 use meshclash::Error;
 use numpy::{PyReadonlyArray2, PyUntypedArrayMethods};
 use pyo3::exceptions::{PyMemoryError, PyOSError, PyValueError};
