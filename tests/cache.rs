@@ -632,3 +632,66 @@ fn a_model_saved_under_another_name_reuses_its_pairs() {
     let (body, (reused, checked, _)) = split(&run_s(d.path(), &args("elsewhere/renamed.obj")));
     assert_eq!((body.as_str(), reused, checked), (cold.as_str(), n, 0), "the index is found by content");
 }
+
+/// `glb` with the JSON chunk edited by `edit` (the binary chunk kept as it is).
+fn edit_glb(glb: &[u8], edit: impl FnOnce(&mut serde_json::Value)) -> Vec<u8> {
+    let u32_at = |i: usize| u32::from_le_bytes(glb[i..i + 4].try_into().unwrap()) as usize;
+    let json_len = u32_at(12);
+    let mut json: serde_json::Value = serde_json::from_slice(&glb[20..20 + json_len]).unwrap();
+    edit(&mut json);
+    let mut text = serde_json::to_vec(&json).unwrap();
+    while !text.len().is_multiple_of(4) {
+        text.push(b' ');
+    }
+    let rest = &glb[20 + json_len..];
+    let mut out = Vec::new();
+    out.extend(&glb[..8]);
+    out.extend(((20 + text.len() + rest.len()) as u32).to_le_bytes());
+    out.extend((text.len() as u32).to_le_bytes());
+    out.extend(&glb[16..20]);
+    out.extend(&text);
+    out.extend(rest);
+    out
+}
+
+#[test]
+fn moved_instance_of_a_gltf_mesh_checks_its_pairs_and_gives_the_cold_report() {
+    let Some(engine) = crate::common::corpus("2CylinderEngine.glb") else { return };
+    let d = tempfile::tempdir().unwrap();
+    let glb = std::fs::read(&engine).unwrap();
+    std::fs::write(d.path().join("engine.glb"), &glb).unwrap();
+    let args = ["scene", "engine.glb", "--no-timings", "--clearance", "0.5"];
+    let cold = run_s(d.path(), &with(&args, &[]));
+    let first = split(&run_s(d.path(), &with(&args, &["--cache", "c"])));
+    assert_eq!(first.0, cold);
+    // Move one node that draws a mesh other nodes draw too: its instances share their shape,
+    // the moved one has new coordinates.
+    let moved = edit_glb(&glb, |json| {
+        let nodes = json["nodes"].as_array_mut().unwrap();
+        let mut drawn = std::collections::HashMap::new();
+        for n in nodes.iter() {
+            if let Some(m) = n["mesh"].as_u64() {
+                *drawn.entry(m).or_insert(0) += 1;
+            }
+        }
+        let node = nodes
+            .iter_mut()
+            .find(|n| n["mesh"].as_u64().is_some_and(|m| drawn[&m] > 1) && n["matrix"].is_array())
+            .expect("an instanced node placed by a matrix");
+        let y = node["matrix"][13].as_f64().unwrap();
+        node["matrix"][13] = serde_json::json!(y + 0.25);
+    });
+    std::fs::write(d.path().join("engine.glb"), &moved).unwrap();
+    let cold_moved = run_s(d.path(), &with(&args, &[]));
+    assert_ne!(cold_moved, cold, "the move changed the report");
+    let warm = split(&run_s(d.path(), &with(&args, &["--cache", "c"])));
+    assert_eq!(warm.0, cold_moved);
+    let (reused, checked) = (warm.1 .0, warm.1 .1);
+    assert_eq!(reused + checked, candidates(&cold_moved));
+    assert!(
+        checked > 0 && reused > checked,
+        "only the moved part's pairs are checked: {reused} reused, {checked} checked"
+    );
+    let again = split(&run_s(d.path(), &with(&args, &["--cache", "c"])));
+    assert_eq!((again.0, again.1 .1), (cold_moved, 0));
+}

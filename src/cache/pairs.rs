@@ -293,7 +293,7 @@ enum Reused {
     /// overlap box (for a clash) and its finding ids (when stored and wanted).
     Fits {
         pack: usize,
-        r: ClashResult,
+        r: Box<ClashResult>,
         bound: Option<Beyond>,
         overlap: Option<Option<Overlap>>,
         ids: Option<Vec<u64>>,
@@ -729,7 +729,7 @@ impl PairReuse {
                     match fits {
                         Ok(overlap) => {
                             let ids = ids.filter(|i| lists && !i.is_empty() && i.len() == r.pairs.len());
-                            Reused::Fits { pack, r, bound, overlap, ids }
+                            Reused::Fits { pack, r: Box::new(r), bound, overlap, ids }
                         }
                         Err(e) => Reused::Refused(e),
                     }
@@ -755,7 +755,7 @@ impl PairReuse {
                         known.extend(r.pairs.iter().zip(ids).map(|(p, id)| (p.a, p.b, id)));
                         known_from.push((*k.as_bytes(), start, known.len()));
                     }
-                    Some(r)
+                    Some(*r)
                 }
             });
         }
