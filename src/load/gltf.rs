@@ -159,6 +159,18 @@ trait Sink {
     fn reserve(&mut self, vertices: usize, triangles: usize, parts: usize);
     /// One part: `prims` placed by `world` (see [`add_instance`]).
     fn part(&mut self, path: &Path, at: Placement, prims: &[Prim], name: String, world: DMat4) -> Result<()>;
+    /// One part whose mesh no other part uses, on a sink that [`Self::expands`]: the same as
+    /// [`Self::part`], given the primitives to keep or drop.
+    fn sole_part(
+        &mut self,
+        path: &Path,
+        at: Placement,
+        prims: Vec<Prim>,
+        name: String,
+        world: DMat4,
+    ) -> Result<()> {
+        self.part(path, at, &prims, name, world)
+    }
 }
 
 impl Sink for Mesh {
@@ -173,6 +185,30 @@ impl Sink for Mesh {
     }
     fn part(&mut self, path: &Path, at: Placement, prims: &[Prim], name: String, world: DMat4) -> Result<()> {
         add_instance(self, path, at, prims, name, world)
+    }
+    fn sole_part(
+        &mut self,
+        path: &Path,
+        at: Placement,
+        mut prims: Vec<Prim>,
+        name: String,
+        world: DMat4,
+    ) -> Result<()> {
+        // The first part, of one primitive: its vectors become the mesh's (the positions placed
+        // where they are), which is what `add_instance` makes of them (its vertices start at
+        // 0, so its triangles are unchanged), without a copy of either.
+        if !(self.positions.is_empty() && self.triangles.is_empty() && prims.len() == 1) {
+            return add_instance(self, path, at, &prims, name, world);
+        }
+        let Prim { mut positions, triangles, .. } = prims.pop().expect("one primitive");
+        let object = self.objects.len() as u32;
+        self.objects.push(Object { name, gltf_mesh: Some(at.mesh as u32), world: Some(world) });
+        positions.iter_mut().for_each(|v| *v = world.transform_point3(*v));
+        check_placed(path, at, &positions)?;
+        self.positions = positions;
+        self.tri_object.resize(triangles.len(), object);
+        self.triangles = triangles;
+        Ok(())
     }
 }
 
@@ -425,6 +461,11 @@ fn walk(path: &Path, bytes: &[u8], sink: &mut dyn Sink) -> Result<(Decoded, Vec<
 
     sink.reserve(total_v, total_t, total_parts);
     let names = node_names(&doc);
+    // The parts of each mesh: a mesh placed once is handed over to an expanding sink.
+    let mut uses = vec![0usize; decoded.len()];
+    for inst in &instances {
+        uses[inst.mesh] = uses[inst.mesh].saturating_add(inst.gpu.as_ref().map_or(1, |g| g.count));
+    }
     for inst in &instances {
         let prims = decoded[inst.mesh].as_deref().unwrap_or(&[]);
         if prims.iter().all(|p| p.triangles.is_empty()) {
@@ -433,7 +474,12 @@ fn walk(path: &Path, bytes: &[u8], sink: &mut dyn Sink) -> Result<(Decoded, Vec<
         let name = node_path(&inst.path, &names);
         let at = |instance| Placement { mesh: inst.mesh, node: inst.node, instance };
         let Some(gpu) = &inst.gpu else {
-            sink.part(path, at(None), prims, name, inst.world)?;
+            if sink.expands() && uses[inst.mesh] == 1 {
+                let prims = decoded[inst.mesh].take().unwrap_or_default();
+                sink.sole_part(path, at(None), prims, name, inst.world)?;
+            } else {
+                sink.part(path, at(None), prims, name, inst.world)?;
+            }
             continue;
         };
         let trs = InstanceTransforms::read(&reader, &accessors, inst.node, gpu)?;
@@ -461,23 +507,24 @@ fn add_instance(
 ) -> Result<()> {
     let object = mesh.objects.len() as u32;
     mesh.objects.push(Object { name, gltf_mesh: Some(at.mesh as u32), world: Some(world) });
-    let bases = place_vertices(&mut mesh.positions, prims, world, |placed| {
-        // Look for the first non-finite result of each run (one tight loop each).
-        match placed.iter().enumerate().find_map(|(i, w)| Some((i, super::non_finite(w.to_array())?))) {
-            Some((i, value)) => {
-                let at =
-                    Location::Placed { mesh: at.mesh, position: i, node: at.node, instance: at.instance };
-                Err(Error::at(path, at, InputProblem::NonFiniteAfterTransform { value: Some(value) }))
-            }
-            None => Ok(()),
-        }
-    })?;
+    let bases = place_vertices(&mut mesh.positions, prims, world, |placed| check_placed(path, at, placed))?;
     for (p, base) in prims.iter().zip(bases) {
         let Some(base) = base else { continue };
         mesh.triangles.extend(p.triangles.iter().map(|t| t.map(|i| base + i)));
         mesh.tri_object.resize(mesh.tri_object.len() + p.triangles.len(), object);
     }
     Ok(())
+}
+
+/// The first non-finite coordinate of a run of placed vertices, as an error (one tight loop).
+fn check_placed(path: &Path, at: Placement, placed: &[DVec3]) -> Result<()> {
+    match placed.iter().enumerate().find_map(|(i, w)| Some((i, super::non_finite(w.to_array())?))) {
+        Some((i, value)) => {
+            let at = Location::Placed { mesh: at.mesh, position: i, node: at.node, instance: at.instance };
+            Err(Error::at(path, at, InputProblem::NonFiniteAfterTransform { value: Some(value) }))
+        }
+        None => Ok(()),
+    }
 }
 
 /// Appends the vertices of `prims` placed by `world` to `positions` and returns where each
