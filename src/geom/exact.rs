@@ -43,72 +43,100 @@ pub(crate) fn cmp_mag(a: &[u32], b: &[u32]) -> Ordering {
 }
 
 pub(crate) fn add_mag(a: &[u32], b: &[u32]) -> Mag {
+    let mut out = Mag::new();
+    add_into(&mut out, a, b);
+    out
+}
+
+/// `out = a + b` (`out` empty on entry).
+fn add_into(out: &mut Mag, a: &[u32], b: &[u32]) {
     let (long, short) = if a.len() >= b.len() { (a, b) } else { (b, a) };
-    let mut out = Mag::from_elem(0, long.len() + 1);
+    out.resize(long.len() + 1, 0);
+    let o = out.as_mut_slice();
     let mut carry = 0u64;
-    for (i, (o, &x)) in out.iter_mut().zip(long).enumerate() {
-        let s = x as u64 + short.get(i).map_or(0, |&y| y as u64) + carry;
-        *o = s as u32;
+    for i in 0..long.len() {
+        let s = long[i] as u64 + short.get(i).map_or(0, |&y| y as u64) + carry;
+        o[i] = s as u32;
         carry = s >> 32;
     }
-    if carry > 0 {
-        out[long.len()] = carry as u32;
-    } else {
-        out.truncate(long.len());
-    }
-    out
+    o[long.len()] = carry as u32;
+    trim_in(out);
 }
 
 /// `a - b` for `|a| >= |b|`.
 pub(crate) fn sub_mag(a: &[u32], b: &[u32]) -> Mag {
-    let mut out = Mag::from_elem(0, a.len());
+    let mut out = Mag::new();
+    sub_into(&mut out, a, b);
+    out
+}
+
+/// `out = a - b` for `|a| >= |b|` (`out` empty on entry).
+fn sub_into(out: &mut Mag, a: &[u32], b: &[u32]) {
+    out.resize(a.len(), 0);
+    let o = out.as_mut_slice();
     let mut borrow = 0i64;
-    for (i, (o, &x)) in out.iter_mut().zip(a).enumerate() {
-        let mut d = x as i64 - b.get(i).map_or(0, |&y| y as i64) - borrow;
+    for i in 0..a.len() {
+        let mut d = a[i] as i64 - b.get(i).map_or(0, |&y| y as i64) - borrow;
         borrow = (d < 0) as i64;
         d += borrow << 32;
-        *o = d as u32;
+        o[i] = d as u32;
     }
-    trim(out)
+    trim_in(out);
 }
 
 pub(crate) fn mul_mag(a: &[u32], b: &[u32]) -> Mag {
+    let mut out = Mag::new();
+    mul_into(&mut out, a, b);
+    out
+}
+
+/// `out = a · b` (`out` empty on entry).
+fn mul_into(out: &mut Mag, a: &[u32], b: &[u32]) {
     if a.is_empty() || b.is_empty() {
-        return Mag::new();
+        return;
     }
-    let mut out = Mag::from_elem(0, a.len() + b.len());
+    out.resize(a.len() + b.len(), 0);
+    let o = out.as_mut_slice();
     for (i, &x) in a.iter().enumerate() {
-        let row = &mut out[i..i + b.len() + 1];
+        let row = &mut o[i..i + b.len() + 1];
+        let (last, body) = row.split_last_mut().expect("a row has b.len() + 1 limbs");
         let mut carry = 0u64;
-        for (o, &y) in row.iter_mut().zip(b) {
-            let t = x as u64 * y as u64 + *o as u64 + carry;
-            *o = t as u32;
+        for (r, &y) in body.iter_mut().zip(b) {
+            let t = x as u64 * y as u64 + *r as u64 + carry;
+            *r = t as u32;
             carry = t >> 32;
         }
-        row[b.len()] = carry as u32;
+        *last = carry as u32;
     }
-    trim(out)
+    trim_in(out);
 }
 
 impl Int {
-    fn new(neg: bool, mag: Mag) -> Int {
-        let mag = trim(mag);
+    fn new(neg: bool, mut mag: Mag) -> Int {
+        trim_in(&mut mag);
         Int { neg: neg && !mag.is_empty(), mag }
     }
 
     /// The integer `v`.
     pub fn from_i64(v: i64) -> Int {
         let m = v.unsigned_abs();
-        Int::new(v < 0, Mag::from_slice(&[m as u32, (m >> 32) as u32]))
+        let mut r = Int::default();
+        r.mag.extend_from_slice(&[m as u32, (m >> 32) as u32]);
+        trim_in(&mut r.mag);
+        r.neg = v < 0;
+        r
     }
 
     /// `m · 2^shift` for a non-negative `shift`.
     fn from_parts(neg: bool, m: u64, shift: u32) -> Int {
         let (limbs, bits) = ((shift / 32) as usize, shift % 32);
         let wide = (m as u128) << bits;
-        let mut mag = Mag::from_elem(0, limbs + 3);
-        mag[limbs..].copy_from_slice(&[wide as u32, (wide >> 32) as u32, (wide >> 64) as u32]);
-        Int::new(neg, mag)
+        let mut r = Int::default();
+        r.mag.resize(limbs, 0);
+        r.mag.extend_from_slice(&[wide as u32, (wide >> 32) as u32, (wide >> 64) as u32]);
+        trim_in(&mut r.mag);
+        r.neg = neg && !r.mag.is_empty();
+        r
     }
 
     /// -1, 0 or 1.
@@ -124,13 +152,19 @@ impl Int {
 
     /// `self + (-1)^o_neg · |o|`.
     fn add_signed(&self, o: &Int, o_neg: bool) -> Int {
+        let mut r = Int::default();
         if self.neg == o_neg {
-            return Int::new(self.neg, add_mag(&self.mag, &o.mag));
+            add_into(&mut r.mag, &self.mag, &o.mag);
+            r.neg = self.neg;
+        } else if cmp_mag(&self.mag, &o.mag) == Ordering::Less {
+            sub_into(&mut r.mag, &o.mag, &self.mag);
+            r.neg = o_neg;
+        } else {
+            sub_into(&mut r.mag, &self.mag, &o.mag);
+            r.neg = self.neg;
         }
-        match cmp_mag(&self.mag, &o.mag) {
-            Ordering::Less => Int::new(o_neg, sub_mag(&o.mag, &self.mag)),
-            _ => Int::new(self.neg, sub_mag(&self.mag, &o.mag)),
-        }
+        r.neg &= !r.mag.is_empty();
+        r
     }
 
     /// `self + o`.
@@ -155,7 +189,10 @@ impl Int {
 
     /// `self · o`.
     pub fn mul(&self, o: &Int) -> Int {
-        Int::new(self.neg != o.neg, mul_mag(&self.mag, &o.mag))
+        let mut r = Int::default();
+        mul_into(&mut r.mag, &self.mag, &o.mag);
+        r.neg = self.neg != o.neg && !r.mag.is_empty();
+        r
     }
 
     /// `(m, e)` with `self ≈ m · 2^e`, `m` the leading 65 to 96 bits as an f64 (a relative
