@@ -10,19 +10,31 @@
 //! the cost of arbitrary precision is paid on borderline cases alone.
 
 use crate::geom::DVec3;
+use smallvec::SmallVec;
 use std::cmp::Ordering;
+
+/// Limbs kept inline before a magnitude moves to the heap: 512 bits, above the products of
+/// the usual frames (a few hundred bits), so the common exact decisions allocate nothing.
+const INLINE_LIMBS: usize = 16;
+
+/// A magnitude: little-endian base-2^32 limbs, inline up to [`INLINE_LIMBS`].
+pub(crate) type Mag = SmallVec<[u32; INLINE_LIMBS]>;
 
 /// A signed integer of any size. Normalized: no high zero limbs, and zero is never negative.
 #[derive(Clone, Debug, PartialEq, Eq, Default)]
 pub struct Int {
     neg: bool,
-    mag: Vec<u32>,
+    mag: Mag,
 }
 
-pub(crate) fn trim(mut m: Vec<u32>) -> Vec<u32> {
-    while m.last() == Some(&0) {
-        m.pop();
-    }
+/// Drop high zero limbs.
+pub(crate) fn trim_in(m: &mut Mag) {
+    let n = m.iter().rposition(|&l| l != 0).map_or(0, |i| i + 1);
+    m.truncate(n);
+}
+
+pub(crate) fn trim(mut m: Mag) -> Mag {
+    trim_in(&mut m);
     m
 }
 
@@ -30,70 +42,101 @@ pub(crate) fn cmp_mag(a: &[u32], b: &[u32]) -> Ordering {
     a.len().cmp(&b.len()).then_with(|| a.iter().rev().cmp(b.iter().rev()))
 }
 
-pub(crate) fn add_mag(a: &[u32], b: &[u32]) -> Vec<u32> {
-    let (long, short) = if a.len() >= b.len() { (a, b) } else { (b, a) };
-    let mut out = Vec::with_capacity(long.len() + 1);
-    let mut carry = 0u64;
-    for (i, &x) in long.iter().enumerate() {
-        let s = x as u64 + *short.get(i).unwrap_or(&0) as u64 + carry;
-        out.push(s as u32);
-        carry = s >> 32;
-    }
-    if carry > 0 {
-        out.push(carry as u32);
-    }
+pub(crate) fn add_mag(a: &[u32], b: &[u32]) -> Mag {
+    let mut out = Mag::new();
+    add_into(&mut out, a, b);
     out
 }
 
-/// `a - b` for `|a| >= |b|`.
-pub(crate) fn sub_mag(a: &[u32], b: &[u32]) -> Vec<u32> {
-    let mut out = Vec::with_capacity(a.len());
-    let mut borrow = 0i64;
-    for (i, &x) in a.iter().enumerate() {
-        let mut d = x as i64 - *b.get(i).unwrap_or(&0) as i64 - borrow;
-        borrow = (d < 0) as i64;
-        d += borrow << 32;
-        out.push(d as u32);
+/// `out = a + b` (`out` empty on entry).
+fn add_into(out: &mut Mag, a: &[u32], b: &[u32]) {
+    let (long, short) = if a.len() >= b.len() { (a, b) } else { (b, a) };
+    out.resize(long.len() + 1, 0);
+    let o = out.as_mut_slice();
+    let mut carry = 0u64;
+    for i in 0..long.len() {
+        let s = long[i] as u64 + short.get(i).map_or(0, |&y| y as u64) + carry;
+        o[i] = s as u32;
+        carry = s >> 32;
     }
-    trim(out)
+    o[long.len()] = carry as u32;
+    trim_in(out);
 }
 
-pub(crate) fn mul_mag(a: &[u32], b: &[u32]) -> Vec<u32> {
-    if a.is_empty() || b.is_empty() {
-        return Vec::new();
+/// `a - b` for `|a| >= |b|`.
+pub(crate) fn sub_mag(a: &[u32], b: &[u32]) -> Mag {
+    let mut out = Mag::new();
+    sub_into(&mut out, a, b);
+    out
+}
+
+/// `out = a - b` for `|a| >= |b|` (`out` empty on entry).
+fn sub_into(out: &mut Mag, a: &[u32], b: &[u32]) {
+    out.resize(a.len(), 0);
+    let o = out.as_mut_slice();
+    let mut borrow = 0i64;
+    for i in 0..a.len() {
+        let mut d = a[i] as i64 - b.get(i).map_or(0, |&y| y as i64) - borrow;
+        borrow = (d < 0) as i64;
+        d += borrow << 32;
+        o[i] = d as u32;
     }
-    let mut out = vec![0u32; a.len() + b.len()];
+    trim_in(out);
+}
+
+pub(crate) fn mul_mag(a: &[u32], b: &[u32]) -> Mag {
+    let mut out = Mag::new();
+    mul_into(&mut out, a, b);
+    out
+}
+
+/// `out = a · b` (`out` empty on entry).
+fn mul_into(out: &mut Mag, a: &[u32], b: &[u32]) {
+    if a.is_empty() || b.is_empty() {
+        return;
+    }
+    out.resize(a.len() + b.len(), 0);
+    let o = out.as_mut_slice();
     for (i, &x) in a.iter().enumerate() {
+        let row = &mut o[i..i + b.len() + 1];
+        let (last, body) = row.split_last_mut().expect("a row has b.len() + 1 limbs");
         let mut carry = 0u64;
-        for (j, &y) in b.iter().enumerate() {
-            let t = x as u64 * y as u64 + out[i + j] as u64 + carry;
-            out[i + j] = t as u32;
+        for (r, &y) in body.iter_mut().zip(b) {
+            let t = x as u64 * y as u64 + *r as u64 + carry;
+            *r = t as u32;
             carry = t >> 32;
         }
-        out[i + b.len()] = carry as u32;
+        *last = carry as u32;
     }
-    trim(out)
+    trim_in(out);
 }
 
 impl Int {
-    fn new(neg: bool, mag: Vec<u32>) -> Int {
-        let mag = trim(mag);
+    fn new(neg: bool, mut mag: Mag) -> Int {
+        trim_in(&mut mag);
         Int { neg: neg && !mag.is_empty(), mag }
     }
 
     /// The integer `v`.
     pub fn from_i64(v: i64) -> Int {
         let m = v.unsigned_abs();
-        Int::new(v < 0, vec![m as u32, (m >> 32) as u32])
+        let mut r = Int::default();
+        r.mag.extend_from_slice(&[m as u32, (m >> 32) as u32]);
+        trim_in(&mut r.mag);
+        r.neg = v < 0;
+        r
     }
 
     /// `m · 2^shift` for a non-negative `shift`.
     fn from_parts(neg: bool, m: u64, shift: u32) -> Int {
         let (limbs, bits) = ((shift / 32) as usize, shift % 32);
         let wide = (m as u128) << bits;
-        let mut mag = vec![0u32; limbs];
-        mag.extend([wide as u32, (wide >> 32) as u32, (wide >> 64) as u32]);
-        Int::new(neg, mag)
+        let mut r = Int::default();
+        r.mag.resize(limbs, 0);
+        r.mag.extend_from_slice(&[wide as u32, (wide >> 32) as u32, (wide >> 64) as u32]);
+        trim_in(&mut r.mag);
+        r.neg = neg && !r.mag.is_empty();
+        r
     }
 
     /// -1, 0 or 1.
@@ -107,30 +150,49 @@ impl Int {
         }
     }
 
+    /// `self + (-1)^o_neg · |o|`.
+    fn add_signed(&self, o: &Int, o_neg: bool) -> Int {
+        let mut r = Int::default();
+        if self.neg == o_neg {
+            add_into(&mut r.mag, &self.mag, &o.mag);
+            r.neg = self.neg;
+        } else if cmp_mag(&self.mag, &o.mag) == Ordering::Less {
+            sub_into(&mut r.mag, &o.mag, &self.mag);
+            r.neg = o_neg;
+        } else {
+            sub_into(&mut r.mag, &self.mag, &o.mag);
+            r.neg = self.neg;
+        }
+        r.neg &= !r.mag.is_empty();
+        r
+    }
+
     /// `self + o`.
     pub fn add(&self, o: &Int) -> Int {
-        if self.neg == o.neg {
-            return Int::new(self.neg, add_mag(&self.mag, &o.mag));
-        }
-        match cmp_mag(&self.mag, &o.mag) {
-            Ordering::Less => Int::new(o.neg, sub_mag(&o.mag, &self.mag)),
-            _ => Int::new(self.neg, sub_mag(&self.mag, &o.mag)),
-        }
+        self.add_signed(o, o.neg)
     }
 
     /// `-self`.
     pub fn neg(&self) -> Int {
-        Int::new(!self.neg, self.mag.clone())
+        self.clone().negated()
+    }
+
+    /// `-self`, reusing the magnitude.
+    fn negated(self) -> Int {
+        Int { neg: !self.neg && !self.mag.is_empty(), mag: self.mag }
     }
 
     /// `self - o`.
     pub fn sub(&self, o: &Int) -> Int {
-        self.add(&o.neg())
+        self.add_signed(o, !o.neg && !o.mag.is_empty())
     }
 
     /// `self · o`.
     pub fn mul(&self, o: &Int) -> Int {
-        Int::new(self.neg != o.neg, mul_mag(&self.mag, &o.mag))
+        let mut r = Int::default();
+        mul_into(&mut r.mag, &self.mag, &o.mag);
+        r.neg = self.neg != o.neg && !r.mag.is_empty();
+        r
     }
 
     /// `(m, e)` with `self ≈ m · 2^e`, `m` the leading 65 to 96 bits as an f64 (a relative
@@ -148,14 +210,14 @@ impl Int {
             return Int::default();
         }
         let (limbs, rest) = ((bits / 32) as usize, bits % 32);
-        let mut mag = vec![0u32; limbs];
+        let mut mag = Mag::from_elem(0, limbs + self.mag.len() + 1);
         let mut carry = 0u32;
-        for &l in &self.mag {
+        for (o, &l) in mag[limbs..].iter_mut().zip(&self.mag) {
             let wide = (l as u64) << rest;
-            mag.push(wide as u32 | carry);
+            *o = wide as u32 | carry;
             carry = (wide >> 32) as u32;
         }
-        mag.push(carry);
+        mag[limbs + self.mag.len()] = carry;
         Int::new(self.neg, mag)
     }
 
@@ -288,7 +350,7 @@ impl Ratio {
     pub fn new(num: Int, den: Int) -> Ratio {
         debug_assert!(den.signum() != 0, "zero denominator");
         if den.signum() < 0 {
-            Ratio { num: num.neg(), den: den.neg() }
+            Ratio { num: num.negated(), den: den.negated() }
         } else {
             Ratio { num, den }
         }
@@ -378,6 +440,8 @@ fn ldexp(m: f64, e: i64) -> f64 {
 mod tests {
     use super::*;
     use crate::geom::predicates as pr;
+    use num_bigint::{BigInt, Sign};
+    use proptest::prelude::*;
 
     fn to_i128(x: &Int) -> i128 {
         let mut v: i128 = 0;
@@ -407,6 +471,67 @@ mod tests {
                 assert_eq!(x.signum() as i128, a.signum());
             }
         }
+    }
+
+    fn big(x: &Int) -> BigInt {
+        let m = x.mag.iter().rev().fold(BigInt::from(0), |m, &l| (m << 32) + BigInt::from(l));
+        if x.neg {
+            -m
+        } else {
+            m
+        }
+    }
+
+    /// Operands from 0 to 40 limbs (inline and spilled magnitudes), with runs of zero and
+    /// all-ones limbs so carries and borrows cross many limbs.
+    fn operand() -> impl Strategy<Value = Int> {
+        let limb = prop_oneof![Just(0u32), Just(u32::MAX), Just(1u32), any::<u32>()];
+        (any::<bool>(), prop::collection::vec(limb, 0..40))
+            .prop_map(|(neg, limbs)| Int::new(neg, Mag::from_vec(limbs)))
+    }
+
+    proptest! {
+        #![proptest_config(ProptestConfig::with_cases(2000))]
+
+        #[test]
+        fn integer_operations_agree_with_bigint(x in operand(), y in operand(), bits in 0u32..700) {
+            let (a, b) = (big(&x), big(&y));
+            for (r, want) in [
+                (x.add(&y), &a + &b),
+                (x.sub(&y), &a - &b),
+                (x.mul(&y), &a * &b),
+                (x.neg(), -a.clone()),
+                (x.shl(bits), &a << bits as usize),
+            ] {
+                prop_assert_eq!(big(&r), want);
+                // Normalized: no high zero limb, zero not negative.
+                prop_assert!(r.mag.last() != Some(&0));
+                prop_assert!(!(r.neg && r.mag.is_empty()));
+            }
+            prop_assert_eq!(x.cmp_value(&y), a.cmp(&b));
+            let sign = match a.sign() {
+                Sign::Minus => -1,
+                Sign::NoSign => 0,
+                Sign::Plus => 1,
+            };
+            prop_assert_eq!(x.signum(), sign);
+        }
+    }
+
+    #[test]
+    fn float_coordinates_stay_inline() {
+        // Single-precision coordinates spanning 2^-20 to 2^10 (a mesh read from glTF): the
+        // orientation values and the products a ratio comparison forms need no heap.
+        let p = [
+            DVec3::new(1023.5, -0.000_976_562_5, 3.25),
+            DVec3::new(-7.0, 511.75, 2f64.powi(-20)),
+            DVec3::new(0.1f32 as f64, 0.2f32 as f64, -1000.3f32 as f64),
+            DVec3::new(12.125, -0.3f32 as f64, 0.7f32 as f64),
+        ];
+        let f = Frame::of_points(&p);
+        let o = orient3d(&f, p[0], p[1], p[2], p[3]);
+        let d = o.mul(&f.int(p[0].x)).mul(&o);
+        assert!(!o.mag.spilled() && !d.mag.spilled(), "{} and {} limbs", o.mag.len(), d.mag.len());
     }
 
     #[test]

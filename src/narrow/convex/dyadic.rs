@@ -3,7 +3,7 @@
 //! penetration depth for the few comparisons its float filter cannot decide; small and slow on
 //! purpose (schoolbook multiplication on base-2^32 limbs).
 
-use crate::geom::exact::{add_mag, cmp_mag, mul_mag, sub_mag, trim};
+use crate::geom::exact::{add_mag, cmp_mag, mul_mag, sub_mag, trim, Mag};
 use std::cmp::Ordering;
 
 /// `(-1)^neg · mag · 2^exp`, `mag` little-endian base-2^32 limbs without trailing zero limbs
@@ -11,16 +11,16 @@ use std::cmp::Ordering;
 #[derive(Clone, Debug, PartialEq, Eq)]
 pub struct Dyadic {
     neg: bool,
-    mag: Vec<u32>,
+    mag: Mag,
     exp: i64,
 }
 
-fn shl_mag(a: &[u32], bits: u64) -> Vec<u32> {
+fn shl_mag(a: &[u32], bits: u64) -> Mag {
     if a.is_empty() {
-        return Vec::new();
+        return Mag::new();
     }
     let (limbs, rem) = ((bits / 32) as usize, (bits % 32) as u32);
-    let mut out = vec![0u32; limbs];
+    let mut out = Mag::from_elem(0, limbs);
     if rem == 0 {
         out.extend_from_slice(a);
     } else {
@@ -37,7 +37,7 @@ fn shl_mag(a: &[u32], bits: u64) -> Vec<u32> {
 impl Dyadic {
     /// Zero.
     pub fn zero() -> Dyadic {
-        Dyadic { neg: false, mag: Vec::new(), exp: 0 }
+        Dyadic { neg: false, mag: Mag::new(), exp: 0 }
     }
 
     /// The exact value of a finite `x` (panics on infinities and NaN: callers pass checked
@@ -52,7 +52,7 @@ impl Dyadic {
         if m == 0 {
             return Dyadic::zero();
         }
-        Dyadic { neg, mag: trim(vec![m as u32, (m >> 32) as u32]), exp: e }
+        Dyadic { neg, mag: trim(Mag::from_slice(&[m as u32, (m >> 32) as u32])), exp: e }
     }
 
     /// -1, 0 or 1.
