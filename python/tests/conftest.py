@@ -89,3 +89,19 @@ def l_prism(scale=1.0, at=(0.0, 0.0, 0.0)):
         j = (i + 1) % n
         f += [[i, j, j + n], [i, j + n, i + n]]
     return v, np.array(f, dtype=np.int64)
+
+
+def manager_of(parts, transforms):
+    """A new meshclash manager holding `parts` ((name, mesh, transform) triples) placed by
+    `transforms` (name -> 4x4): the reference that decides every pair from scratch."""
+    import meshclash
+
+    m = meshclash.CollisionManager()
+    for name, mesh, _ in parts:
+        m.add_object(name, mesh, transforms[name])
+    return m
+
+
+def flipped(t):
+    """`t` with every zero of the other sign: the same placement under other bits."""
+    return np.where(t == 0.0, np.where(np.signbit(t), 0.0, -0.0), t)

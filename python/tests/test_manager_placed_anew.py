@@ -7,7 +7,7 @@ import numpy as np
 import pytest
 import trimesh
 
-import meshclash
+from conftest import flipped, manager_of
 
 
 def scene(seed):
@@ -31,15 +31,6 @@ def scene(seed):
     return parts
 
 
-def fresh(parts, transforms):
-    m = meshclash.CollisionManager()
-    for name, mesh, _ in parts:
-        m.add_object(name, mesh, transforms[name])
-    return m
-
-
-def flipped(t):
-    return np.where(t == 0.0, np.where(np.signbit(t), 0.0, -0.0), t)
 
 
 def query(m, which, probe):
@@ -72,7 +63,7 @@ def test_placed_anew_answers_as_a_fresh_manager_in_any_query_order():
     for seed in range(3):
         parts = scene(seed)
         transforms = {name: t for name, _, t in parts}
-        kept = fresh(parts, transforms)
+        kept = manager_of(parts, transforms)
         rng = np.random.default_rng(100 + seed)
         for step in range(6):
             # Every other step the same places under other bits; else some objects really move.
@@ -85,7 +76,7 @@ def test_placed_anew_answers_as_a_fresh_manager_in_any_query_order():
                     transforms[name] = t
             for name, t in transforms.items():
                 kept.set_transform(name, t)
-            reference = fresh(parts, transforms)
+            reference = manager_of(parts, transforms)
             # The first query after the move reads the fresh placements; the order varies.
             order = [QUERIES[(step + k) % len(QUERIES)] for k in range(len(QUERIES))]
             for which in order:
@@ -95,7 +86,7 @@ def test_placed_anew_answers_as_a_fresh_manager_in_any_query_order():
 def test_a_transform_out_of_range_fails_at_the_call_and_changes_nothing():
     parts = scene(5)
     transforms = {name: t for name, _, t in parts}
-    m = fresh(parts, transforms)
+    m = manager_of(parts, transforms)
     before = [query(m, which, None) for which in QUERIES[:4]]
     huge = np.diag([1e300, 1e300, 1e300, 1.0])
     overflow = np.array([[1e308, 0, 0, 1e308], [0, 1, 0, 0], [0, 0, 1, 0], [0, 0, 0, 1.0]])
@@ -112,4 +103,4 @@ def test_a_transform_out_of_range_fails_at_the_call_and_changes_nothing():
     edge = np.eye(4)
     edge[:3, 3] = np.nextafter(2.0**250, 0.0)
     m.set_transform("p1", edge)
-    assert query(m, "names", None) == query(fresh(parts, {**transforms, "p1": edge}), "names", None)
+    assert query(m, "names", None) == query(manager_of(parts, {**transforms, "p1": edge}), "names", None)

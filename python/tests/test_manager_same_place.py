@@ -6,7 +6,7 @@ pair from scratch)."""
 import numpy as np
 import trimesh
 
-import meshclash
+from conftest import manager_of
 
 
 def scene(seed):
@@ -23,12 +23,6 @@ def scene(seed):
     parts.append(("inner", trimesh.creation.icosphere(subdivisions=1, radius=0.05), parts[0][2].copy()))
     return parts
 
-
-def fresh(parts, transforms):
-    m = meshclash.CollisionManager()
-    for name, mesh, _ in parts:
-        m.add_object(name, mesh, transforms[name])
-    return m
 
 
 def answers(m):
@@ -51,8 +45,8 @@ def test_setting_the_same_transform_keeps_the_answers_of_a_fresh_manager():
     for seed in range(3):
         parts = scene(seed)
         transforms = {name: t for name, _, t in parts}
-        kept = fresh(parts, transforms)
-        expected = answers(fresh(parts, transforms))
+        kept = manager_of(parts, transforms)
+        expected = answers(manager_of(parts, transforms))
         assert answers(kept) == expected
         for _ in range(2):
             # The same transform, as a new array each time (the same bits).
@@ -63,13 +57,13 @@ def test_setting_the_same_transform_keeps_the_answers_of_a_fresh_manager():
         flipped = {name: np.where(t == 0.0, -0.0, t) for name, t in transforms.items()}
         for name, t in flipped.items():
             kept.set_transform(name, t)
-        assert answers(kept) == answers(fresh(parts, flipped)) == expected, seed
+        assert answers(kept) == answers(manager_of(parts, flipped)) == expected, seed
 
 
 def test_moving_away_and_back_gives_the_answers_of_a_fresh_manager_at_each_step():
     parts = scene(7)
     transforms = {name: t for name, _, t in parts}
-    kept = fresh(parts, transforms)
+    kept = manager_of(parts, transforms)
     away = dict(transforms)
     shift = np.eye(4)
     shift[:3, 3] = [0.0, 0.0, 40.0]
@@ -77,6 +71,6 @@ def test_moving_away_and_back_gives_the_answers_of_a_fresh_manager_at_each_step(
     for step in [transforms, away, away, transforms, transforms, away, transforms]:
         for name, t in step.items():
             kept.set_transform(name, t)
-        assert answers(kept) == answers(fresh(parts, step))
+        assert answers(kept) == answers(manager_of(parts, step))
     # Both kinds of step answer differently (the first object's pairs change).
-    assert answers(fresh(parts, transforms)) != answers(fresh(parts, away))
+    assert answers(manager_of(parts, transforms)) != answers(manager_of(parts, away))
