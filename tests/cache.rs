@@ -695,3 +695,65 @@ fn moved_instance_of_a_gltf_mesh_checks_its_pairs_and_gives_the_cold_report() {
     let again = split(&run_s(d.path(), &with(&args, &["--cache", "c"])));
     assert_eq!((again.0, again.1 .1), (cold_moved, 0));
 }
+
+/// The deterministic report of `req` run instanced (`expanded` false: asserting that it takes
+/// the instanced path) or expanded.
+fn report_of(req: &meshclash::pipeline::Request, expanded: bool) -> String {
+    use meshclash::pipeline;
+    let name = req.inputs[0].path().display().to_string();
+    let o = if expanded {
+        pipeline::run_expanded(req, &|_| {}).unwrap()
+    } else {
+        assert!(pipeline::instanced_path(req), "{name}: takes the instanced path");
+        pipeline::run(req, &|_| {}).unwrap()
+    };
+    assert_eq!(o.inputs[0].instanced.is_some(), !expanded, "{name}");
+    serde_json::to_string_pretty(&pipeline::report::build(&o)).unwrap()
+}
+
+/// A scene run instanced with the cache, cold then warm, gives the report of an instanced run
+/// without it, and shares its entries with an expanded run both ways.
+fn instanced_and_expanded_share_the_cache(file: &Path, detail: meshclash::check::query::Detail) {
+    use meshclash::cache::{CacheConfig, DEFAULT_MAX_BYTES};
+    use meshclash::pipeline::{Request, Tolerance};
+    let name = file.display().to_string();
+    let d = tempfile::tempdir().unwrap();
+    let request = |cache: Option<&str>| {
+        let mut req = Request::scene(file);
+        req.settings.detail = detail;
+        req.clearance = Tolerance::Rel(0.002);
+        req.deterministic = true;
+        req.cache = cache.map(|c| CacheConfig { dir: d.path().join(c), max_bytes: DEFAULT_MAX_BYTES });
+        req
+    };
+    let plain = report_of(&request(None), false);
+    let n = candidates(&plain);
+    let dir = |c: &str| d.path().join(c).display().to_string();
+    // Instanced cold, instanced warm, then expanded warm on the same entries.
+    for (expanded, counts) in [(false, (0, n)), (false, (n, 0)), (true, (n, 0))] {
+        let (body, got) = split(&report_of(&request(Some("i")), expanded));
+        assert_eq!(body, plain, "{name}: expanded {expanded}");
+        assert_eq!(got, (counts.0, counts.1, dir("i")), "{name}: expanded {expanded}");
+    }
+    // Expanded cold, then instanced warm on its entries.
+    for (expanded, counts) in [(true, (0, n)), (false, (n, 0))] {
+        let (body, got) = split(&report_of(&request(Some("e")), expanded));
+        assert_eq!(body, plain, "{name}: expanded {expanded}");
+        assert_eq!(got, (counts.0, counts.1, dir("e")), "{name}: expanded {expanded}");
+    }
+}
+
+#[test]
+fn instanced_scene_with_the_cache_equals_the_run_without_and_shares_entries_with_expanded_runs() {
+    use meshclash::check::query::Detail;
+    let mut files: Vec<PathBuf> = ["Box.glb", "SimpleMeshes.gltf", "pins.glb", "simple_pole.glb"]
+        .iter()
+        .map(|n| crate::common::shared(n))
+        .collect();
+    files.extend(crate::common::corpus("2CylinderEngine.glb"));
+    for file in &files {
+        for detail in [Detail::Pairs, Detail::Parts] {
+            instanced_and_expanded_share_the_cache(file, detail);
+        }
+    }
+}

@@ -50,12 +50,22 @@ pub(crate) fn to_hex(d: &Digest) -> String {
 /// file names: a model saved under another name or moved elsewhere finds its earlier runs, and
 /// a moved or reshaped part keeps its model's index.
 pub fn lineage(inputs: &[&Mesh]) -> String {
+    lineage_of_names(inputs.iter().map(|m| m.objects.iter().map(|o| o.name.as_str()).collect()))
+}
+
+/// [`lineage`] of one instanced glTF scene: the same name its expanded mesh gives (its
+/// objects are the scene's parts, in order).
+pub fn lineage_of_scene(scene: &crate::load::InstancedScene) -> String {
+    lineage_of_names(std::iter::once(scene.parts.iter().map(|p| p.name.as_str()).collect()))
+}
+
+fn lineage_of_names<'a>(inputs: impl Iterator<Item = Vec<&'a str>>) -> String {
     let mut sha = Sha256::default();
-    for mesh in inputs {
-        put_len(&mut sha, mesh.objects.len());
-        for o in &mesh.objects {
-            put_len(&mut sha, o.name.len());
-            sha.update(o.name.as_bytes());
+    for names in inputs {
+        put_len(&mut sha, names.len());
+        for name in names {
+            put_len(&mut sha, name.len());
+            sha.update(name.as_bytes());
         }
     }
     format!("objects:{}", to_hex(&finish(sha)))
@@ -174,7 +184,7 @@ impl PartKey {
     /// them, and then only each instance's vertices.
     pub fn of_part_layout(name: &str, mesh: &Mesh, triangles: &[u32]) -> PartKey {
         let shape = Shape::of(mesh, triangles);
-        shape.key(name, mesh, 0)
+        shape.key(name, &mesh.positions, 0)
     }
 
     /// The keys of `parts` (see [`PartKey::of_part_layout`]), computed in parallel, in the
@@ -209,7 +219,49 @@ impl PartKey {
             .into_par_iter()
             .map(|j| {
                 let (l, s) = shift[j].unwrap_or((j, 0));
-                shapes[&l].key(&parts[j].name, meshes[parts[j].input as usize], s)
+                shapes[&l].key(&parts[j].name, &meshes[parts[j].input as usize].positions, s)
+            })
+            .collect()
+    }
+
+    /// The keys of `parts` of an instanced glTF scene (each part's [`Part::object`] is its
+    /// place in `scene.parts`), in the order of `parts`, computed in parallel: the keys
+    /// [`PartKey::of_part_layout`] gives for the same parts of the scene's expanded mesh, so an
+    /// instanced run and an expanded one find each other's results.
+    ///
+    /// They are the same function of the same bytes: a part placed
+    /// ([`crate::load::InstancedScene::place`]) holds exactly the world vertices and
+    /// triangles the expanded mesh holds for it, by the same arithmetic, its triangles' vertex
+    /// numbers less the offset of its first vertex. Numbering vertices in order of first use
+    /// does not see that offset, so the shape digest and the vertex order are the expanded
+    /// part's. The instances of one glTF mesh index their vertices alike (the loader places
+    /// their triangles unchanged, whatever the matrix), so the shape is hashed once per mesh
+    /// and each instance then costs its placed vertices alone.
+    pub fn of_placed_parts(scene: &crate::load::InstancedScene, parts: &[&Part]) -> Vec<PartKey> {
+        use rayon::prelude::*;
+        use std::collections::HashMap;
+        let mesh_of = |p: &Part| scene.parts[p.object as usize].mesh;
+        let mut leader_of: HashMap<u32, usize> = HashMap::new();
+        for (j, p) in parts.iter().enumerate() {
+            leader_of.entry(mesh_of(p)).or_insert(j);
+        }
+        let leaders: Vec<(u32, usize)> = leader_of.into_iter().collect();
+        let shapes: HashMap<u32, Shape> = leaders
+            .par_iter()
+            .map(|&(m, j)| {
+                // The loader placed every part and found it finite: placing again cannot fail
+                // (an empty part would give a key no expanded part has: a miss, never a hit).
+                let (positions, triangles) = scene.place(parts[j].object as usize).unwrap_or_default();
+                let one = Mesh { positions, triangles, ..Mesh::default() };
+                let all: Vec<u32> = (0..one.triangles.len() as u32).collect();
+                (m, Shape::of(&one, &all))
+            })
+            .collect();
+        parts
+            .par_iter()
+            .map(|p| {
+                let positions = scene.place_positions(p.object as usize);
+                shapes[&mesh_of(p)].key(&p.name, &positions, 0)
             })
             .collect()
     }
@@ -500,8 +552,8 @@ impl Shape {
     }
 
     /// The key of the part named `name` of this shape whose vertex `v` is mesh vertex
-    /// `vmap[v] + shift`.
-    fn key(&self, name: &str, mesh: &Mesh, shift: i64) -> PartKey {
+    /// `positions[vmap[v] + shift]`.
+    fn key(&self, name: &str, positions: &[DVec3], shift: i64) -> PartKey {
         let mut sha = Sha256::default();
         sha.update(VERTICES_TAG);
         put_len(&mut sha, name.len());
@@ -510,7 +562,7 @@ impl Shape {
         put_len(&mut sha, self.vmap.len());
         let mut buf: Vec<u8> = Vec::with_capacity(1 << 16);
         for &v in &self.vmap {
-            let p = mesh.positions[(v as i64 + shift) as usize];
+            let p = positions[(v as i64 + shift) as usize];
             for c in [p.x, p.y, p.z] {
                 buf.extend(c.to_bits().to_le_bytes());
             }

@@ -77,14 +77,15 @@ use super::key::{Digest, Fingerprint, PairKey, PartKey, Setting};
 use super::pack::{self, Beyond, Stored};
 use super::store::{CacheSummary, Store};
 use crate::check::assembly::{
-    check_parts_kept, glob_match, AssemblyInfo, Hook, Outcome, Pairing, Part, PartPairReduction, PartsHook,
-    Selection, MAX_CANDIDATE_PART_PAIRS,
+    check_parts_from, glob_match, AssemblyInfo, Hook, Outcome, Pairing, Part, PartPairReduction, PartsHook,
+    Selection, Source, MAX_CANDIDATE_PART_PAIRS,
 };
 use crate::check::containment::Containment;
 use crate::check::overlap::Overlap;
 use crate::check::query::{ClashResult, Closest, PairFinding, Settings, Timings, Verdict};
 use crate::scene::mesh::Mesh;
 use crate::shard::sha256::Sha256;
+use crate::shard::stats;
 use std::collections::{HashMap, HashSet};
 use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
 use std::sync::{Arc, Mutex};
@@ -230,6 +231,21 @@ impl CheckCache {
             CheckCache::Whole(_) => compute(&|_| true),
             CheckCache::Pairs(p) => p.overlaps(o, compute),
         }
+    }
+
+    /// The check of the parts `parts` of an instanced scene (scene mode, every part against
+    /// every other), reused pair by pair: the outcome a check of the scene gives, or None when
+    /// this cache does not reuse by pairs here (then the check runs, and the `cache` block says
+    /// every candidate part pair was checked). The keys are those of the expanded scene's parts
+    /// ([`PartKey::of_placed_parts`]): an instanced run and an expanded one share their results.
+    pub fn check_placed(&self, scene: &crate::load::InstancedScene, parts: &[Part]) -> Option<Outcome> {
+        let CheckCache::Pairs(p) = self else { return None };
+        let pairwise = p.inner.is_none() && p.sel.scene && p.sel.select_b.is_empty();
+        let o = if pairwise { p.by_pairs([Source::Placed(scene); 2], parts) } else { None };
+        if o.is_none() {
+            p.delegated.store(true, Ordering::Relaxed);
+        }
+        o
     }
 
     /// The warnings collected (entries ignored, results not stored).
@@ -650,7 +666,7 @@ impl PairReuse {
 
     /// The check, by pairs: see the module documentation. `None` when this run cannot be
     /// reused pair by pair (then the whole-check cache takes it).
-    fn by_pairs(&self, meshes: [&Mesh; 2], parts: &[Part]) -> Option<Outcome> {
+    fn by_pairs(&self, sources: [Source<'_>; 2], parts: &[Part]) -> Option<Outcome> {
         let sel = &self.sel;
         let settings = &self.settings;
         let b_input = if sel.scene { 0 } else { 1 };
@@ -669,7 +685,7 @@ impl PairReuse {
             }
             false
         };
-        check_parts_kept(meshes, parts.to_vec(), &sa, &sb, pairing, settings, &record);
+        check_parts_from(sources, parts.to_vec(), &sa, &sb, pairing, settings, &record);
         if over.load(Ordering::Relaxed) {
             return None; // the check refuses it
         }
@@ -687,7 +703,14 @@ impl PairReuse {
         needed.dedup();
         let needed_parts: Vec<&Part> = needed.iter().map(|&i| &parts[i]).collect();
         let mut part_key: Vec<Option<PartKey>> = vec![None; parts.len()];
-        for (&i, k) in needed.iter().zip(PartKey::of_part_layouts(meshes, &needed_parts)) {
+        let keys = match sources {
+            [Source::Loaded(a), Source::Loaded(b)] => PartKey::of_part_layouts([a, b], &needed_parts),
+            // Scene mode: one input, its parts placed one at a time.
+            [Source::Placed(scene), _] | [_, Source::Placed(scene)] => {
+                PartKey::of_placed_parts(scene, &needed_parts)
+            }
+        };
+        for (&i, k) in needed.iter().zip(keys) {
             part_key[i] = Some(k);
         }
         let key_of = |i: usize| part_key[i].expect("needed part has a key");
@@ -769,7 +792,7 @@ impl PairReuse {
                 return;
             }
             let keep = |a: usize, b: usize| which.contains(&(a, b));
-            let ar = check_parts_kept(meshes, parts.to_vec(), &sa, &sb, pairing, settings, &keep);
+            let ar = check_parts_from(sources, parts.to_vec(), &sa, &sb, pairing, settings, &keep);
             timings.build_ms += ar.build_ms;
             timings.query_ms += ar.query_ms;
             // The least candidate of the pairs searched together: every clear pair's closest
@@ -858,7 +881,7 @@ impl PairReuse {
         }
         // Tree-sharing figures: the tree sizes they need, stored by part key or measured.
         let mut new_trees: Vec<(Digest, u64)> = Vec::new();
-        let (sah_builds, sharing) = crate::shard::stats::sharing_lazy(meshes, parts, &needed, |wanted, _| {
+        let (sah_builds, sharing) = stats::sharing_lazy_from(sources, parts, &needed, |wanted, _| {
             let mut sizes = HashMap::new();
             let mut build = Vec::new();
             for &p in wanted {
@@ -869,7 +892,7 @@ impl PairReuse {
                     None => build.push(p),
                 }
             }
-            for (p, b) in crate::shard::stats::owned_tree_bytes(meshes, parts, &build, settings.bvh) {
+            for (p, b) in stats::owned_tree_bytes_from(sources, parts, &build, settings.bvh) {
                 sizes.insert(p, b);
                 new_trees.push((*key_of(p).as_bytes(), b));
             }
@@ -911,7 +934,7 @@ impl PartsHook for PairReuse {
             self.delegated.store(true, Ordering::Relaxed);
             return Some(o);
         }
-        match self.by_pairs(meshes, parts) {
+        match self.by_pairs([Source::Loaded(meshes[0]), Source::Loaded(meshes[1])], parts) {
             Some(o) => Some(Ok(o)),
             None => {
                 self.delegated.store(true, Ordering::Relaxed);

@@ -1036,3 +1036,56 @@ fn part_layout_keys_of_instances_are_each_parts_own() {
     let at = copy.triangles.len() as u32;
     assert_eq!(PartKey::of_part_layout(&p.name, &copy, &[at - 2, at - 1]), k);
 }
+
+/// The part keys of an instanced scene's parts, placed one by one, against the keys of the
+/// same parts of the scene's expanded mesh.
+fn placed_keys_match_expanded(path: &Path) {
+    let bytes = fs::read(path).expect("read the scene");
+    let scene = crate::load::load_gltf_instanced(path, &bytes).expect("load instanced");
+    let expanded = scene.expand().expect("expand").mesh;
+    let parts = crate::check::assembly::parts_of(&expanded, 0);
+    assert_eq!(parts.len(), scene.parts.len(), "{}", path.display());
+    let refs: Vec<&crate::check::assembly::Part> = parts.iter().collect();
+    let placed = PartKey::of_placed_parts(&scene, &refs);
+    let want = PartKey::of_part_layouts([&expanded, &expanded], &refs);
+    assert_eq!(placed, want, "{}", path.display());
+    let one_by_one: Vec<PartKey> =
+        parts.iter().map(|p| PartKey::of_part_layout(&p.name, &expanded, &p.triangles)).collect();
+    assert_eq!(placed, one_by_one, "{}", path.display());
+    // Any subset, in any order: each part's own key.
+    let some: Vec<&crate::check::assembly::Part> = parts.iter().rev().step_by(2).collect();
+    let want_some: Vec<PartKey> = some.iter().map(|p| one_by_one[p.object as usize]).collect();
+    assert_eq!(PartKey::of_placed_parts(&scene, &some), want_some, "{}", path.display());
+}
+
+#[test]
+fn placed_part_keys_are_the_expanded_parts_keys() {
+    let dir = Path::new(env!("CARGO_MANIFEST_DIR"));
+    for name in ["Box.glb", "SimpleMeshes.gltf", "pins.glb", "simple_pole.glb"] {
+        placed_keys_match_expanded(&dir.join("meshes").join(name));
+    }
+    // A scene of many instances of shared meshes, when the corpus is at hand.
+    let engine = dir.join("../shared/meshes/2CylinderEngine.glb");
+    if engine.is_file() {
+        placed_keys_match_expanded(&engine);
+    }
+}
+
+#[test]
+fn placed_part_keys_change_with_the_placement() {
+    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("meshes/SimpleMeshes.gltf");
+    let bytes = fs::read(&path).expect("read the scene");
+    let scene = crate::load::load_gltf_instanced(&path, &bytes).expect("load instanced");
+    let expanded = scene.expand().expect("expand").mesh;
+    let parts = crate::check::assembly::parts_of(&expanded, 0);
+    let refs: Vec<&crate::check::assembly::Part> = parts.iter().collect();
+    let keys = PartKey::of_placed_parts(&scene, &refs);
+    // Two instances of one mesh at two places: two keys.
+    let distinct: std::collections::HashSet<PartKey> = keys.iter().copied().collect();
+    assert_eq!(distinct.len(), keys.len());
+    let mut moved = scene.clone();
+    moved.parts[0].world.w_axis.x += 0.5;
+    let moved_keys = PartKey::of_placed_parts(&moved, &refs);
+    assert_ne!(moved_keys[0], keys[0]);
+    assert_eq!(moved_keys[1..], keys[1..]);
+}

@@ -165,8 +165,10 @@ pub(crate) fn shift_of(mesh: &Mesh, leader: &Part, inst: &Part) -> Option<i64> {
 /// instanced glTF scene whose parts are placed when they are read (by the loader's own
 /// arithmetic, so the coordinates are the loaded mesh's, bit for bit) and dropped after.
 #[derive(Clone, Copy)]
-enum Source<'a> {
+pub enum Source<'a> {
+    /// The loaded mesh, in world coordinates.
     Loaded(&'a Mesh),
+    /// An instanced glTF scene (scene mode: one input).
     Placed(&'a InstancedScene),
 }
 
@@ -215,7 +217,7 @@ impl<'a> Source<'a> {
 /// Part `k` of `scene` placed, as a mesh of its positions and triangles. The loader placed
 /// every part by the same arithmetic and found all coordinates finite, so placing cannot fail
 /// here (an empty mesh stands in if it ever did).
-fn placed_part(scene: &InstancedScene, k: usize) -> Mesh {
+pub(crate) fn placed_part(scene: &InstancedScene, k: usize) -> Mesh {
     let (positions, triangles) = scene.place(k).unwrap_or_default();
     Mesh { positions, triangles, ..Mesh::default() }
 }
@@ -440,7 +442,7 @@ pub fn check_parts_kept(
 }
 
 /// [`check_parts_kept`] on parts read from `sources` (by input).
-fn check_parts_from(
+pub fn check_parts_from(
     sources: [Source<'_>; 2],
     parts: Vec<Part>,
     sel_a: &[usize],
@@ -998,11 +1000,27 @@ pub fn run_instanced(
     sel: &Selection,
     settings: &Settings,
 ) -> Result<Outcome, String> {
+    run_instanced_with(scene, bounds, sel, settings, |_| None)
+}
+
+/// [`run_instanced`], where `stand_in(parts)` (called once the parts are known and each side
+/// of the selection holds one) may give the outcome instead of the check: the result cache's
+/// per-part-pair reuse over the scene's parts, placed as they are read.
+pub fn run_instanced_with(
+    scene: &InstancedScene,
+    bounds: &[Aabb],
+    sel: &Selection,
+    settings: &Settings,
+    stand_in: impl FnOnce(&[Part]) -> Option<Outcome>,
+) -> Result<Outcome, String> {
     if !sel.scene || sel.hook.is_some() {
         return Err("an instanced scene is checked in scene mode without a sharding hook".to_string());
     }
     let parts = parts_of_scene(scene, bounds);
     let (sa, sb) = selected(&parts, sel)?;
+    if let Some(o) = stand_in(&parts) {
+        return Ok(o);
+    }
     by_parts([Source::Placed(scene); 2], parts, &sa, &sb, sel, settings)
 }
 

@@ -525,7 +525,7 @@ impl std::fmt::Debug for InstancedInput {
 
 /// Whether `req` runs on its glTF scene instanced ([`InstancedInput`]) rather than expanded:
 /// the one place that decides it. A scene check (at either detail) with nothing that reads the
-/// whole world mesh: no cache (its keys hash the mesh), sharding hook, scene self-check,
+/// whole world mesh: no sharding hook, scene self-check,
 /// penetration estimates, cross-check, `--split-bodies`, units, scales or placement (a
 /// baseline compares finding ids alone, so it runs here).
 /// Every other request expands the scene as it is loaded. Both paths give the same outcome;
@@ -536,7 +536,7 @@ impl std::fmt::Debug for InstancedInput {
 /// ([`LoadedInput::world_mesh`]).
 pub fn instanced_path(req: &Request) -> bool {
     req.selection.scene
-        && req.cache.is_none()
+        && (req.cache.is_none() || cache_by_pairs(req))
         && req.selection.hook.is_none()
         && req.self_check.is_none()
         && !req.penetration
@@ -546,6 +546,16 @@ pub fn instanced_path(req: &Request) -> bool {
         && req.inputs.len() == 1
         && req.inputs[0].transform == DMat4::IDENTITY
         && matches!(req.inputs[0].source, Source::File(_))
+}
+
+/// Whether `req`'s cache reuses a scene's results part pair by part pair over every part
+/// against every other ([`crate::cache::CheckCache::check_placed`]), keyed by each part's
+/// world vertices alone: then the scene need not be expanded. A whole-check cache
+/// (`--first-hit`, a distance error allowance) keys the whole world mesh, and `--select-b`
+/// can put one part on both sides: those expand it.
+fn cache_by_pairs(req: &Request) -> bool {
+    let de = req.settings.distance_error;
+    req.selection.select_b.is_empty() && !req.settings.first_hit && de.rel == 0.0 && de.abs == 0.0
 }
 
 /// Load a glTF scene file instanced (see [`instanced_path`]); any other format loads as usual.
@@ -786,7 +796,10 @@ fn run_on(req: &Request, progress: &(dyn Fn(Phase) + Sync), instanced: bool) -> 
         // The cache finds its index of earlier runs by what the inputs are (their objects'
         // names), never by file name; results are found by their geometry.
         let sides = if req.selection.scene { 1 } else { 2 };
-        let lineage = crate::cache::key::lineage(&[&a.mesh, &b.mesh][..sides]);
+        let lineage = match &inputs[0].instanced {
+            Some(i) => crate::cache::key::lineage_of_scene(&i.scene),
+            None => crate::cache::key::lineage(&[&a.mesh, &b.mesh][..sides]),
+        };
         crate::cache::CheckCache::new(
             std::sync::Arc::new(s),
             &settings,
@@ -799,7 +812,11 @@ fn run_on(req: &Request, progress: &(dyn Fn(Phase) + Sync), instanced: bool) -> 
     });
     let selection = cache.as_ref().map(|c| c.selection(&req.selection));
     let outcome = match &inputs[0].instanced {
-        Some(i) => assembly::run_instanced(&i.scene, &i.part_bounds, &req.selection, &settings),
+        Some(i) => {
+            assembly::run_instanced_with(&i.scene, &i.part_bounds, &req.selection, &settings, |parts| {
+                cache.as_ref().and_then(|c| c.check_placed(&i.scene, parts))
+            })
+        }
         None => assembly::run(&a.mesh, &b.mesh, selection.as_ref().unwrap_or(&req.selection), &settings),
     }
     .map_err(|e| Error::in_file(req.inputs[problem_side(req, &a.mesh)].path(), InputProblem::Selection(e)))?;

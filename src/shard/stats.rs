@@ -10,7 +10,7 @@
 //! (see [`owned_tree_bytes`]) and the merge adds them up.
 
 use crate::bvh::{BuildOptions, Bvh, Node};
-use crate::check::assembly::{Part, Sharing};
+use crate::check::assembly::{Part, Sharing, Source};
 use crate::geom::predicates::BoxMap;
 use crate::geom::{Aabb, DVec3};
 use crate::scene::mesh::{Mesh, Object};
@@ -50,14 +50,27 @@ fn relative_rows(leader: &Object, inst: &Object) -> Option<[[f64; 4]; 3]> {
 
 /// Group the `needed` parts (ascending) as the check does.
 pub fn group(meshes: [&Mesh; 2], parts: &[Part], needed: &[usize]) -> Grouping {
+    group_from([Source::Loaded(meshes[0]), Source::Loaded(meshes[1])], parts, needed)
+}
+
+/// [`group`] over parts read from `sources` (by input). Placed, the instances of one glTF mesh
+/// index their own vertices alike (as the check reads them).
+fn group_from(sources: [Source<'_>; 2], parts: &[Part], needed: &[usize]) -> Grouping {
     let mut leader_of_mesh: HashMap<(u8, u32), usize> = HashMap::new();
     let mut own = Vec::new();
     let mut plan: BTreeMap<usize, (usize, i64, usize)> = BTreeMap::new();
+    let shift = |src: Source<'_>, leader: &Part, inst: &Part| match src {
+        Source::Loaded(mesh) => shift_of(mesh, leader, inst),
+        Source::Placed(_) => (leader.gltf_mesh == inst.gltf_mesh
+            && leader.triangles.len() == inst.triangles.len()
+            && !leader.triangles.is_empty())
+        .then_some(0),
+    };
     for &i in needed {
-        let mesh = meshes[parts[i].input as usize];
+        let src = sources[parts[i].input as usize];
         let shared = parts[i].gltf_mesh.and_then(|m| {
             let l = *leader_of_mesh.entry((parts[i].input, m)).or_insert(i);
-            let shift = if l == i { None } else { shift_of(mesh, &parts[l], &parts[i]) }?;
+            let shift = if l == i { None } else { shift(src, &parts[l], &parts[i]) }?;
             let (layout, _, _) = *plan.get(&l)?;
             Some((layout, shift, l))
         });
@@ -89,11 +102,38 @@ pub fn owned_tree_bytes(
     owned: &[usize],
     opts: BuildOptions,
 ) -> Vec<(usize, u64)> {
+    owned_tree_bytes_from([Source::Loaded(meshes[0]), Source::Loaded(meshes[1])], parts, owned, opts)
+}
+
+/// [`owned_tree_bytes`] over parts read from `sources` (an instanced scene's placed one at a
+/// time, as the check builds their trees).
+pub fn owned_tree_bytes_from(
+    sources: [Source<'_>; 2],
+    parts: &[Part],
+    owned: &[usize],
+    opts: BuildOptions,
+) -> Vec<(usize, u64)> {
     use rayon::prelude::*;
     owned
         .par_iter()
-        .map(|&i| (i, tree_bytes(&build_tree(meshes[parts[i].input as usize], &parts[i], opts)) as u64))
+        .map(|&i| {
+            let bytes = match sources[parts[i].input as usize] {
+                Source::Loaded(mesh) => tree_bytes(&build_tree(mesh, &parts[i], opts)),
+                Source::Placed(scene) => {
+                    let (one, all) = placed(scene, &parts[i]);
+                    tree_bytes(&build_tree(&one, &Part { triangles: all, ..parts[i].clone() }, opts))
+                }
+            };
+            (i, bytes as u64)
+        })
         .collect()
+}
+
+/// Part `part` of `scene` placed, as a mesh, and the list of all its triangles.
+fn placed(scene: &crate::load::InstancedScene, part: &Part) -> (Mesh, Vec<u32>) {
+    let one = crate::check::assembly::placed_part(scene, part.object as usize);
+    let all = (0..one.triangles.len() as u32).collect();
+    (one, all)
 }
 
 /// The layout of one own-tree part: (part-local vertices, bytes kept, vertex map or a run start).
@@ -150,10 +190,47 @@ pub fn sharing_lazy(
     needed: &[usize],
     sizes: impl FnOnce(&[usize], &[usize]) -> Result<HashMap<usize, u64>, usize>,
 ) -> Result<(usize, Sharing), usize> {
+    sharing_lazy_from([Source::Loaded(meshes[0]), Source::Loaded(meshes[1])], parts, needed, sizes)
+}
+
+/// [`sharing_lazy`] over parts read from `sources`: an instanced scene's parts are placed one
+/// at a time, as the check places them, and give the figures the expanded mesh gives.
+pub fn sharing_lazy_from(
+    sources: [Source<'_>; 2],
+    parts: &[Part],
+    needed: &[usize],
+    sizes: impl FnOnce(&[usize], &[usize]) -> Result<HashMap<usize, u64>, usize>,
+) -> Result<(usize, Sharing), usize> {
     use rayon::prelude::*;
-    let g = group(meshes, parts, needed);
-    let mesh_of = |i: usize| meshes[parts[i].input as usize];
-    let layouts: Vec<Layout> = g.own.par_iter().map(|&i| Layout::of(mesh_of(i), &parts[i])).collect();
+    use std::borrow::Cow;
+    let g = group_from(sources, parts, needed);
+    let src_of = |i: usize| sources[parts[i].input as usize];
+    let layouts: Vec<Layout> = g
+        .own
+        .par_iter()
+        .map(|&i| match src_of(i) {
+            Source::Loaded(mesh) => Layout::of(mesh, &parts[i]),
+            Source::Placed(scene) => {
+                let (one, all) = placed(scene, &parts[i]);
+                Layout::of(&one, &Part { triangles: all, ..parts[i].clone() })
+            }
+        })
+        .collect();
+    let world_of = |i: usize| -> Cow<'_, [DVec3]> {
+        match src_of(i) {
+            Source::Loaded(mesh) => Cow::Borrowed(&mesh.positions),
+            Source::Placed(scene) => Cow::Owned(scene.place_positions(parts[i].object as usize)),
+        }
+    };
+    let object_of = |i: usize| -> Cow<'_, Object> {
+        match src_of(i) {
+            Source::Loaded(mesh) => Cow::Borrowed(&mesh.objects[parts[i].object as usize]),
+            Source::Placed(scene) => {
+                let p = &scene.parts[parts[i].object as usize];
+                Cow::Owned(Object { name: String::new(), gltf_mesh: Some(p.mesh), world: Some(p.world) })
+            }
+        }
+    };
     // Instances: a box map when one fits, else a refitted copy (same size as the leader's tree).
     let instances: Vec<(usize, usize, i64, usize)> = g
         .plan
@@ -164,13 +241,17 @@ pub fn sharing_lazy(
     let mapped: Vec<(usize, bool)> = instances
         .par_iter()
         .map(|&(i, layout, shift, l)| {
-            let objects = &mesh_of(i).objects;
             let lay = &layouts[layout];
-            let world = &mesh_of(i).positions;
-            let rows = relative_rows(&objects[parts[l].object as usize], &objects[parts[i].object as usize]);
+            let rows = relative_rows(&object_of(l), &object_of(i));
             let fits = rows.is_some_and(|r| {
+                // Loaded, both read the one mesh's vertices (the instance `shift` apart); placed,
+                // each its own.
+                let (wl, wi) = match src_of(i) {
+                    Source::Loaded(_) => (world_of(i), world_of(i)),
+                    Source::Placed(_) => (world_of(l), world_of(i)),
+                };
                 let pairs =
-                    (0..lay.vertices as u32).map(|v| (lay.vertex(world, v, 0), lay.vertex(world, v, shift)));
+                    (0..lay.vertices as u32).map(|v| (lay.vertex(&wl, v, 0), lay.vertex(&wi, v, shift)));
                 BoxMap::fit(r, &parts[l].bounds, pairs).is_some()
             });
             (layout, fits)
