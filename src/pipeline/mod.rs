@@ -525,9 +525,9 @@ impl std::fmt::Debug for InstancedInput {
 
 /// Whether `req` runs on its glTF scene instanced ([`InstancedInput`]) rather than expanded:
 /// the one place that decides it. A scene check (at either detail) with nothing that reads the
-/// whole world mesh: no sharding hook, scene self-check,
-/// penetration estimates, cross-check, `--split-bodies`, units, scales or placement (a
-/// baseline compares finding ids alone, so it runs here).
+/// whole world mesh: no sharding hook, scene self-check, penetration estimates, cross-check,
+/// `--split-bodies`, units, scales or placement, and a cache only where it reuses part pair by
+/// part pair ([`cache_by_pairs`]; a baseline compares finding ids alone, so it runs here).
 /// Every other request expands the scene as it is loaded. Both paths give the same outcome;
 /// this path's memory grows with the distinct meshes, not the instances. The pair lists keep
 /// the expanded mesh's triangle numbers; finding ids and regions read the triangles of the
