@@ -29,6 +29,7 @@ use crate::geom::exact::{self, Frame, Int, Ratio};
 use crate::geom::predicates as pr;
 use crate::geom::{Aabb, DVec3};
 use crate::narrow::tri_tri::Shape;
+use crate::scene::bodies::{find, union};
 use crate::scene::mesh::TriMesh;
 
 /// The box of A ∩ B, each bound correctly rounded to f64.
@@ -397,30 +398,15 @@ impl Sides {
     fn new<M: TriMesh + ?Sized>(m: &M, meets: &[bool]) -> Sides {
         let n = m.vertex_count();
         let mut parent: Vec<u32> = (0..n as u32).collect();
-        fn root(parent: &mut [u32], mut v: u32) -> u32 {
-            while parent[v as usize] != v {
-                let up = parent[parent[v as usize] as usize];
-                parent[v as usize] = up;
-                v = up;
-            }
-            v
-        }
         for t in 0..m.triangle_count() as u32 {
             if meets[t as usize] {
                 continue;
             }
             let [x, y, z] = m.indices(t);
-            let rx = root(&mut parent, x);
-            for w in [y, z] {
-                let rw = root(&mut parent, w);
-                let rx = root(&mut parent, rx);
-                if rw != rx {
-                    let (lo, hi) = (rw.min(rx), rw.max(rx));
-                    parent[hi as usize] = lo;
-                }
-            }
+            union(&mut parent, x, y);
+            union(&mut parent, x, z);
         }
-        let class: Vec<u32> = (0..n as u32).map(|v| root(&mut parent, v)).collect();
+        let class: Vec<u32> = (0..n as u32).map(|v| find(&mut parent, v)).collect();
         Sides { class, answer: (0..n).map(|_| std::sync::OnceLock::new()).collect() }
     }
 
