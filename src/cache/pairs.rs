@@ -126,6 +126,23 @@ pub fn pair_fingerprint(settings: &Settings, split_bodies: bool, penetration: bo
     ])
 }
 
+/// Whether a check with `settings` and `sel` can be reused part pair by part pair: its parts
+/// are selected (scene mode or a selection), and no stop rule (`--first-hit`) or distance
+/// error allowance makes one pair's answer depend on the others. Otherwise the whole check is
+/// the unit ([`WholeCheck`]).
+fn reusable_by_pairs(settings: &Settings, sel: &Selection) -> bool {
+    let exact_distance = settings.distance_error.rel == 0.0 && settings.distance_error.abs == 0.0;
+    sel.by_parts() && !settings.first_hit && exact_distance
+}
+
+/// Whether an instanced scene's check with `settings` and `sel` is reused pair by pair over
+/// its placed parts ([`CheckCache::check_placed`]): reusable by pairs, every part against
+/// every other (`--select-b` can put one part on both sides). Then the scene need not be
+/// expanded for the cache.
+pub fn reuses_placed_pairs(settings: &Settings, sel: &Selection) -> bool {
+    reusable_by_pairs(settings, sel) && sel.scene && sel.select_b.is_empty()
+}
+
 /// The cache of one check: per part pair when it can be, else the whole check.
 #[derive(Debug)]
 pub enum CheckCache {
@@ -153,8 +170,7 @@ impl CheckCache {
         let whole_fp = super::hook::check_fingerprint(settings, sel, split_bodies, penetration);
         let inner = sel.hook.clone();
         let whole = WholeCheck::new(store.clone(), whole_fp, active && inner.is_none());
-        let exact_distance = settings.distance_error.rel == 0.0 && settings.distance_error.abs == 0.0;
-        if !(active && sel.by_parts() && !settings.first_hit && exact_distance) {
+        if !(active && reusable_by_pairs(settings, sel)) {
             return CheckCache::Whole(Arc::new(whole));
         }
         let fingerprint = pair_fingerprint(settings, split_bodies, penetration);
@@ -240,7 +256,7 @@ impl CheckCache {
     /// ([`PartKey::of_placed_parts`]): an instanced run and an expanded one share their results.
     pub fn check_placed(&self, scene: &crate::load::InstancedScene, parts: &[Part]) -> Option<Outcome> {
         let CheckCache::Pairs(p) = self else { return None };
-        let pairwise = p.inner.is_none() && p.sel.scene && p.sel.select_b.is_empty();
+        let pairwise = p.inner.is_none() && reuses_placed_pairs(&p.settings, &p.sel);
         let o = if pairwise { p.by_pairs([Source::Placed(scene); 2], parts) } else { None };
         if o.is_none() {
             p.delegated.store(true, Ordering::Relaxed);

@@ -527,7 +527,8 @@ impl std::fmt::Debug for InstancedInput {
 /// the one place that decides it. A scene check (at either detail) with nothing that reads the
 /// whole world mesh: no sharding hook, scene self-check, penetration estimates, cross-check,
 /// `--split-bodies`, units, scales or placement, and a cache only where it reuses part pair by
-/// part pair ([`cache_by_pairs`]; a baseline compares finding ids alone, so it runs here).
+/// part pair ([`crate::cache::pairs::reuses_placed_pairs`]; a baseline compares finding ids
+/// alone, so it runs here).
 /// Every other request expands the scene as it is loaded. Both paths give the same outcome;
 /// this path's memory grows with the distinct meshes, not the instances. The pair lists keep
 /// the expanded mesh's triangle numbers; finding ids and regions read the triangles of the
@@ -536,7 +537,7 @@ impl std::fmt::Debug for InstancedInput {
 /// ([`LoadedInput::world_mesh`]).
 pub fn instanced_path(req: &Request) -> bool {
     req.selection.scene
-        && (req.cache.is_none() || cache_by_pairs(req))
+        && (req.cache.is_none() || crate::cache::pairs::reuses_placed_pairs(&req.settings, &req.selection))
         && req.selection.hook.is_none()
         && req.self_check.is_none()
         && !req.penetration
@@ -546,16 +547,6 @@ pub fn instanced_path(req: &Request) -> bool {
         && req.inputs.len() == 1
         && req.inputs[0].transform == DMat4::IDENTITY
         && matches!(req.inputs[0].source, Source::File(_))
-}
-
-/// Whether `req`'s cache reuses a scene's results part pair by part pair over every part
-/// against every other ([`crate::cache::CheckCache::check_placed`]), keyed by each part's
-/// world vertices alone: then the scene need not be expanded. A whole-check cache
-/// (`--first-hit`, a distance error allowance) keys the whole world mesh, and `--select-b`
-/// can put one part on both sides: those expand it.
-fn cache_by_pairs(req: &Request) -> bool {
-    let de = req.settings.distance_error;
-    req.selection.select_b.is_empty() && !req.settings.first_hit && de.rel == 0.0 && de.abs == 0.0
 }
 
 /// Load a glTF scene file instanced (see [`instanced_path`]); any other format loads as usual.
