@@ -21,7 +21,7 @@ use crate::narrow::convex::{self, Penetration, Polytope, Surface};
 use crate::scene::mesh::{Mesh, TriMesh};
 use glam::DMat4;
 use std::path::{Path, PathBuf};
-use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
 use std::sync::{Arc, OnceLock};
 use topology::Fragile;
 
@@ -130,6 +130,7 @@ impl Prepared {
             coarse: None,
             outline: OnceLock::new(),
             laid,
+            reads: AtomicUsize::new(0),
             topology: OnceLock::new(),
             convex: OnceLock::new(),
             translated: OnceLock::new(),
@@ -187,6 +188,7 @@ impl Prepared {
             coarse: None,
             outline: OnceLock::new(),
             laid: OnceLock::from(laid),
+            reads: AtomicUsize::new(0),
             topology: OnceLock::new(),
             convex: OnceLock::new(),
             translated: OnceLock::new(),
@@ -312,6 +314,9 @@ pub struct Placed {
     coarse: Option<(Coarse, BoxMap)>,
     outline: OnceLock<Vec<Aabb>>,
     laid: OnceLock<Laid>,
+    /// How many vertices were computed one by one before the world coordinates
+    /// ([`Placed::vertex`]; approximate under concurrent reads: only speed depends on it).
+    reads: AtomicUsize,
     topology: OnceLock<Arc<Topology>>,
     convex: OnceLock<bool>,
     translated: OnceLock<bool>,
@@ -370,6 +375,32 @@ impl Ball {
     /// Certainly apart: no point of one ball within the other.
     pub fn apart(&self, o: &Ball) -> bool {
         self.gap(o) > 0.0
+    }
+}
+
+/// A placed mesh read vertex by vertex ([`Placed::corners`]).
+#[derive(Debug, Clone, Copy)]
+pub struct Corners<'a>(&'a Placed);
+
+impl TriMesh for Corners<'_> {
+    #[inline]
+    fn vertex_count(&self) -> usize {
+        self.0.prepared.mesh.positions.len()
+    }
+    #[inline]
+    fn vertex(&self, v: u32) -> DVec3 {
+        self.0.vertex(v)
+    }
+    #[inline]
+    fn triangle_count(&self) -> usize {
+        self.0.prepared.mesh.triangles.len()
+    }
+    #[inline]
+    fn indices(&self, t: u32) -> [u32; 3] {
+        self.0.prepared.mesh.triangles[t as usize]
+    }
+    fn positions(&self) -> std::borrow::Cow<'_, [DVec3]> {
+        std::borrow::Cow::Borrowed(self.0.positions())
     }
 }
 
@@ -434,15 +465,25 @@ impl Placed {
 
     /// The world coordinates of vertex `v`: the very value [`Placed::positions`] holds, found
     /// alone (when the world coordinates are not computed yet, by transforming that vertex
-    /// as they would be).
+    /// as they would be). Once half as many vertices as the mesh has were found alone, the
+    /// world coordinates are computed (a walk that reads that many reads more).
     pub fn vertex(&self, v: u32) -> DVec3 {
-        match self.laid.get() {
-            Some(l) => l.world.as_ref().map_or(self.prepared.mesh.positions[v as usize], |w| w[v as usize]),
-            None => match &self.coarse {
-                Some((_, map)) => map.image(self.prepared.mesh.positions[v as usize]),
-                None => self.transform.transform_point3(self.prepared.mesh.positions[v as usize]),
-            },
-        }
+        let local = self.prepared.mesh.positions[v as usize];
+        let laid = match (self.laid.get(), &self.coarse) {
+            (Some(l), _) => l,
+            (None, Some((_, map))) => {
+                // A plain load and store: a lost count under concurrent reads only delays
+                // the switch.
+                let n = self.reads.load(Ordering::Relaxed);
+                if n < self.prepared.mesh.positions.len() / 2 {
+                    self.reads.store(n + 1, Ordering::Relaxed);
+                    return map.image(local);
+                }
+                self.laid()
+            }
+            (None, None) => self.laid(),
+        };
+        laid.world.as_ref().map_or(local, |w| w[v as usize])
     }
 
     /// The world corners of triangle `t` ([`Placed::vertex`]).
@@ -455,13 +496,27 @@ impl Placed {
         self.laid.get().is_some()
     }
 
-    /// The mesh view.
+    /// The mesh view (the world coordinates, computed now if they are not yet).
     pub fn mesh(&self) -> PlacedMesh<'_> {
         PlacedMesh { positions: self.positions(), triangles: &self.prepared.mesh.triangles }
     }
 
-    /// The tree view.
+    /// The mesh view for a walk that reads few triangles (the search for a first meeting
+    /// pair, a witness): each vertex read alone ([`Placed::vertex`]) until the world
+    /// coordinates are computed. Same values as [`Placed::mesh`].
+    pub fn corners(&self) -> Corners<'_> {
+        Corners(self)
+    }
+
+    /// The tree view: the prepared tree through the placement's box map, or a tree refitted on
+    /// the world coordinates when no box map fits them. When the world coordinates were not
+    /// computed at once, the root's box is [`Placed::reach`] (known from the transform: a walk
+    /// needs no world coordinate to start, and starts the same whenever they are computed);
+    /// else it is the exact box.
     pub fn tree(&self) -> MappedTree<'_> {
+        if let Some((_, map)) = &self.coarse {
+            return MappedTree { bvh: &self.prepared.tree, map: Some(*map), root: self.reach };
+        }
         let laid = self.laid();
         let (bvh, map) = match &laid.tree {
             Mapping::Own => (&self.prepared.tree, None),
@@ -844,9 +899,12 @@ pub fn collide(a: &Placed, b: &Placed, all: bool) -> Collision {
     if surely_clear(a, b) || !a.bounds().overlaps(&b.bounds()) {
         return none;
     }
-    let (ma, mb, ta, tb) = (a.mesh(), b.mesh(), a.tree(), b.tree());
-    let contacts =
-        if no_meeting_triangles(a, b) { Vec::new() } else { meeting_pairs(&ma, &ta, &mb, &tb, !all) };
+    let (ta, tb) = (a.tree(), b.tree());
+    let contacts = match (no_meeting_triangles(a, b), all) {
+        (true, _) => Vec::new(),
+        (false, true) => meeting_pairs(&a.mesh(), &ta, &b.mesh(), &tb, false),
+        (false, false) => meeting_pairs(&a.corners(), &ta, &b.corners(), &tb, true),
+    };
     if !contacts.is_empty() {
         return Collision { contacts, containment: Containment::None };
     }
@@ -865,7 +923,7 @@ pub fn collide(a: &Placed, b: &Placed, all: bool) -> Collision {
     if !any_inside(a, b) && !any_inside(b, a) {
         return none;
     }
-    let containment = containment::decide(&ma, &ta, a.topology(), &mb, &tb, b.topology());
+    let containment = containment::decide(&a.mesh(), &ta, a.topology(), &b.mesh(), &tb, b.topology());
     Collision { contacts, containment }
 }
 
@@ -876,15 +934,17 @@ pub fn distance(a: &Placed, b: &Placed, bound: f64) -> Option<Closest> {
     if a.bounds().distance_sq(&b.bounds()).sqrt() > bound {
         return None;
     }
-    let (ma, mb, ta, tb) = (a.mesh(), b.mesh(), a.tree(), b.tree());
+    let (ta, tb) = (a.tree(), b.tree());
     if a.bounds().overlaps(&b.bounds()) {
         // Stops at the first meeting pair: the distance is 0 either way, the witness is a
         // shared point of some meeting pair.
-        if let Some(p) = meeting_pairs(&ma, &ta, &mb, &tb, true).first() {
-            return Some(query::pair_witness(&ma, &mb, p));
+        let (ca, cb) = (a.corners(), b.corners());
+        if let Some(p) = meeting_pairs(&ca, &ta, &cb, &tb, true).first() {
+            return Some(query::pair_witness(&ca, &cb, p));
         }
     }
-    query::closest_pair(&ma, &ta, &mb, &tb, DistanceError::default()).filter(|c| c.distance <= bound)
+    query::closest_pair(&a.mesh(), &ta, &b.mesh(), &tb, DistanceError::default())
+        .filter(|c| c.distance <= bound)
 }
 
 /// The exact penetration of two placed convex meshes ([`convex::penetration`]): `None` unless
@@ -941,8 +1001,10 @@ pub fn signed_meeting(a: &Placed, b: &Placed, contact: &PairFinding) -> Signed {
 }
 
 fn colliding(a: &Placed, b: &Placed, c: &Collision) -> Signed {
-    let contact =
-        c.contacts.first().map(|p| (p.a as i64, p.b as i64, query::pair_witness(&a.mesh(), &b.mesh(), p)));
+    let contact = c
+        .contacts
+        .first()
+        .map(|p| (p.a as i64, p.b as i64, query::pair_witness(&a.corners(), &b.corners(), p)));
     if let Some(p) = a.polytope().zip(b.polytope()).and_then(|(pa, pb)| convex::penetration(&pa, &pb)) {
         let half = p.normal * (p.depth * 0.5);
         let (fa, fb) = contact.as_ref().map_or((-1, -1), |c| (c.0, c.1));
@@ -1122,9 +1184,12 @@ mod tests {
     }
 
     /// A placement's world coordinates computed when first read are bit for bit those computed
-    /// at once, and so are its exact box, tree boxes, ball and every answer about it; its box
-    /// from the transform alone holds every world vertex, and reading single vertices or a pair
-    /// lower bound computes nothing.
+    /// at once, and so are its exact box, tree boxes below the root, ball and every verdict and
+    /// distance; its box from the transform alone holds every world vertex (it is the tree
+    /// view's root), and reading single vertices or a pair lower bound computes nothing. Every
+    /// answer, witnesses included, is the same whether a query finds the world coordinates
+    /// computed or computes them (or reads only the vertices it needs), and a first-contact
+    /// search reads few vertices and computes none of them all.
     #[test]
     fn lazy_placements_answer_as_eager_ones() {
         let mut compared = 0;
@@ -1139,8 +1204,13 @@ mod tests {
                 let (ea, eb) = (a.place_now(ma).unwrap(), b.place_now(mb).unwrap());
                 assert!(!la.is_laid() && !lb.is_laid(), "placing computes nothing");
                 // Single vertices and the box bound, before the world coordinates exist.
-                let singles: Vec<DVec3> = (0..a.mesh.positions.len() as u32).map(|v| la.vertex(v)).collect();
                 assert_eq!(la.triangle(1), ea.triangle(1));
+                assert!(!la.is_laid(), "reading a few vertices computes no other");
+                // Reading every vertex alone gives the same values, and past half of them the
+                // world coordinates are computed.
+                let sa = a.place(ma).unwrap();
+                let singles: Vec<DVec3> = (0..a.mesh.positions.len() as u32).map(|v| sa.vertex(v)).collect();
+                assert!(sa.is_laid());
                 assert!(la.reach_gap(&lb) <= ea.gap(&eb));
                 if !la.reach().overlaps(&lb.reach()) {
                     assert!(la.apart(&lb) && !la.is_laid() && !lb.is_laid());
@@ -1157,14 +1227,19 @@ mod tests {
                 let bits =
                     |p: &[DVec3]| p.iter().flat_map(|v| v.to_array().map(f64::to_bits)).collect::<Vec<_>>();
                 assert_eq!(bits(&singles), bits(ea.positions()));
-                for (l, e) in [(&la, &ea), (&lb, &eb)] {
+                // The same placements with their world coordinates computed before any query.
+                let (fa, fb) = (a.place(ma).unwrap(), b.place(mb).unwrap());
+                let _ = (fa.positions(), fb.positions());
+                for (l, e, f) in [(&la, &ea, &fa), (&lb, &eb, &fb)] {
                     assert_eq!(bits(l.positions()), bits(e.positions()));
                     assert_eq!(l.bounds(), e.bounds());
                     assert!(l.reach().contains(&l.bounds()), "{:?} {:?}", l.reach(), l.bounds());
                     assert!(e.reach() == e.bounds());
-                    let (tl, te) = (l.tree(), e.tree());
+                    let (tl, te, tf) = (l.tree(), e.tree(), f.tree());
+                    assert_eq!(tl.node_box(0), l.reach());
                     for n in 0..l.prepared.tree.nodes.len() as u32 {
-                        assert_eq!(tl.node_box(n), te.node_box(n));
+                        assert_eq!(tl.node_box(n), tf.node_box(n));
+                        assert!(n == 0 || tl.node_box(n) == te.node_box(n));
                     }
                     assert_eq!(l.ball(), e.ball());
                     assert_eq!(l.is_convex(), e.is_convex());
@@ -1172,18 +1247,51 @@ mod tests {
                 assert_eq!(la.apart(&lb), ea.apart(&eb));
                 assert_eq!(la.gap(&lb), ea.gap(&eb));
                 assert_eq!(collide(&la, &lb, true), collide(&ea, &eb, true));
-                assert_eq!(distance(&la, &lb, f64::INFINITY), distance(&ea, &eb, f64::INFINITY));
-                // Fresh lazy placements (nothing computed yet) for the signed distance.
+                let d = distance(&la, &lb, f64::INFINITY);
+                assert_eq!(d, distance(&fa, &fb, f64::INFINITY));
+                assert_eq!(d.map(|c| c.distance), distance(&ea, &eb, f64::INFINITY).map(|c| c.distance));
+                // Fresh lazy placements (nothing computed yet) for the first contact and the
+                // signed distance.
                 let (la, lb) = (a.place(ma).unwrap(), b.place(mb).unwrap());
-                assert_eq!(
-                    signed_distance(&la, &lb, f64::INFINITY),
-                    signed_distance(&ea, &eb, f64::INFINITY)
-                );
+                let first = meeting_pairs(&la.corners(), &la.tree(), &lb.corners(), &lb.tree(), true);
+                assert_eq!(first, meeting_pairs(&fa.mesh(), &fa.tree(), &fb.mesh(), &fb.tree(), true));
+                let s = signed_distance(&la, &lb, f64::INFINITY);
+                assert_eq!(s, signed_distance(&fa, &fb, f64::INFINITY));
+                let e = signed_distance(&ea, &eb, f64::INFINITY);
+                assert_eq!(s.map(|s| s.distance), e.map(|s| s.distance));
                 compared += 1;
             }
         }
         assert_eq!(compared, 60);
         assert!(outcomes.iter().all(|&n| n >= 3), "{outcomes:?}");
+    }
+
+    /// Two dense soups placed across each other: the first-contact search on vertices read
+    /// one by one finds the pair the search on computed world coordinates finds, and the signed
+    /// distance from it is the same, without computing the world coordinates of either (soups
+    /// are not convex: no depth is computed).
+    #[test]
+    fn first_contact_reads_few_vertices() {
+        let (a, b) = (prepared(soup(3000, 5)), prepared(soup(3000, 6)));
+        let mut found = 0;
+        for (k, m) in random_transforms(9, 20).into_iter().enumerate() {
+            let m =
+                DMat4::from_translation(DVec3::splat(4.0)) * m * DMat4::from_translation(DVec3::splat(-4.0));
+            let mb = DMat4::from_rotation_z(0.3 + k as f64) * DMat4::from_translation(DVec3::splat(0.01));
+            let (la, lb) = (a.place(m).unwrap(), b.place(mb).unwrap());
+            let (fa, fb) = (a.place(m).unwrap(), b.place(mb).unwrap());
+            let _ = (fa.positions(), fb.positions());
+            let first = meeting_pairs(&la.corners(), &la.tree(), &lb.corners(), &lb.tree(), true);
+            assert_eq!(first, meeting_pairs(&fa.mesh(), &fa.tree(), &fb.mesh(), &fb.tree(), true));
+            if let Some(p) = first.first() {
+                found += 1;
+                assert!(!la.is_laid() && !lb.is_laid(), "{k}: a first contact computed every vertex");
+                assert_eq!(signed_meeting(&la, &lb, p), signed_meeting(&fa, &fb, p));
+                assert!(!la.is_laid() && !lb.is_laid(), "{k}: a witness computed every vertex");
+            }
+            assert_eq!(signed_distance(&la, &lb, f64::INFINITY), signed_distance(&fa, &fb, f64::INFINITY));
+        }
+        assert!(found >= 10, "{found}");
     }
 
     /// A transform that takes some vertex out of the finite or exact range fails at placing,

@@ -827,7 +827,7 @@ fn collide_pairs(
             if prepared::no_meeting_triangles(x, y) {
                 return None;
             }
-            let m = api::meeting_pairs(&x.mesh(), &x.tree(), &y.mesh(), &y.tree(), true);
+            let m = api::meeting_pairs(&x.corners(), &x.tree(), &y.corners(), &y.tree(), true);
             let first = m.first()?;
             memo.keep_hint(hint_key(a, b, *p), (first.a, first.b));
             Some(met(p))
@@ -940,7 +940,7 @@ fn nearest(
             let m = if prepared::no_meeting_triangles(x, y) {
                 Vec::new()
             } else {
-                api::meeting_pairs(&x.mesh(), &x.tree(), &y.mesh(), &y.tree(), true)
+                api::meeting_pairs(&x.corners(), &x.tree(), &y.corners(), &y.tree(), true)
             };
             let Some(first) = m.into_iter().next() else {
                 memo.keep_no_meeting(key(i, j));
