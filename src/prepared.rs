@@ -18,6 +18,7 @@ use crate::error::{Error, InputProblem, Location, Result};
 use crate::geom::predicates::{self, BoxMap, PlacementRounding, Tolerances};
 use crate::geom::{Aabb, DVec3};
 use crate::narrow::convex::{self, Penetration, Polytope, Surface};
+use crate::narrow::tri_tri;
 use crate::scene::mesh::{Mesh, TriMesh};
 use glam::DMat4;
 use std::path::{Path, PathBuf};
@@ -378,29 +379,36 @@ impl Ball {
     }
 }
 
-/// A placed mesh read vertex by vertex ([`Placed::corners`]).
+/// A placed mesh read vertex by vertex ([`Placed::corners`]): from the world coordinates when
+/// they were computed when the view was made, else each vertex alone ([`Placed::vertex`]).
 #[derive(Debug, Clone, Copy)]
-pub struct Corners<'a>(&'a Placed);
+pub struct Corners<'a> {
+    placed: &'a Placed,
+    world: Option<&'a [DVec3]>,
+}
 
 impl TriMesh for Corners<'_> {
     #[inline]
     fn vertex_count(&self) -> usize {
-        self.0.prepared.mesh.positions.len()
+        self.placed.prepared.mesh.positions.len()
     }
     #[inline]
     fn vertex(&self, v: u32) -> DVec3 {
-        self.0.vertex(v)
+        match self.world {
+            Some(w) => w[v as usize],
+            None => self.placed.vertex(v),
+        }
     }
     #[inline]
     fn triangle_count(&self) -> usize {
-        self.0.prepared.mesh.triangles.len()
+        self.placed.prepared.mesh.triangles.len()
     }
     #[inline]
     fn indices(&self, t: u32) -> [u32; 3] {
-        self.0.prepared.mesh.triangles[t as usize]
+        self.placed.prepared.mesh.triangles[t as usize]
     }
     fn positions(&self) -> std::borrow::Cow<'_, [DVec3]> {
-        std::borrow::Cow::Borrowed(self.0.positions())
+        std::borrow::Cow::Borrowed(self.placed.positions())
     }
 }
 
@@ -505,7 +513,8 @@ impl Placed {
     /// pair, a witness): each vertex read alone ([`Placed::vertex`]) until the world
     /// coordinates are computed. Same values as [`Placed::mesh`].
     pub fn corners(&self) -> Corners<'_> {
-        Corners(self)
+        let world = self.laid.get().map(|l| l.world.as_deref().unwrap_or(&self.prepared.mesh.positions));
+        Corners { placed: self, world }
     }
 
     /// The tree view: the prepared tree through the placement's box map, or a tree refitted on
@@ -756,31 +765,12 @@ where
         tb,
         |x, y| !stop.load(Ordering::Relaxed) && tol.boxes_may_meet(x, y),
         |la, lb, out| {
-            for &i in la {
-                let ti = a.triangle(i);
-                let bi = Aabb::of_triangle(&ti);
-                for &j in lb {
-                    if stop.load(Ordering::Relaxed) {
-                        return;
-                    }
-                    let tj = b.triangle(j);
-                    if !tol.boxes_may_meet(&bi, &Aabb::of_triangle(&tj)) {
-                        continue;
-                    }
-                    if let Some(h) = crate::narrow::tri_tri::classify(&ti, &tj) {
-                        let kind = if h.crossing { PairKind::Crossing } else { PairKind::Touching };
-                        out.push(PairFinding {
-                            a: i,
-                            b: j,
-                            kind,
-                            contact: Some(h.contact),
-                            distance: 0.0,
-                            segment: h.segment,
-                        });
-                        stop.store(true, Ordering::Relaxed);
-                        return;
-                    }
-                }
+            let mut near_b = Vec::with_capacity(lb.len());
+            let everywhere = Aabb { min: DVec3::NEG_INFINITY, max: DVec3::INFINITY };
+            let leaves = (a, la, &everywhere, b, lb, &everywhere);
+            if let Some(p) = first_in_leaves(leaves, &mut near_b, &|| stop.load(Ordering::Relaxed)) {
+                out.push(p);
+                stop.store(true, Ordering::Relaxed);
             }
         },
     );
@@ -820,44 +810,13 @@ where
     // trees, plus one).
     let mut stack = Vec::with_capacity(64);
     stack.push((0u32, 0u32, root_a, root_b));
-    // The triangles of the current leaf of B whose boxes meet the leaf of A's box.
-    let mut near_b: Vec<(u32, [DVec3; 3], Aabb)> = Vec::with_capacity(16);
+    let mut near_b = Vec::with_capacity(16);
     while let Some((i, j, bi, bj)) = stack.pop() {
         let open_a = match (ta.is_leaf(i), tb.is_leaf(j)) {
             (true, true) => {
-                near_b.clear();
-                for &t in tb.leaf_prims(j) {
-                    let tt = b.triangle(t);
-                    let bt = Aabb::of_triangle(&tt);
-                    if tol.boxes_may_meet(&bi, &bt) {
-                        near_b.push((t, tt, bt));
-                    }
-                }
-                if near_b.is_empty() {
-                    continue;
-                }
-                for &s in ta.leaf_prims(i) {
-                    let ts = a.triangle(s);
-                    let bs = Aabb::of_triangle(&ts);
-                    if !tol.boxes_may_meet(&bs, &bj) {
-                        continue;
-                    }
-                    for (t, tt, bt) in &near_b {
-                        if !tol.boxes_may_meet(&bs, bt) {
-                            continue;
-                        }
-                        if let Some(h) = crate::narrow::tri_tri::classify(&ts, tt) {
-                            let kind = if h.crossing { PairKind::Crossing } else { PairKind::Touching };
-                            return Some(PairFinding {
-                                a: s,
-                                b: *t,
-                                kind,
-                                contact: Some(h.contact),
-                                distance: 0.0,
-                                segment: h.segment,
-                            });
-                        }
-                    }
+                let leaves = (a, ta.leaf_prims(i), &bi, b, tb.leaf_prims(j), &bj);
+                if let Some(p) = first_in_leaves(leaves, &mut near_b, &|| false) {
+                    return Some(p);
                 }
                 continue;
             }
@@ -883,6 +842,68 @@ where
     None
 }
 
+/// Two leaves of a first-contact walk: (mesh A, its leaf's triangles, a box holding them; the
+/// same of B).
+type Leaves<'a, A, B> = (&'a A, &'a [u32], &'a Aabb, &'a B, &'a [u32], &'a Aabb);
+
+/// The first triangle pair of two leaves that meets, in leaf order (A's triangles outside,
+/// B's inside): a triangle of one leaf is tried only when its box meets the other leaf's box,
+/// and each triangle is read, boxed and prepared ([`tri_tri::Prepared`]) once. The pair found
+/// is classified again with its segment, as [`tri_tri::classify`] gives it. `near_b` is room
+/// for B's triangles; `stop` is asked before each pair.
+fn first_in_leaves<A, B>(
+    (a, la, box_a, b, lb, box_b): Leaves<'_, A, B>,
+    near_b: &mut Vec<(u32, tri_tri::Prepared, Aabb)>,
+    stop: &dyn Fn() -> bool,
+) -> Option<PairFinding>
+where
+    A: TriMesh + ?Sized,
+    B: TriMesh + ?Sized,
+{
+    let tol = Tolerances::default();
+    near_b.clear();
+    for &t in lb {
+        let tt = b.triangle(t);
+        let bt = Aabb::of_triangle(&tt);
+        if tol.boxes_may_meet(box_a, &bt) {
+            near_b.push((t, tri_tri::Prepared::new(tt), bt));
+        }
+    }
+    if near_b.is_empty() {
+        return None;
+    }
+    for &s in la {
+        let ts = a.triangle(s);
+        let bs = Aabb::of_triangle(&ts);
+        if !tol.boxes_may_meet(&bs, box_b) {
+            continue;
+        }
+        let mut ps: Option<tri_tri::Prepared> = None;
+        for (t, pt, bt) in near_b.iter() {
+            if !tol.boxes_may_meet(&bs, bt) {
+                continue;
+            }
+            if stop() {
+                return None;
+            }
+            let ps = &*ps.get_or_insert_with(|| tri_tri::Prepared::new(ts));
+            if tri_tri::classify_prepared(ps, pt, false).is_some() {
+                let h = tri_tri::classify_prepared(ps, pt, true).expect("the same pair meets");
+                let kind = if h.crossing { PairKind::Crossing } else { PairKind::Touching };
+                return Some(PairFinding {
+                    a: s,
+                    b: *t,
+                    kind,
+                    contact: Some(h.contact),
+                    distance: 0.0,
+                    segment: h.segment,
+                });
+            }
+        }
+    }
+    None
+}
+
 /// The surface (half area) of the intersection of two boxes, 0 when they only touch or miss:
 /// the walk's measure of how much two node boxes share.
 #[inline]
@@ -894,6 +915,8 @@ fn shared_surface(x: &Aabb, y: &Aabb) -> f64 {
 /// Exact collision test of two placed meshes: every meeting triangle pair (`all`), or stop at
 /// the first meeting pair; when none meet, containment decides (left at `None`, not decided,
 /// when no vertex of either mesh lies in the other's box: nothing can be contained then).
+/// Without `all` (a yes/no question) containment is decided only as far as a clash
+/// ([`containment::decide_clash`]: the undefined inside of an open surface is not looked into).
 pub fn collide(a: &Placed, b: &Placed, all: bool) -> Collision {
     let none = Collision { contacts: Vec::new(), containment: Containment::None };
     if surely_clear(a, b) || !a.bounds().overlaps(&b.bounds()) {
@@ -923,7 +946,11 @@ pub fn collide(a: &Placed, b: &Placed, all: bool) -> Collision {
     if !any_inside(a, b) && !any_inside(b, a) {
         return none;
     }
-    let containment = containment::decide(&a.mesh(), &ta, a.topology(), &b.mesh(), &tb, b.topology());
+    let (ma, mb) = (a.mesh(), b.mesh());
+    let containment = match all {
+        true => containment::decide(&ma, &ta, a.topology(), &mb, &tb, b.topology()),
+        false => containment::decide_clash(&ma, &ta, a.topology(), &mb, &tb, b.topology()),
+    };
     Collision { contacts, containment }
 }
 
@@ -1141,7 +1168,11 @@ mod tests {
                 let found = first_contact_sequential(&ma, &ta, &mb, &tb);
                 assert_eq!(found.is_some(), any, "seed {seed}");
                 if let Some(f) = found {
-                    assert!(crate::narrow::tri_tri::classify(&ma.triangle(f.a), &mb.triangle(f.b)).is_some());
+                    let h = crate::narrow::tri_tri::classify(&ma.triangle(f.a), &mb.triangle(f.b)).unwrap();
+                    assert_eq!(
+                        (f.kind == PairKind::Crossing, f.contact, f.segment),
+                        (h.crossing, Some(h.contact), h.segment)
+                    );
                     met += 1;
                 } else {
                     missed += 1;
@@ -1150,6 +1181,32 @@ mod tests {
             }
         }
         assert!(met > 10 && missed > 5, "{met} met, {missed} missed");
+    }
+
+    /// Above [`SEQUENTIAL_FIRST_CONTACT`] triangles the first-contact search runs in parallel:
+    /// it finds a meeting pair, as classified alone, exactly when the full search finds some.
+    #[test]
+    fn parallel_first_contact_finds_a_meeting_pair() {
+        let (a, b) = (prepared(soup(26_000, 3)), prepared(soup(26_000, 4)));
+        for shift in [0.3, 9.0] {
+            let (pa, pb) = (
+                a.place(DMat4::IDENTITY).unwrap(),
+                b.place(DMat4::from_translation(DVec3::splat(shift))).unwrap(),
+            );
+            let (ma, mb, ta, tb) = (pa.mesh(), pb.mesh(), pa.tree(), pb.tree());
+            assert!(ma.triangle_count() + mb.triangle_count() > SEQUENTIAL_FIRST_CONTACT);
+            let first = meeting_pairs(&ma, &ta, &mb, &tb, true);
+            let all = meeting_pairs(&ma, &ta, &mb, &tb, false);
+            assert_eq!(first.is_empty(), all.is_empty(), "shift {shift}");
+            assert_eq!(all.is_empty(), shift > 8.0);
+            for f in &first {
+                let h = crate::narrow::tri_tri::classify(&ma.triangle(f.a), &mb.triangle(f.b)).unwrap();
+                assert_eq!(
+                    (f.kind == PairKind::Crossing, f.contact, f.segment),
+                    (h.crossing, Some(h.contact), h.segment)
+                );
+            }
+        }
     }
 
     /// Random affine maps: rotations, uneven scales, reflections, shears, large translations,

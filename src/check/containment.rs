@@ -486,13 +486,24 @@ where
     tb.root_box().overlaps(&ba) || ta.root_box().overlaps(&bb)
 }
 
-fn one_way<I, O, T>(inner: &I, it: &Topology, outer: &O, ot: &T, otopo: &Topology, name: &str) -> OneWay
+fn one_way<I, O, T>(
+    inner: &I,
+    it: &Topology,
+    outer: &O,
+    ot: &T,
+    otopo: &Topology,
+    name: &str,
+    explain_open: bool,
+) -> OneWay
 where
     I: TriMesh + ?Sized,
     O: TriMesh + ?Sized,
     T: Tree + ?Sized,
 {
     let n = it.component_seeds.len();
+    if !otopo.closed && !explain_open {
+        return OneWay::Counts(0, n);
+    }
     let ib = Aabb::of_points(inner.positions().iter());
     if !ot.root_box().overlaps(&ib) {
         return OneWay::Counts(0, n);
@@ -554,8 +565,48 @@ where
     B: TriMesh + ?Sized,
     TB: Tree + ?Sized,
 {
-    let ab = one_way(a, topo_a, b, tb, topo_b, "b");
-    let ba = one_way(b, topo_b, a, ta, topo_a, "a");
+    decide_as(a, ta, topo_a, b, tb, topo_b, true)
+}
+
+/// [`decide`] as far as a clash: the same answer when it is a clash, else
+/// [`Containment::None`] or [`Containment::Undecided`] (a ray that met an edge exactly), never
+/// the undefined inside of an open surface (no generalized winding number is computed: for a
+/// yes/no question it would only turn "no" into "undecided", which is no clash either).
+pub fn decide_clash<A, TA, B, TB>(
+    a: &A,
+    ta: &TA,
+    topo_a: &Topology,
+    b: &B,
+    tb: &TB,
+    topo_b: &Topology,
+) -> Containment
+where
+    A: TriMesh + ?Sized,
+    TA: Tree + ?Sized,
+    B: TriMesh + ?Sized,
+    TB: Tree + ?Sized,
+{
+    decide_as(a, ta, topo_a, b, tb, topo_b, false)
+}
+
+#[allow(clippy::too_many_arguments)]
+fn decide_as<A, TA, B, TB>(
+    a: &A,
+    ta: &TA,
+    topo_a: &Topology,
+    b: &B,
+    tb: &TB,
+    topo_b: &Topology,
+    explain_open: bool,
+) -> Containment
+where
+    A: TriMesh + ?Sized,
+    TA: Tree + ?Sized,
+    B: TriMesh + ?Sized,
+    TB: Tree + ?Sized,
+{
+    let ab = one_way(a, topo_a, b, tb, topo_b, "b", explain_open);
+    let ba = one_way(b, topo_b, a, ta, topo_a, "a", explain_open);
     match (ab, ba) {
         (OneWay::Counts(i, n), _) if i > 0 && i == n => Containment::AInB,
         (_, OneWay::Counts(i, n)) if i > 0 && i == n => Containment::BInA,
@@ -981,5 +1032,42 @@ mod tests {
         let apart = cube(DVec3::splat(20.0), DVec3::splat(21.0));
         let ta = Bvh::build(&apart, BuildOptions::default());
         assert_eq!(decide(&apart, &ta, &topology(&apart), &outer, &to, &po), Containment::None);
+    }
+
+    /// The yes/no containment equals the full one wherever either is a clash; it differs only
+    /// where an open surface's inside is undefined (no clash either way): a small cube in a big
+    /// one, in a big one with one face removed (open), and apart from both, every order.
+    #[test]
+    fn clash_only_containment_agrees_with_the_full_one() {
+        let mut open = cube(DVec3::ZERO, DVec3::splat(10.0));
+        open.triangles.truncate(10);
+        open.tri_object.truncate(10);
+        let meshes = [
+            cube(DVec3::ZERO, DVec3::splat(10.0)),
+            open,
+            cube(DVec3::splat(4.0), DVec3::splat(5.0)),
+            cube(DVec3::splat(20.0), DVec3::splat(21.0)),
+        ];
+        let built: Vec<_> =
+            meshes.iter().map(|m| (m, Bvh::build(m, BuildOptions::default()), topology(m))).collect();
+        let mut undefined = 0;
+        for (a, ta, pa) in &built {
+            for (b, tb, pb) in &built {
+                let full = decide(*a, ta, pa, *b, tb, pb);
+                let clash = decide_clash(*a, ta, pa, *b, tb, pb);
+                if full.is_clash() || clash.is_clash() {
+                    assert_eq!(full, clash);
+                } else if full != clash {
+                    assert!(
+                        matches!(full, Containment::Undecided(ref e) if e.contains("not closed")),
+                        "{full:?}"
+                    );
+                    assert_eq!(clash, Containment::None);
+                    undefined += 1;
+                }
+            }
+        }
+        // The small cube in the open box, both orders.
+        assert_eq!(undefined, 2);
     }
 }
