@@ -765,10 +765,10 @@ where
         tb,
         |x, y| !stop.load(Ordering::Relaxed) && tol.boxes_may_meet(x, y),
         |la, lb, out| {
-            let mut near_b = Vec::with_capacity(lb.len());
+            let mut room = (Vec::with_capacity(la.len()), Vec::with_capacity(lb.len()), Vec::new());
             let everywhere = Aabb { min: DVec3::NEG_INFINITY, max: DVec3::INFINITY };
             let leaves = (a, la, &everywhere, b, lb, &everywhere);
-            if let Some(p) = first_in_leaves(leaves, &mut near_b, &|| stop.load(Ordering::Relaxed)) {
+            if let Some(p) = first_in_leaves(leaves, &mut room, &|| stop.load(Ordering::Relaxed)) {
                 out.push(p);
                 stop.store(true, Ordering::Relaxed);
             }
@@ -810,12 +810,12 @@ where
     // trees, plus one).
     let mut stack = Vec::with_capacity(64);
     stack.push((0u32, 0u32, root_a, root_b));
-    let mut near_b = Vec::with_capacity(16);
+    let mut room = (Vec::with_capacity(16), Vec::with_capacity(16), Vec::with_capacity(16));
     while let Some((i, j, bi, bj)) = stack.pop() {
         let open_a = match (ta.is_leaf(i), tb.is_leaf(j)) {
             (true, true) => {
                 let leaves = (a, ta.leaf_prims(i), &bi, b, tb.leaf_prims(j), &bj);
-                if let Some(p) = first_in_leaves(leaves, &mut near_b, &|| false) {
+                if let Some(p) = first_in_leaves(leaves, &mut room, &|| false) {
                     return Some(p);
                 }
                 continue;
@@ -846,14 +846,23 @@ where
 /// same of B).
 type Leaves<'a, A, B> = (&'a A, &'a [u32], &'a Aabb, &'a B, &'a [u32], &'a Aabb);
 
+/// A triangle of a leaf near the other leaf: its index, corners and box.
+type Near = (u32, [DVec3; 3], Aabb);
+
+/// Room for [`first_in_leaves`]: the near triangles of each leaf, and the classifier facts of
+/// B's, prepared when some pair needs them.
+type LeafRoom = (Vec<Near>, Vec<Near>, Vec<Option<tri_tri::Prepared>>);
+
 /// The first triangle pair of two leaves that meets, in leaf order (A's triangles outside,
-/// B's inside): a triangle of one leaf is tried only when its box meets the other leaf's box,
-/// and each triangle is read, boxed and prepared ([`tri_tri::Prepared`]) once. The pair found
-/// is classified again with its segment, as [`tri_tri::classify`] gives it. `near_b` is room
-/// for B's triangles; `stop` is asked before each pair.
+/// B's inside): a triangle of one leaf is tried only when its box meets the other leaf's box;
+/// none when those triangles are apart along the normal of the first of them on either side
+/// ([`predicates::apart_along`]); each triangle is read, boxed and prepared
+/// ([`tri_tri::Prepared`]) once. The pair found is classified again with its segment, as
+/// [`tri_tri::classify`] gives it. `room` is room for the near triangles of each side; `stop`
+/// is asked before each pair.
 fn first_in_leaves<A, B>(
     (a, la, box_a, b, lb, box_b): Leaves<'_, A, B>,
-    near_b: &mut Vec<(u32, tri_tri::Prepared, Aabb)>,
+    room: &mut LeafRoom,
     stop: &dyn Fn() -> bool,
 ) -> Option<PairFinding>
 where
@@ -861,37 +870,54 @@ where
     B: TriMesh + ?Sized,
 {
     let tol = Tolerances::default();
-    near_b.clear();
-    for &t in lb {
-        let tt = b.triangle(t);
-        let bt = Aabb::of_triangle(&tt);
-        if tol.boxes_may_meet(box_a, &bt) {
-            near_b.push((t, tri_tri::Prepared::new(tt), bt));
+    let (near_a, near_b, facts_b) = (&mut room.0, &mut room.1, &mut room.2);
+    let near = |m: &dyn Fn(u32) -> [DVec3; 3], leaf: &[u32], other: &Aabb, out: &mut Vec<Near>| {
+        out.clear();
+        for &t in leaf {
+            let tt = m(t);
+            let bt = Aabb::of_triangle(&tt);
+            if tol.boxes_may_meet(other, &bt) {
+                out.push((t, tt, bt));
+            }
         }
-    }
+    };
+    near(&|t| b.triangle(t), lb, box_a, near_b);
     if near_b.is_empty() {
         return None;
     }
-    for &s in la {
-        let ts = a.triangle(s);
-        let bs = Aabb::of_triangle(&ts);
-        if !tol.boxes_may_meet(&bs, box_b) {
-            continue;
-        }
-        let mut ps: Option<tri_tri::Prepared> = None;
-        for (t, pt, bt) in near_b.iter() {
-            if !tol.boxes_may_meet(&bs, bt) {
+    near(&|t| a.triangle(t), la, box_b, near_a);
+    // Two patches of surface near each other without meeting (a part in a bore, a face over
+    // another) are often apart along the normal of one of their triangles: no pair needs
+    // classifying then.
+    fn corners(l: &[Near]) -> impl Iterator<Item = &DVec3> {
+        l.iter().flat_map(|x| x.1.iter())
+    }
+    let normal = |l: &[Near]| l.first().map(|x| (x.1[1] - x.1[0]).cross(x.1[2] - x.1[0]));
+    if [normal(near_a), normal(near_b)]
+        .into_iter()
+        .flatten()
+        .any(|n| predicates::apart_along(n, corners(near_a), corners(near_b)))
+    {
+        return None;
+    }
+    facts_b.clear();
+    facts_b.resize_with(near_b.len(), || None);
+    for (s, ts, bs) in near_a.iter() {
+        let mut ps = None;
+        for ((t, tt, bt), pt) in near_b.iter().zip(facts_b.iter_mut()) {
+            if !tol.boxes_may_meet(bs, bt) {
                 continue;
             }
             if stop() {
                 return None;
             }
-            let ps = &*ps.get_or_insert_with(|| tri_tri::Prepared::new(ts));
+            let ps = &*ps.get_or_insert_with(|| tri_tri::Prepared::new(*ts));
+            let pt = &*pt.get_or_insert_with(|| tri_tri::Prepared::new(*tt));
             if tri_tri::classify_prepared(ps, pt, false).is_some() {
                 let h = tri_tri::classify_prepared(ps, pt, true).expect("the same pair meets");
                 let kind = if h.crossing { PairKind::Crossing } else { PairKind::Touching };
                 return Some(PairFinding {
-                    a: s,
+                    a: *s,
                     b: *t,
                     kind,
                     contact: Some(h.contact),
@@ -1181,6 +1207,68 @@ mod tests {
             }
         }
         assert!(met > 10 && missed > 5, "{met} met, {missed} missed");
+    }
+
+    /// An open tube of radius `r` around the z axis, `n` sides, `rings` rings from z = 0 to 4.
+    fn tube(r: f64, n: u32, rings: u32) -> Mesh {
+        let angle = |k: u32| std::f64::consts::TAU * k as f64 / n as f64;
+        let positions = (0..=rings)
+            .flat_map(|j| {
+                (0..n).map(move |k| {
+                    DVec3::new(r * angle(k).cos(), r * angle(k).sin(), 4.0 * j as f64 / rings as f64)
+                })
+            })
+            .collect();
+        let mut triangles = Vec::new();
+        for j in 0..rings {
+            for k in 0..n {
+                let (a, b) = (j * n + k, j * n + (k + 1) % n);
+                triangles.push([a, b, b + n]);
+                triangles.push([a, b + n, a + n]);
+            }
+        }
+        Mesh {
+            positions,
+            tri_object: vec![0; triangles.len()],
+            triangles,
+            objects: vec![crate::scene::mesh::Object { name: "tube".into(), ..Default::default() }],
+        }
+    }
+
+    /// Near misses, where leaves are set apart along a triangle's normal: a tube inside
+    /// another with clearances from 1e-9 to 1e-2, coincident, shifted sideways into it, and
+    /// turned about z (facets crossing). The first-contact search finds a pair exactly when
+    /// some pair meets (every pair classified), and it is a meeting pair.
+    #[test]
+    fn first_contact_on_near_misses_matches_every_pair() {
+        let outer = prepared(tube(1.0, 48, 12));
+        let (mut met, mut missed) = (0, 0);
+        for (gap, shift, turn) in [
+            (1.0e-9, 0.0, 0.0),
+            (1.0e-3, 0.0, 0.0),
+            (1.0e-2, 0.0, 0.3),
+            (0.0, 0.0, 0.0),
+            (1.0e-3, 2.0e-3, 0.0),
+            (1.0e-9, 0.0, 0.01),
+        ] {
+            let inner = prepared(tube(1.0 - gap, 48, 12));
+            let m = DMat4::from_translation(DVec3::new(shift, 0.0, 0.1)) * DMat4::from_rotation_z(turn);
+            let (pa, pb) = (outer.place(DMat4::IDENTITY).unwrap(), inner.place(m).unwrap());
+            let (ma, mb, ta, tb) = (pa.mesh(), pb.mesh(), pa.tree(), pb.tree());
+            let any = (0..ma.triangle_count() as u32).any(|s| {
+                (0..mb.triangle_count() as u32)
+                    .any(|t| crate::narrow::tri_tri::classify(&ma.triangle(s), &mb.triangle(t)).is_some())
+            });
+            let found = first_contact_sequential(&ma, &ta, &mb, &tb);
+            assert_eq!(found.is_some(), any, "gap {gap} shift {shift} turn {turn}");
+            if let Some(f) = found {
+                assert!(crate::narrow::tri_tri::classify(&ma.triangle(f.a), &mb.triangle(f.b)).is_some());
+                met += 1;
+            } else {
+                missed += 1;
+            }
+        }
+        assert!(met >= 2 && missed >= 2, "{met} met, {missed} missed");
     }
 
     /// Above [`SEQUENTIAL_FIRST_CONTACT`] triangles the first-contact search runs in parallel:

@@ -555,6 +555,37 @@ impl Kernel for Float {
     }
 }
 
+/// Rounding of an f64 projection `n · p` ([`apart_along`]), in ulps of
+/// `(|n_x| + |n_y| + |n_z|) · max_i |p_i|`: three products and two sums are within
+/// `γ_3 ≈ 1.5` ulps of that of the exact value; 4 covers it with room (the bound's own
+/// rounding included).
+pub const PROJECTION_ROUNDING_ULPS: f64 = 4.0;
+
+/// Exact: are the convex hulls of the points `xs` and `ys` strictly apart along the direction
+/// `n` (any f64 vector, taken as exact)? True when the f64 projections of one set all lie
+/// below those of the other by more than three times their rounding bound
+/// ([`PROJECTION_ROUNDING_ULPS`], plus [`FILTER_UNDERFLOW_ALLOWANCE`]): then every exact
+/// projection of the one is below every exact projection of the other, so no point is shared.
+/// False proves nothing (a zero or non-finite `n` always gives false).
+pub fn apart_along<'a>(
+    n: DVec3,
+    xs: impl Iterator<Item = &'a DVec3>,
+    ys: impl Iterator<Item = &'a DVec3>,
+) -> bool {
+    let range = |ps: &mut dyn Iterator<Item = &'a DVec3>| {
+        ps.fold((f64::INFINITY, f64::NEG_INFINITY, 0.0f64), |(lo, hi, m), p| {
+            let d = n.dot(*p);
+            (lo.min(d), hi.max(d), m.max(p.abs().max_element()))
+        })
+    };
+    let ((xlo, xhi, xm), (ylo, yhi, ym)) = (range(&mut { xs }), range(&mut { ys }));
+    let e = PROJECTION_ROUNDING_ULPS * f64::EPSILON * n.abs().element_sum() * xm.max(ym)
+        + FILTER_UNDERFLOW_ALLOWANCE;
+    // The computed difference is within one rounding of the exact one: above 3e, the exact
+    // difference exceeds 2e, the most the two projections' roundings can take off it.
+    ylo - xhi > 3.0 * e || xlo - yhi > 3.0 * e
+}
+
 /// How much f64 rounding may move a closed-form triangle–triangle distance between inputs whose
 /// coordinates are at most `scale` in magnitude: `DISTANCE_ROUNDING_ULPS` ulps of `scale`.
 /// The closest-pair search never prunes a node pair whose box distance is within this of the
@@ -897,6 +928,52 @@ impl BoxMap {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// `apart_along` never separates point sets that share a point, whatever the direction;
+    /// separates sets moved apart along the direction by far more than rounding; and, on small
+    /// integer inputs (every projection exact), is true only where the exact projections are
+    /// apart.
+    #[test]
+    fn apart_along_is_never_wrong() {
+        let mut next = crate::load::test_rng(0xA11A_5EED);
+        let mut unit = move || next(1 << 30) as f64 / (1u64 << 30) as f64 - 0.5;
+        let (mut separated, mut exact_true) = (0, 0);
+        for k in 0..3000 {
+            let scale = [1.0, 1.0e-6, 3.0e5][k % 3];
+            let n = DVec3::new(unit(), unit(), unit());
+            let xs: Vec<DVec3> = (0..6).map(|_| DVec3::new(unit(), unit(), unit()) * scale).collect();
+            let mut ys: Vec<DVec3> = (0..6).map(|_| DVec3::new(unit(), unit(), unit()) * scale).collect();
+            // A shared point: never apart.
+            ys[k % 6] = xs[(k / 6) % 6];
+            assert!(!apart_along(n, xs.iter(), ys.iter()), "{k}");
+            // Moved along n past the other set's projections: apart.
+            let span = xs.iter().chain(&ys).map(|p| n.dot(*p)).fold(0.0f64, |m, d| m.max(d.abs()));
+            let shift = n * (3.0 * span / n.length_squared() + 1.0e-9 * scale);
+            let moved: Vec<DVec3> = ys.iter().map(|p| *p + shift).collect();
+            separated += apart_along(n, xs.iter(), moved.iter()) as usize;
+            // Small integers: exact projections decide.
+            let int = |v: DVec3| (v * 16.0).round();
+            let (ni, xi, yi) = (
+                int(n),
+                xs.iter().map(|p| int(*p / scale)).collect::<Vec<_>>(),
+                ys.iter().map(|p| int(*p / scale) + int(n)).collect::<Vec<_>>(),
+            );
+            let proj = |ps: &[DVec3]| {
+                ps.iter()
+                    .map(|p| ni.dot(*p))
+                    .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), d| (lo.min(d), hi.max(d)))
+            };
+            let ((xlo, xhi), (ylo, yhi)) = (proj(&xi), proj(&yi));
+            if apart_along(ni, xi.iter(), yi.iter()) {
+                assert!(xhi < ylo || yhi < xlo, "{k}");
+                exact_true += 1;
+            }
+        }
+        assert!(separated > 2900, "{separated}");
+        assert!(exact_true > 100, "{exact_true}");
+        assert!(!apart_along(DVec3::ZERO, [DVec3::X].iter(), [DVec3::Y].iter()));
+        assert!(!apart_along(DVec3::splat(f64::NAN), [DVec3::X].iter(), [DVec3::Y].iter()));
+    }
 
     /// Collinearity with repeated vertices (the shortcut) and without agrees with the exact
     /// components of the normal, signed zeros included.
