@@ -725,8 +725,11 @@ pub fn no_meeting_triangles(a: &Placed, b: &Placed) -> bool {
         return true;
     }
     let (ra, rb) = (a.reach(), b.reach());
-    let near =
-        |o: &[Aabb], r: &Aabb| o.iter().filter(|x| tol.boxes_may_meet(x, r)).copied().collect::<Vec<_>>();
+    // At most 2^OUTLINE_DEPTH boxes each: kept on the stack (this runs for every candidate pair
+    // of a query).
+    let near = |o: &[Aabb], r: &Aabb| {
+        o.iter().filter(|x| tol.boxes_may_meet(x, r)).copied().collect::<smallvec::SmallVec<[Aabb; 64]>>()
+    };
     let (oa, ob) = (near(a.outline(), &rb), near(b.outline(), &ra));
     !oa.iter().any(|x| ob.iter().any(|y| tol.boxes_may_meet(x, y)))
 }
