@@ -945,7 +945,8 @@ fn shared_surface(x: &Aabb, y: &Aabb) -> f64 {
 /// the first meeting pair; when none meet, containment decides (left at `None`, not decided,
 /// when no vertex of either mesh lies in the other's box: nothing can be contained then).
 /// Without `all` (a yes/no question) containment is decided only as far as a clash
-/// ([`containment::decide_clash`]: the undefined inside of an open surface is not looked into).
+/// ([`containment::OpenInside::Skip`]: the undefined inside of an open surface is not looked
+/// into).
 pub fn collide(a: &Placed, b: &Placed, all: bool) -> Collision {
     let none = Collision { contacts: Vec::new(), containment: Containment::None };
     if surely_clear(a, b) || !a.bounds().overlaps(&b.bounds()) {
@@ -976,10 +977,8 @@ pub fn collide(a: &Placed, b: &Placed, all: bool) -> Collision {
         return none;
     }
     let (ma, mb) = (a.mesh(), b.mesh());
-    let containment = match all {
-        true => containment::decide(&ma, &ta, a.topology(), &mb, &tb, b.topology()),
-        false => containment::decide_clash(&ma, &ta, a.topology(), &mb, &tb, b.topology()),
-    };
+    let open = if all { containment::OpenInside::Explain } else { containment::OpenInside::Skip };
+    let containment = containment::decide(&ma, &ta, a.topology(), &mb, &tb, b.topology(), open);
     Collision { contacts, containment }
 }
 
@@ -1092,11 +1091,16 @@ mod tests {
     fn cube(at: DVec3) -> Mesh {
         let v = crate::testing::gen::box_corners(at, at + DVec3::ONE).to_vec();
         let t = crate::testing::gen::BOX_TRIANGLES.to_vec();
+        one_object(v, t, "cube")
+    }
+
+    /// A mesh of one object named `name`.
+    fn one_object(positions: Vec<DVec3>, triangles: Vec<[u32; 3]>, name: &str) -> Mesh {
         Mesh {
-            positions: v,
-            tri_object: vec![0; t.len()],
-            triangles: t,
-            objects: vec![crate::scene::mesh::Object { name: "cube".into(), ..Default::default() }],
+            positions,
+            tri_object: vec![0; triangles.len()],
+            triangles,
+            objects: vec![crate::scene::mesh::Object { name: name.into(), ..Default::default() }],
         }
     }
 
@@ -1156,12 +1160,26 @@ mod tests {
             }
             triangles.push([3 * t, 3 * t + 1, 3 * t + 2]);
         }
-        Mesh {
-            positions,
-            tri_object: vec![0; triangles.len()],
-            triangles,
-            objects: vec![crate::scene::mesh::Object { name: "soup".into(), ..Default::default() }],
+        one_object(positions, triangles, "soup")
+    }
+
+    /// The one-thread first-contact search on `pa` and `pb` finds a pair exactly when some pair
+    /// of their triangles meets (every pair classified), and the pair it finds is the finding
+    /// [`tri_tri::classify`] gives for it. Whether some pair meets.
+    fn first_contact_matches_every_pair(pa: &Placed, pb: &Placed, case: &str) -> bool {
+        let (ma, mb, ta, tb) = (pa.mesh(), pb.mesh(), pa.tree(), pb.tree());
+        let any = (0..ma.triangle_count() as u32).any(|s| {
+            (0..mb.triangle_count() as u32)
+                .any(|t| tri_tri::classify(&ma.triangle(s), &mb.triangle(t)).is_some())
+        });
+        let found = first_contact_sequential(&ma, &ta, &mb, &tb);
+        assert_eq!(found.is_some(), any, "{case}");
+        if let Some(f) = found {
+            let h = tri_tri::classify(&ma.triangle(f.a), &mb.triangle(f.b)).expect(case);
+            let got = (f.kind == PairKind::Crossing, f.contact, f.segment);
+            assert_eq!(got, (h.crossing, Some(h.contact), h.segment), "{case}");
         }
+        any
     }
 
     /// The first-contact walk (ordered by box overlap, children culled before they are walked,
@@ -1189,19 +1207,8 @@ mod tests {
             let pa = a.place(DMat4::from_translation(DVec3::new(0.25, 0.0, 0.0))).unwrap();
             for m in placements {
                 let pb = b.place(m).unwrap();
-                let (ma, mb, ta, tb) = (pa.mesh(), pb.mesh(), pa.tree(), pb.tree());
-                let any = (0..ma.triangle_count() as u32).any(|s| {
-                    (0..mb.triangle_count() as u32)
-                        .any(|t| crate::narrow::tri_tri::classify(&ma.triangle(s), &mb.triangle(t)).is_some())
-                });
-                let found = first_contact_sequential(&ma, &ta, &mb, &tb);
-                assert_eq!(found.is_some(), any, "seed {seed}");
-                if let Some(f) = found {
-                    let h = crate::narrow::tri_tri::classify(&ma.triangle(f.a), &mb.triangle(f.b)).unwrap();
-                    assert_eq!(
-                        (f.kind == PairKind::Crossing, f.contact, f.segment),
-                        (h.crossing, Some(h.contact), h.segment)
-                    );
+                let any = first_contact_matches_every_pair(&pa, &pb, &format!("seed {seed}"));
+                if any {
                     met += 1;
                 } else {
                     missed += 1;
@@ -1230,12 +1237,7 @@ mod tests {
                 triangles.push([a, b + n, a + n]);
             }
         }
-        Mesh {
-            positions,
-            tri_object: vec![0; triangles.len()],
-            triangles,
-            objects: vec![crate::scene::mesh::Object { name: "tube".into(), ..Default::default() }],
-        }
+        one_object(positions, triangles, "tube")
     }
 
     /// Near misses, where leaves are set apart along a triangle's normal: a tube inside
@@ -1257,15 +1259,7 @@ mod tests {
             let inner = prepared(tube(1.0 - gap, 48, 12));
             let m = DMat4::from_translation(DVec3::new(shift, 0.0, 0.1)) * DMat4::from_rotation_z(turn);
             let (pa, pb) = (outer.place(DMat4::IDENTITY).unwrap(), inner.place(m).unwrap());
-            let (ma, mb, ta, tb) = (pa.mesh(), pb.mesh(), pa.tree(), pb.tree());
-            let any = (0..ma.triangle_count() as u32).any(|s| {
-                (0..mb.triangle_count() as u32)
-                    .any(|t| crate::narrow::tri_tri::classify(&ma.triangle(s), &mb.triangle(t)).is_some())
-            });
-            let found = first_contact_sequential(&ma, &ta, &mb, &tb);
-            assert_eq!(found.is_some(), any, "gap {gap} shift {shift} turn {turn}");
-            if let Some(f) = found {
-                assert!(crate::narrow::tri_tri::classify(&ma.triangle(f.a), &mb.triangle(f.b)).is_some());
+            if first_contact_matches_every_pair(&pa, &pb, &format!("gap {gap} shift {shift} turn {turn}")) {
                 met += 1;
             } else {
                 missed += 1;

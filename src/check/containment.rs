@@ -493,7 +493,7 @@ fn one_way<I, O, T>(
     ot: &T,
     otopo: &Topology,
     name: &str,
-    explain_open: bool,
+    open: OpenInside,
 ) -> OneWay
 where
     I: TriMesh + ?Sized,
@@ -501,7 +501,7 @@ where
     T: Tree + ?Sized,
 {
     let n = it.component_seeds.len();
-    if !otopo.closed && !explain_open {
+    if !otopo.closed && open == OpenInside::Skip {
         return OneWay::Counts(0, n);
     }
     let ib = Aabb::of_points(inner.positions().iter());
@@ -550,6 +550,17 @@ where
     OneWay::Counts(state.iter().filter(|s| **s == Some(true)).count(), n)
 }
 
+/// Whether [`decide`] looks into the inside of an open surface.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum OpenInside {
+    /// Say where it is undefined and could matter ([`Containment::Undecided`], from the
+    /// generalized winding number at a vertex of the other part).
+    Explain,
+    /// Not looked into (no winding number is computed): for a yes/no question it could only
+    /// turn "no" into "undecided", which is no clash either. Every clash is the same.
+    Skip,
+}
+
 /// Decide containment both ways for two meshes with no meeting triangles.
 pub fn decide<A, TA, B, TB>(
     a: &A,
@@ -558,6 +569,7 @@ pub fn decide<A, TA, B, TB>(
     b: &B,
     tb: &TB,
     topo_b: &Topology,
+    open: OpenInside,
 ) -> Containment
 where
     A: TriMesh + ?Sized,
@@ -565,48 +577,8 @@ where
     B: TriMesh + ?Sized,
     TB: Tree + ?Sized,
 {
-    decide_as(a, ta, topo_a, b, tb, topo_b, true)
-}
-
-/// [`decide`] as far as a clash: the same answer when it is a clash, else
-/// [`Containment::None`] or [`Containment::Undecided`] (a ray that met an edge exactly), never
-/// the undefined inside of an open surface (no generalized winding number is computed: for a
-/// yes/no question it would only turn "no" into "undecided", which is no clash either).
-pub fn decide_clash<A, TA, B, TB>(
-    a: &A,
-    ta: &TA,
-    topo_a: &Topology,
-    b: &B,
-    tb: &TB,
-    topo_b: &Topology,
-) -> Containment
-where
-    A: TriMesh + ?Sized,
-    TA: Tree + ?Sized,
-    B: TriMesh + ?Sized,
-    TB: Tree + ?Sized,
-{
-    decide_as(a, ta, topo_a, b, tb, topo_b, false)
-}
-
-#[allow(clippy::too_many_arguments)]
-fn decide_as<A, TA, B, TB>(
-    a: &A,
-    ta: &TA,
-    topo_a: &Topology,
-    b: &B,
-    tb: &TB,
-    topo_b: &Topology,
-    explain_open: bool,
-) -> Containment
-where
-    A: TriMesh + ?Sized,
-    TA: Tree + ?Sized,
-    B: TriMesh + ?Sized,
-    TB: Tree + ?Sized,
-{
-    let ab = one_way(a, topo_a, b, tb, topo_b, "b", explain_open);
-    let ba = one_way(b, topo_b, a, ta, topo_a, "a", explain_open);
+    let ab = one_way(a, topo_a, b, tb, topo_b, "b", open);
+    let ba = one_way(b, topo_b, a, ta, topo_a, "a", open);
     match (ab, ba) {
         (OneWay::Counts(i, n), _) if i > 0 && i == n => Containment::AInB,
         (_, OneWay::Counts(i, n)) if i > 0 && i == n => Containment::BInA,
@@ -1027,11 +999,12 @@ mod tests {
         let (to, ti) =
             (Bvh::build(&outer, BuildOptions::default()), Bvh::build(&inner, BuildOptions::default()));
         let (po, pi) = (topology(&outer), topology(&inner));
-        assert_eq!(decide(&inner, &ti, &pi, &outer, &to, &po), Containment::AInB);
-        assert_eq!(decide(&outer, &to, &po, &inner, &ti, &pi), Containment::BInA);
+        let explain = OpenInside::Explain;
+        assert_eq!(decide(&inner, &ti, &pi, &outer, &to, &po, explain), Containment::AInB);
+        assert_eq!(decide(&outer, &to, &po, &inner, &ti, &pi, explain), Containment::BInA);
         let apart = cube(DVec3::splat(20.0), DVec3::splat(21.0));
         let ta = Bvh::build(&apart, BuildOptions::default());
-        assert_eq!(decide(&apart, &ta, &topology(&apart), &outer, &to, &po), Containment::None);
+        assert_eq!(decide(&apart, &ta, &topology(&apart), &outer, &to, &po, explain), Containment::None);
     }
 
     /// The yes/no containment equals the full one wherever either is a clash; it differs only
@@ -1053,8 +1026,8 @@ mod tests {
         let mut undefined = 0;
         for (a, ta, pa) in &built {
             for (b, tb, pb) in &built {
-                let full = decide(*a, ta, pa, *b, tb, pb);
-                let clash = decide_clash(*a, ta, pa, *b, tb, pb);
+                let full = decide(*a, ta, pa, *b, tb, pb, OpenInside::Explain);
+                let clash = decide(*a, ta, pa, *b, tb, pb, OpenInside::Skip);
                 if full.is_clash() || clash.is_clash() {
                     assert_eq!(full, clash);
                 } else if full != clash {

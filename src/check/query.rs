@@ -924,7 +924,7 @@ impl PairPhase {
                 match touching {
                     Some(c) => c,
                     None if volumes_overlap(a, ta_, b, tb_, &pairs) => Containment::VolumesOverlap,
-                    None => containment::decide(a, ta, ta_, b, tb, tb_),
+                    None => containment::decide(a, ta, ta_, b, tb, tb_, containment::OpenInside::Explain),
                 }
             }
         };
