@@ -21,6 +21,7 @@ use crate::narrow::convex::{self, Penetration, Polytope, Surface};
 use crate::narrow::tri_tri;
 use crate::scene::mesh::{Mesh, TriMesh};
 use glam::DMat4;
+use smallvec::SmallVec;
 use std::path::{Path, PathBuf};
 use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
 use std::sync::{Arc, OnceLock};
@@ -728,7 +729,7 @@ pub fn no_meeting_triangles(a: &Placed, b: &Placed) -> bool {
     // At most 2^OUTLINE_DEPTH boxes each: kept on the stack (this runs for every candidate pair
     // of a query).
     let near = |o: &[Aabb], r: &Aabb| {
-        o.iter().filter(|x| tol.boxes_may_meet(x, r)).copied().collect::<smallvec::SmallVec<[Aabb; 64]>>()
+        o.iter().filter(|x| tol.boxes_may_meet(x, r)).copied().collect::<SmallVec<[Aabb; 64]>>()
     };
     let (oa, ob) = (near(a.outline(), &rb), near(b.outline(), &ra));
     !oa.iter().any(|x| ob.iter().any(|y| tol.boxes_may_meet(x, y)))
@@ -768,7 +769,7 @@ where
         tb,
         |x, y| !stop.load(Ordering::Relaxed) && tol.boxes_may_meet(x, y),
         |la, lb, out| {
-            let mut room = (Vec::with_capacity(la.len()), Vec::with_capacity(lb.len()), Vec::new());
+            let mut room = LeafRoom::default();
             let everywhere = Aabb { min: DVec3::NEG_INFINITY, max: DVec3::INFINITY };
             let leaves = (a, la, &everywhere, b, lb, &everywhere);
             if let Some(p) = first_in_leaves(leaves, &mut room, &|| stop.load(Ordering::Relaxed)) {
@@ -813,7 +814,7 @@ where
     // trees, plus one).
     let mut stack = Vec::with_capacity(64);
     stack.push((0u32, 0u32, root_a, root_b));
-    let mut room = (Vec::with_capacity(16), Vec::with_capacity(16), Vec::with_capacity(16));
+    let mut room = LeafRoom::default();
     while let Some((i, j, bi, bj)) = stack.pop() {
         let open_a = match (ta.is_leaf(i), tb.is_leaf(j)) {
             (true, true) => {
@@ -853,8 +854,9 @@ type Leaves<'a, A, B> = (&'a A, &'a [u32], &'a Aabb, &'a B, &'a [u32], &'a Aabb)
 type Near = (u32, [DVec3; 3], Aabb);
 
 /// Room for [`first_in_leaves`]: the near triangles of each leaf, and the classifier facts of
-/// B's, prepared when some pair needs them.
-type LeafRoom = (Vec<Near>, Vec<Near>, Vec<Option<tri_tri::Prepared>>);
+/// B's, prepared when some pair needs them (on the stack for leaves of up to 8 triangles; the
+/// default leaves hold 4).
+type LeafRoom = (SmallVec<[Near; 8]>, SmallVec<[Near; 8]>, SmallVec<[Option<tri_tri::Prepared>; 8]>);
 
 /// The first triangle pair of two leaves that meets, in leaf order (A's triangles outside,
 /// B's inside): a triangle of one leaf is tried only when its box meets the other leaf's box;
@@ -874,7 +876,7 @@ where
 {
     let tol = Tolerances::default();
     let (near_a, near_b, facts_b) = (&mut room.0, &mut room.1, &mut room.2);
-    let near = |m: &dyn Fn(u32) -> [DVec3; 3], leaf: &[u32], other: &Aabb, out: &mut Vec<Near>| {
+    let near = |m: &dyn Fn(u32) -> [DVec3; 3], leaf: &[u32], other: &Aabb, out: &mut SmallVec<[Near; 8]>| {
         out.clear();
         for &t in leaf {
             let tt = m(t);
