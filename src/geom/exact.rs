@@ -27,14 +27,10 @@ pub struct Int {
     mag: Mag,
 }
 
-/// Drop high zero limbs.
-pub(crate) fn trim_in(m: &mut Mag) {
+/// `m` without its high zero limbs.
+pub(crate) fn trim(mut m: Mag) -> Mag {
     let n = m.iter().rposition(|&l| l != 0).map_or(0, |i| i + 1);
     m.truncate(n);
-}
-
-pub(crate) fn trim(mut m: Mag) -> Mag {
-    trim_in(&mut m);
     m
 }
 
@@ -42,16 +38,10 @@ pub(crate) fn cmp_mag(a: &[u32], b: &[u32]) -> Ordering {
     a.len().cmp(&b.len()).then_with(|| a.iter().rev().cmp(b.iter().rev()))
 }
 
+/// `a + b`.
 pub(crate) fn add_mag(a: &[u32], b: &[u32]) -> Mag {
-    let mut out = Mag::new();
-    add_into(&mut out, a, b);
-    out
-}
-
-/// `out = a + b` (`out` empty on entry).
-fn add_into(out: &mut Mag, a: &[u32], b: &[u32]) {
     let (long, short) = if a.len() >= b.len() { (a, b) } else { (b, a) };
-    out.resize(long.len() + 1, 0);
+    let mut out = Mag::from_elem(0, long.len() + 1);
     let o = out.as_mut_slice();
     let mut carry = 0u64;
     for i in 0..long.len() {
@@ -60,19 +50,12 @@ fn add_into(out: &mut Mag, a: &[u32], b: &[u32]) {
         carry = s >> 32;
     }
     o[long.len()] = carry as u32;
-    trim_in(out);
+    trim(out)
 }
 
 /// `a - b` for `|a| >= |b|`.
 pub(crate) fn sub_mag(a: &[u32], b: &[u32]) -> Mag {
-    let mut out = Mag::new();
-    sub_into(&mut out, a, b);
-    out
-}
-
-/// `out = a - b` for `|a| >= |b|` (`out` empty on entry).
-fn sub_into(out: &mut Mag, a: &[u32], b: &[u32]) {
-    out.resize(a.len(), 0);
+    let mut out = Mag::from_elem(0, a.len());
     let o = out.as_mut_slice();
     let mut borrow = 0i64;
     for i in 0..a.len() {
@@ -81,21 +64,15 @@ fn sub_into(out: &mut Mag, a: &[u32], b: &[u32]) {
         d += borrow << 32;
         o[i] = d as u32;
     }
-    trim_in(out);
+    trim(out)
 }
 
+/// `a · b`.
 pub(crate) fn mul_mag(a: &[u32], b: &[u32]) -> Mag {
-    let mut out = Mag::new();
-    mul_into(&mut out, a, b);
-    out
-}
-
-/// `out = a · b` (`out` empty on entry).
-fn mul_into(out: &mut Mag, a: &[u32], b: &[u32]) {
     if a.is_empty() || b.is_empty() {
-        return;
+        return Mag::new();
     }
-    out.resize(a.len() + b.len(), 0);
+    let mut out = Mag::from_elem(0, a.len() + b.len());
     let o = out.as_mut_slice();
     for (i, &x) in a.iter().enumerate() {
         let row = &mut o[i..i + b.len() + 1];
@@ -108,35 +85,28 @@ fn mul_into(out: &mut Mag, a: &[u32], b: &[u32]) {
         }
         *last = carry as u32;
     }
-    trim_in(out);
+    trim(out)
 }
 
 impl Int {
-    fn new(neg: bool, mut mag: Mag) -> Int {
-        trim_in(&mut mag);
+    fn new(neg: bool, mag: Mag) -> Int {
+        let mag = trim(mag);
         Int { neg: neg && !mag.is_empty(), mag }
     }
 
     /// The integer `v`.
     pub fn from_i64(v: i64) -> Int {
         let m = v.unsigned_abs();
-        let mut r = Int::default();
-        r.mag.extend_from_slice(&[m as u32, (m >> 32) as u32]);
-        trim_in(&mut r.mag);
-        r.neg = v < 0;
-        r
+        Int::new(v < 0, Mag::from_slice(&[m as u32, (m >> 32) as u32]))
     }
 
     /// `m · 2^shift` for a non-negative `shift`.
     fn from_parts(neg: bool, m: u64, shift: u32) -> Int {
         let (limbs, bits) = ((shift / 32) as usize, shift % 32);
         let wide = (m as u128) << bits;
-        let mut r = Int::default();
-        r.mag.resize(limbs, 0);
-        r.mag.extend_from_slice(&[wide as u32, (wide >> 32) as u32, (wide >> 64) as u32]);
-        trim_in(&mut r.mag);
-        r.neg = neg && !r.mag.is_empty();
-        r
+        let mut mag = Mag::from_elem(0, limbs);
+        mag.extend_from_slice(&[wide as u32, (wide >> 32) as u32, (wide >> 64) as u32]);
+        Int::new(neg, mag)
     }
 
     /// -1, 0 or 1.
@@ -152,19 +122,13 @@ impl Int {
 
     /// `self + (-1)^o_neg · |o|`.
     fn add_signed(&self, o: &Int, o_neg: bool) -> Int {
-        let mut r = Int::default();
         if self.neg == o_neg {
-            add_into(&mut r.mag, &self.mag, &o.mag);
-            r.neg = self.neg;
+            Int::new(self.neg, add_mag(&self.mag, &o.mag))
         } else if cmp_mag(&self.mag, &o.mag) == Ordering::Less {
-            sub_into(&mut r.mag, &o.mag, &self.mag);
-            r.neg = o_neg;
+            Int::new(o_neg, sub_mag(&o.mag, &self.mag))
         } else {
-            sub_into(&mut r.mag, &self.mag, &o.mag);
-            r.neg = self.neg;
+            Int::new(self.neg, sub_mag(&self.mag, &o.mag))
         }
-        r.neg &= !r.mag.is_empty();
-        r
     }
 
     /// `self + o`.
@@ -189,10 +153,7 @@ impl Int {
 
     /// `self · o`.
     pub fn mul(&self, o: &Int) -> Int {
-        let mut r = Int::default();
-        mul_into(&mut r.mag, &self.mag, &o.mag);
-        r.neg = self.neg != o.neg && !r.mag.is_empty();
-        r
+        Int::new(self.neg != o.neg, mul_mag(&self.mag, &o.mag))
     }
 
     /// `(m, e)` with `self ≈ m · 2^e`, `m` the leading 65 to 96 bits as an f64 (a relative
