@@ -249,11 +249,9 @@ impl PartKey {
         let shapes: HashMap<u32, Shape> = leaders
             .par_iter()
             .map(|&(m, j)| {
-                // The loader placed every part and found it finite: placing again cannot fail
-                // (an empty part would give a key no expanded part has: a miss, never a hit).
-                let (positions, triangles) = scene.place(parts[j].object as usize).unwrap_or_default();
-                let one = Mesh { positions, triangles, ..Mesh::default() };
-                let all: Vec<u32> = (0..one.triangles.len() as u32).collect();
+                // Placed alone (an empty part, if placing ever failed, would give a key no
+                // expanded part has: a miss, never a hit).
+                let (one, all) = crate::check::assembly::Source::Placed(scene).part_mesh(parts[j]);
                 (m, Shape::of(&one, &all))
             })
             .collect();

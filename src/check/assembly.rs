@@ -173,20 +173,29 @@ pub enum Source<'a> {
 }
 
 impl<'a> Source<'a> {
-    /// The layout of `part` (see [`Layout`]).
-    fn layout(self, part: &Part) -> Layout {
+    /// The mesh `part` is read from and its triangles there: the loaded mesh and the part's
+    /// triangle numbers (borrowed), or the part placed alone ([`placed_part`]) and all of its
+    /// triangles.
+    pub(crate) fn part_mesh<'p>(self, part: &'p Part) -> (Cow<'a, Mesh>, Cow<'p, [u32]>) {
         match self {
-            Source::Loaded(m) => Layout::of(m, &part.triangles),
+            Source::Loaded(m) => (Cow::Borrowed(m), Cow::Borrowed(&part.triangles)),
             Source::Placed(s) => {
                 let one = placed_part(s, part.object as usize);
-                Layout::of(&one, &(0..one.triangles.len() as u32).collect::<Vec<_>>())
+                let all = (0..one.triangles.len() as u32).collect();
+                (Cow::Owned(one), Cow::Owned(all))
             }
         }
     }
 
+    /// The layout of `part` (see [`Layout`]).
+    fn layout(self, part: &Part) -> Layout {
+        let (mesh, triangles) = self.part_mesh(part);
+        Layout::of(&mesh, &triangles)
+    }
+
     /// The vertex offset that makes `inst` read like `leader` (see [`shift_of`]). Placed, the
     /// instances of one glTF mesh index their own vertices alike.
-    fn shift(self, leader: &Part, inst: &Part) -> Option<i64> {
+    pub(crate) fn shift(self, leader: &Part, inst: &Part) -> Option<i64> {
         match self {
             Source::Loaded(m) => shift_of(m, leader, inst),
             Source::Placed(_) => (leader.gltf_mesh == inst.gltf_mesh
@@ -198,7 +207,7 @@ impl<'a> Source<'a> {
 
     /// The world coordinates `part`'s layout indexes: the loaded mesh's (borrowed), or the part
     /// placed.
-    fn world(self, part: &Part) -> Cow<'a, [DVec3]> {
+    pub(crate) fn world(self, part: &Part) -> Cow<'a, [DVec3]> {
         match self {
             Source::Loaded(m) => Cow::Borrowed(&m.positions),
             Source::Placed(s) => Cow::Owned(s.place_positions(part.object as usize)),
@@ -206,7 +215,7 @@ impl<'a> Source<'a> {
     }
 
     /// The glTF world matrix of `part`, if known.
-    fn matrix(self, part: &Part) -> Option<glam::DMat4> {
+    pub(crate) fn matrix(self, part: &Part) -> Option<glam::DMat4> {
         match self {
             Source::Loaded(m) => m.objects[part.object as usize].world,
             Source::Placed(s) => Some(s.parts[part.object as usize].world),
@@ -306,7 +315,7 @@ impl<'l> Views<'l> {
 /// The affine map from `leader`'s world coordinates to `inst`'s: `world(inst) · world(leader)⁻¹`
 /// from the glTF node matrices, as [`BoxMap`] rows. `None` without matrices or for a singular
 /// leader matrix.
-fn relative_rows(leader: Option<glam::DMat4>, inst: Option<glam::DMat4>) -> Option<[[f64; 4]; 3]> {
+pub(crate) fn relative_rows(leader: Option<glam::DMat4>, inst: Option<glam::DMat4>) -> Option<[[f64; 4]; 3]> {
     let (l, i) = (leader?, inst?);
     let det = l.determinant();
     if det == 0.0 || !det.is_finite() {

@@ -10,10 +10,10 @@
 //! (see [`owned_tree_bytes`]) and the merge adds them up.
 
 use crate::bvh::{BuildOptions, Bvh, Node};
-use crate::check::assembly::{Part, Sharing, Source};
+use crate::check::assembly::{relative_rows, Part, Sharing, Source};
 use crate::geom::predicates::BoxMap;
 use crate::geom::{Aabb, DVec3};
-use crate::scene::mesh::{Mesh, Object};
+use crate::scene::mesh::Mesh;
 use std::collections::{BTreeMap, HashMap};
 
 /// How each needed part gets its tree: its own (`leader == part`) or its leader's.
@@ -25,52 +25,22 @@ pub struct Grouping {
     plan: BTreeMap<usize, (usize, i64, usize)>,
 }
 
-fn shift_of(mesh: &Mesh, leader: &Part, inst: &Part) -> Option<i64> {
-    if leader.triangles.len() != inst.triangles.len() || leader.triangles.is_empty() {
-        return None;
-    }
-    let first = |p: &Part| mesh.triangles[p.triangles[0] as usize][0] as i64;
-    let shift = first(inst) - first(leader);
-    let same = leader.triangles.iter().zip(&inst.triangles).all(|(&l, &i)| {
-        let (l, i) = (mesh.triangles[l as usize], mesh.triangles[i as usize]);
-        (0..3).all(|k| i[k] as i64 == l[k] as i64 + shift)
-    });
-    same.then_some(shift)
-}
-
-fn relative_rows(leader: &Object, inst: &Object) -> Option<[[f64; 4]; 3]> {
-    let (l, i) = (leader.world?, inst.world?);
-    let det = l.determinant();
-    if det == 0.0 || !det.is_finite() {
-        return None;
-    }
-    let r = i * l.inverse();
-    Some([0, 1, 2].map(|k| [r.x_axis[k], r.y_axis[k], r.z_axis[k], r.w_axis[k]]))
-}
-
 /// Group the `needed` parts (ascending) as the check does.
 pub fn group(meshes: [&Mesh; 2], parts: &[Part], needed: &[usize]) -> Grouping {
     group_from([Source::Loaded(meshes[0]), Source::Loaded(meshes[1])], parts, needed)
 }
 
-/// [`group`] over parts read from `sources` (by input). Placed, the instances of one glTF mesh
-/// index their own vertices alike (as the check reads them).
+/// [`group`] over parts read from `sources` (by input), with the check's shift test
+/// ([`Source::shift`]).
 fn group_from(sources: [Source<'_>; 2], parts: &[Part], needed: &[usize]) -> Grouping {
     let mut leader_of_mesh: HashMap<(u8, u32), usize> = HashMap::new();
     let mut own = Vec::new();
     let mut plan: BTreeMap<usize, (usize, i64, usize)> = BTreeMap::new();
-    let shift = |src: Source<'_>, leader: &Part, inst: &Part| match src {
-        Source::Loaded(mesh) => shift_of(mesh, leader, inst),
-        Source::Placed(_) => (leader.gltf_mesh == inst.gltf_mesh
-            && leader.triangles.len() == inst.triangles.len()
-            && !leader.triangles.is_empty())
-        .then_some(0),
-    };
     for &i in needed {
         let src = sources[parts[i].input as usize];
         let shared = parts[i].gltf_mesh.and_then(|m| {
             let l = *leader_of_mesh.entry((parts[i].input, m)).or_insert(i);
-            let shift = if l == i { None } else { shift(src, &parts[l], &parts[i]) }?;
+            let shift = if l == i { None } else { src.shift(&parts[l], &parts[i]) }?;
             let (layout, _, _) = *plan.get(&l)?;
             Some((layout, shift, l))
         });
@@ -88,10 +58,11 @@ pub fn tree_bytes(t: &Bvh) -> usize {
     t.nodes.len() * std::mem::size_of::<Node>() + t.prims.len() * 4
 }
 
-/// The tree the check builds for own-tree part `part` (over its triangles' world boxes).
-pub fn build_tree(mesh: &Mesh, part: &Part, opts: BuildOptions) -> Bvh {
+/// The tree the check builds for an own-tree part, whose triangles in `mesh` are `triangles`
+/// (over their world boxes).
+fn build_tree(mesh: &Mesh, triangles: &[u32], opts: BuildOptions) -> Bvh {
     let boxes: Vec<Aabb> =
-        part.triangles.iter().map(|&t| Aabb::of_triangle(&crate::bvh::triangle(mesh, t))).collect();
+        triangles.iter().map(|&t| Aabb::of_triangle(&crate::bvh::triangle(mesh, t))).collect();
     Bvh::build_from_boxes(&boxes, opts)
 }
 
@@ -117,23 +88,10 @@ pub fn owned_tree_bytes_from(
     owned
         .par_iter()
         .map(|&i| {
-            let bytes = match sources[parts[i].input as usize] {
-                Source::Loaded(mesh) => tree_bytes(&build_tree(mesh, &parts[i], opts)),
-                Source::Placed(scene) => {
-                    let (one, all) = placed(scene, &parts[i]);
-                    tree_bytes(&build_tree(&one, &Part { triangles: all, ..parts[i].clone() }, opts))
-                }
-            };
-            (i, bytes as u64)
+            let (mesh, triangles) = sources[parts[i].input as usize].part_mesh(&parts[i]);
+            (i, tree_bytes(&build_tree(&mesh, &triangles, opts)) as u64)
         })
         .collect()
-}
-
-/// Part `part` of `scene` placed, as a mesh, and the list of all its triangles.
-fn placed(scene: &crate::load::InstancedScene, part: &Part) -> (Mesh, Vec<u32>) {
-    let one = crate::check::assembly::placed_part(scene, part.object as usize);
-    let all = (0..one.triangles.len() as u32).collect();
-    (one, all)
 }
 
 /// The layout of one own-tree part: (part-local vertices, bytes kept, vertex map or a run start).
@@ -146,8 +104,8 @@ struct Layout {
 }
 
 impl Layout {
-    fn of(mesh: &Mesh, part: &Part) -> Layout {
-        let (tris, vmap) = mesh.reindex(&part.triangles);
+    fn of(mesh: &Mesh, triangles: &[u32]) -> Layout {
+        let (tris, vmap) = mesh.reindex(triangles);
         let run = vmap.first().copied().filter(|&s| vmap.iter().zip(s..).all(|(&v, w)| v == w));
         let kept_map = if run.is_some() { 0 } else { vmap.len() };
         Layout { tris: tris.len(), vertices: vmap.len(), bytes: tris.len() * 12 + kept_map * 4, vmap, run }
@@ -202,35 +160,16 @@ pub fn sharing_lazy_from(
     sizes: impl FnOnce(&[usize], &[usize]) -> Result<HashMap<usize, u64>, usize>,
 ) -> Result<(usize, Sharing), usize> {
     use rayon::prelude::*;
-    use std::borrow::Cow;
     let g = group_from(sources, parts, needed);
     let src_of = |i: usize| sources[parts[i].input as usize];
     let layouts: Vec<Layout> = g
         .own
         .par_iter()
-        .map(|&i| match src_of(i) {
-            Source::Loaded(mesh) => Layout::of(mesh, &parts[i]),
-            Source::Placed(scene) => {
-                let (one, all) = placed(scene, &parts[i]);
-                Layout::of(&one, &Part { triangles: all, ..parts[i].clone() })
-            }
+        .map(|&i| {
+            let (mesh, triangles) = src_of(i).part_mesh(&parts[i]);
+            Layout::of(&mesh, &triangles)
         })
         .collect();
-    let world_of = |i: usize| -> Cow<'_, [DVec3]> {
-        match src_of(i) {
-            Source::Loaded(mesh) => Cow::Borrowed(&mesh.positions),
-            Source::Placed(scene) => Cow::Owned(scene.place_positions(parts[i].object as usize)),
-        }
-    };
-    let object_of = |i: usize| -> Cow<'_, Object> {
-        match src_of(i) {
-            Source::Loaded(mesh) => Cow::Borrowed(&mesh.objects[parts[i].object as usize]),
-            Source::Placed(scene) => {
-                let p = &scene.parts[parts[i].object as usize];
-                Cow::Owned(Object { name: String::new(), gltf_mesh: Some(p.mesh), world: Some(p.world) })
-            }
-        }
-    };
     // Instances: a box map when one fits, else a refitted copy (same size as the leader's tree).
     let instances: Vec<(usize, usize, i64, usize)> = g
         .plan
@@ -241,15 +180,12 @@ pub fn sharing_lazy_from(
     let mapped: Vec<(usize, bool)> = instances
         .par_iter()
         .map(|&(i, layout, shift, l)| {
-            let lay = &layouts[layout];
-            let rows = relative_rows(&object_of(l), &object_of(i));
+            let (lay, src) = (&layouts[layout], src_of(i));
+            let rows = relative_rows(src.matrix(&parts[l]), src.matrix(&parts[i]));
             let fits = rows.is_some_and(|r| {
                 // Loaded, both read the one mesh's vertices (the instance `shift` apart); placed,
                 // each its own.
-                let (wl, wi) = match src_of(i) {
-                    Source::Loaded(_) => (world_of(i), world_of(i)),
-                    Source::Placed(_) => (world_of(l), world_of(i)),
-                };
+                let (wl, wi) = (src.world(&parts[l]), src.world(&parts[i]));
                 let pairs =
                     (0..lay.vertices as u32).map(|v| (lay.vertex(&wl, v, 0), lay.vertex(&wi, v, shift)));
                 BoxMap::fit(r, &parts[l].bounds, pairs).is_some()
