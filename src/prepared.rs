@@ -125,23 +125,9 @@ impl Prepared {
     /// the world coordinates (a vertex not finite or beyond the exact range) are raised here:
     /// when the box does not show every vertex clear of them, the vertices are placed now.
     pub fn place(self: &Arc<Self>, m: DMat4) -> Result<Placed> {
-        let placed = |reach: Aabb, laid: OnceLock<Laid>| Placed {
-            prepared: self.clone(),
-            transform: m,
-            reach,
-            coarse: None,
-            outline: OnceLock::new(),
-            laid,
-            reads: AtomicUsize::new(0),
-            topology: OnceLock::new(),
-            convex: OnceLock::new(),
-            translated: OnceLock::new(),
-            ball: OnceLock::new(),
-            id: next_id(),
-        };
         if m == DMat4::IDENTITY {
             let laid = Laid { world: None, tree: Mapping::Own, root: self.root };
-            return Ok(placed(self.root, OnceLock::from(laid)));
+            return Ok(self.placed(m, self.root, OnceLock::from(laid)));
         }
         let rows = rows_of(&m);
         if let Some((coarse, map)) =
@@ -150,7 +136,7 @@ impl Prepared {
             let reach = coarse.map_box(&self.root);
             let bound = reach.min.abs().max(reach.max.abs()).max_element();
             if bound.is_finite() && bound <= predicates::MAX_EXACT_MAGNITUDE {
-                let mut p = placed(reach, OnceLock::new());
+                let mut p = self.placed(m, reach, OnceLock::new());
                 p.coarse = Some((coarse, map));
                 // When every vertex is a triangle's, the outline's boxes hold them all: their
                 // union is a tighter box for a rotated mesh.
@@ -183,20 +169,26 @@ impl Prepared {
             world.push(w);
         }
         let laid = self.lay(&m, world);
-        Ok(Placed {
+        Ok(self.placed(m, laid.root, OnceLock::from(laid)))
+    }
+
+    /// A fresh placement under `m` with box `reach` and what is computed of it (`laid`):
+    /// nothing else found yet.
+    fn placed(self: &Arc<Self>, m: DMat4, reach: Aabb, laid: OnceLock<Laid>) -> Placed {
+        Placed {
             prepared: self.clone(),
             transform: m,
-            reach: laid.root,
+            reach,
             coarse: None,
             outline: OnceLock::new(),
-            laid: OnceLock::from(laid),
+            laid,
             reads: AtomicUsize::new(0),
             topology: OnceLock::new(),
             convex: OnceLock::new(),
             translated: OnceLock::new(),
             ball: OnceLock::new(),
             id: next_id(),
-        })
+        }
     }
 
     /// The tree mapped onto the world coordinates `world` (placed by `m`, not the identity) and
